@@ -1,0 +1,28 @@
+// Image files: OpenEXR (linear) through tinyexr and PNG (8-bit sRGB) through
+// stb, both header-only so that the renderer needs no shared libraries.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "camhead/renderer/image.h"
+
+namespace camhead::renderer {
+
+class ImageError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// EXR: RGB (or Y) channels as linear float. PNG: 8/16-bit sRGB decoded to
+// linear. Returns a 3-channel image. Throws ImageError naming the file.
+[[nodiscard]] Image read_image(const std::filesystem::path &path);
+
+// Chosen by extension: .exr writes linear float32 (ZIP); .png writes 8-bit
+// sRGB, clipped to [0, 1] and rounded. 1-channel images are written as grey.
+void write_image(const std::filesystem::path &path, const Image &image);
+
+[[nodiscard]] float srgb_to_linear(float v);
+[[nodiscard]] float linear_to_srgb(float v);
+
+} // namespace camhead::renderer

@@ -1,0 +1,34 @@
+// Reads scene files (JSON, scene-format.md version 1) into the scene model.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "camhead/renderer/scene.h"
+
+namespace camhead::renderer {
+
+// A scene file that cannot be used. what() reads "FILE: FIELD: REASON", where
+// FIELD is a JSON path such as objects[2].radius.
+class SceneError : public std::runtime_error {
+public:
+  SceneError(std::string file, std::string field, std::string reason);
+  [[nodiscard]] const std::string &file() const { return file_; }
+  [[nodiscard]] const std::string &field() const { return field_; }
+  [[nodiscard]] const std::string &reason() const { return reason_; }
+
+private:
+  std::string file_, field_, reason_;
+};
+
+// Loads a scene with its meshes and plate. Throws SceneError on any problem
+// (unknown field, wrong type, out-of-range value, unreadable mesh or plate).
+[[nodiscard]] Scene load_scene(const std::filesystem::path &path);
+
+// Parses scene JSON text; relative mesh and plate paths resolve against
+// source.parent_path(). Throws SceneError naming `source`.
+[[nodiscard]] Scene parse_scene(std::string_view json_text, const std::filesystem::path &source);
+
+} // namespace camhead::renderer

@@ -1,0 +1,112 @@
+// Scene and frame layout shared by the GLSL kernels and the C++ host code.
+//
+// This header is included by GLSL (std430 buffers, std140 uniform block) and by
+// C++ (through renderer/src/kernel_types.h, which maps the GLSL vocabulary onto
+// glm). Every struct is built from vec4/uint quads so that std430 and C++ agree
+// without padding rules; the C++ side static_asserts the sizes.
+#ifndef CAMHEAD_RENDERER_LAYOUT_H
+#define CAMHEAD_RENDERER_LAYOUT_H
+
+// Primitive kinds, stored in bits 24..31 of Primitive.p0.w.
+#define PRIM_TRIANGLE 0u
+#define PRIM_SPHERE 1u
+// Bit 16 of Primitive.p0.w: the primitive belongs to the real proxy.
+#define PRIM_REAL_BIT 0x10000u
+#define PRIM_MATERIAL_MASK 0xffffu
+
+// One primitive, 48 bytes. Triangles store an edge form for Moeller-Trumbore.
+//   triangle: p0.xyz = v0, p1.xyz = v1 - v0, p2.xyz = v2 - v0
+//   sphere:   p0.xyz = centre, p1.x = radius
+//   p0.w = floatBitsFromUint(material | real << 16 | kind << 24)
+struct Primitive {
+  vec4 p0;
+  vec4 p1;
+  vec4 p2;
+};
+
+// Bounding volume hierarchy node, 32 bytes.
+//   bmin.xyz / bmax.xyz: bounds
+//   interior: bmax.w = 0, bmin.w = index of the left child; the right child
+//             follows it directly (left + 1)
+//   leaf:     bmax.w = primitive count > 0, bmin.w = first primitive
+//   (w fields hold uint bits)
+struct BvhNode {
+  vec4 bmin;
+  vec4 bmax;
+};
+
+#define MAT_DIFFUSE 0u
+#define MAT_MIRROR 1u
+#define MAT_GLASS 2u
+#define MAT_EMISSION 3u
+
+// color.rgb: albedo (diffuse), tint (mirror), radiance (emission), unused (glass)
+// params.x: index of refraction (glass); params.w: type (uint bits)
+struct Material {
+  vec4 color;
+  vec4 params;
+};
+
+#define LIGHT_POINT 0u
+#define LIGHT_AREA 1u
+#define LIGHT_SUN 2u
+
+// position.xyz: point / area centre; position.w: type (uint bits)
+// emission.rgb: point: radiant intensity (W/sr) x colour; area: radiance
+//               x colour; sun: irradiance (W/m^2) x colour
+// axis_u.xyz, axis_v.xyz: area light full edge vectors (size[0], size[1])
+// normal.xyz: area: unit front normal; sun: unit direction the light travels
+// axis_u.w: area: surface area (m^2)
+struct Light {
+  vec4 position;
+  vec4 emission;
+  vec4 axis_u;
+  vec4 axis_v;
+  vec4 normal;
+};
+
+// Per-frame parameters (std140 uniform block; vec4 and uvec4 only).
+//
+// The camera frame is orthonormal: right, up, forward (forward = -Z of the
+// camera). focal_px is the projection focal length in pixels; lens.x the
+// aperture radius (m, 0 = pinhole); lens.y the focal-plane depth (m).
+struct FrameParams {
+  vec4 cam_position;
+  vec4 cam_right;
+  vec4 cam_up;
+  vec4 cam_forward;
+  vec4 lens;            // x: aperture radius, y: focus depth, z: focal_px, w: unused
+  vec4 world_color;     // rgb
+  uvec4 image;          // x: width, y: height, z: has_plate, w: light count
+  uvec4 sampling;       // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
+  uvec4 tracing;        // x: max_bounces, y: primitive count, z: node count, w: flags
+};
+
+// Descriptor bindings, one set shared by the trace and resolve kernels.
+#define BINDING_PRIMITIVES 0
+#define BINDING_NODES 1
+#define BINDING_MATERIALS 2
+#define BINDING_LIGHTS 3
+#define BINDING_FRAME 4          // uniform FrameParams
+#define BINDING_ACCUM_MIXED 5    // vec4 per pixel: sum of mixed radiance (rgb), sum of mask (a)
+#define BINDING_ACCUM_REAL 6     // vec4 per pixel: sum of real radiance (rgb)
+#define BINDING_ACCUM_AUX 7      // vec4 per pixel: x sum of hit depth, y number of hits
+#define BINDING_PLATE 8          // vec4 per pixel: camera image I_c (rgb); unused without plate
+#define BINDING_OUT_COMPOSITE 9  // vec4 per pixel: I_f (rgb)
+#define BINDING_OUT_MIXED 10     // vec4 per pixel: I_m (rgb)
+#define BINDING_OUT_REAL 11      // vec4 per pixel: I_r (rgb)
+#define BINDING_OUT_AUX 12       // vec4 per pixel: x mask M, y mean hit depth (0 if none)
+#define BINDING_COUNT 13
+
+// The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to
+// the accumulators (the host clears them before the first batch); the resolve
+// kernel divides by sampling.z and composites.
+
+// Workgroup shape of both kernels (pixels).
+#define CAMHEAD_TILE_X 8
+#define CAMHEAD_TILE_Y 8
+
+// Shadow-ray and secondary-ray offsets are relative to the scene scale.
+#define CAMHEAD_RAY_EPSILON 1e-4f
+
+#endif
