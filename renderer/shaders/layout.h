@@ -75,11 +75,11 @@ struct FrameParams {
   vec4 cam_right;
   vec4 cam_up;
   vec4 cam_forward;
-  vec4 lens;            // x: aperture radius, y: focus depth, z: focal_px, w: unused
-  vec4 world_color;     // rgb
-  uvec4 image;          // x: width, y: height, z: has_plate, w: light count
-  uvec4 sampling;       // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
-  uvec4 tracing;        // x: max_bounces, y: primitive count, z: node count, w: flags
+  vec4 lens;        // x: aperture radius, y: focus depth, z: focal_px, w: pixel filter width (px)
+  vec4 world_color; // rgb
+  uvec4 image;      // x: width, y: height, z: has_plate, w: light count
+  uvec4 sampling; // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
+  uvec4 tracing;  // x: max_bounces, y: primitive count, z: node count, w: flags
 };
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.
@@ -87,15 +87,15 @@ struct FrameParams {
 #define BINDING_NODES 1
 #define BINDING_MATERIALS 2
 #define BINDING_LIGHTS 3
-#define BINDING_FRAME 4          // uniform FrameParams
-#define BINDING_ACCUM_MIXED 5    // vec4 per pixel: sum of mixed radiance (rgb), sum of mask (a)
-#define BINDING_ACCUM_REAL 6     // vec4 per pixel: sum of real radiance (rgb)
-#define BINDING_ACCUM_AUX 7      // vec4 per pixel: x sum of hit depth, y number of hits
-#define BINDING_PLATE 8          // vec4 per pixel: camera image I_c (rgb); unused without plate
-#define BINDING_OUT_COMPOSITE 9  // vec4 per pixel: I_f (rgb)
-#define BINDING_OUT_MIXED 10     // vec4 per pixel: I_m (rgb)
-#define BINDING_OUT_REAL 11      // vec4 per pixel: I_r (rgb)
-#define BINDING_OUT_AUX 12       // vec4 per pixel: x mask M, y mean hit depth (0 if none)
+#define BINDING_FRAME 4         // uniform FrameParams
+#define BINDING_ACCUM_MIXED 5   // vec4 per pixel: sum of mixed radiance (rgb), sum of mask (a)
+#define BINDING_ACCUM_REAL 6    // vec4 per pixel: sum of real radiance (rgb)
+#define BINDING_ACCUM_AUX 7     // vec4 per pixel: x sum of hit depth, y number of hits
+#define BINDING_PLATE 8         // vec4 per pixel: camera image I_c (rgb); unused without plate
+#define BINDING_OUT_COMPOSITE 9 // vec4 per pixel: I_f (rgb)
+#define BINDING_OUT_MIXED 10    // vec4 per pixel: I_m (rgb)
+#define BINDING_OUT_REAL 11     // vec4 per pixel: I_r (rgb)
+#define BINDING_OUT_AUX 12      // vec4 per pixel: x mask M, y mean hit depth (0 if none)
 #define BINDING_COUNT 13
 
 // The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to

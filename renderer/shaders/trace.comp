@@ -1,5 +1,19 @@
 #version 450
+// Adds a batch of samples per pixel to the accumulators (kernel.glsl).
 #extension GL_GOOGLE_include_directive : require
-#include "layout.h"
-layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
-void main() {}
+#include "buffers.glsl"
+#include "kernel.glsl"
+
+void main() {
+  int i = pixel_index();
+  if (i < 0) {
+    return;
+  }
+  vec4 acc_mixed = accum_mixed[i];
+  vec4 acc_real = accum_real[i];
+  vec4 acc_aux = accum_aux[i];
+  trace_pixel(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y, acc_mixed, acc_real, acc_aux);
+  accum_mixed[i] = acc_mixed;
+  accum_real[i] = acc_real;
+  accum_aux[i] = acc_aux;
+}

@@ -1,1 +1,264 @@
-// placeholder: being written
+// The scene model flattened into the kernels' buffers. The geometric
+// conventions are those of reference/blender_scene.py (trs, look_at_matrix,
+// add_object, add_light) in camhead's own frame (Y up, camera down -Z), so
+// that camhead and the Cycles references see the same scene.
+#include "camhead/renderer/compiled_scene.h"
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/trigonometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "camhead/renderer/bvh.h"
+
+namespace camhead::renderer {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+
+// Blender's Euler 'XYZ': about X first, then Y, then Z, i.e. R = Rz Ry Rx on
+// column vectors (mathutils Euler.to_matrix, used by trs()).
+glm::mat3 euler_xyz(const glm::vec3 &degrees) {
+  const glm::vec3 r = glm::radians(degrees);
+  const float cx = std::cos(r.x), sx = std::sin(r.x);
+  const float cy = std::cos(r.y), sy = std::sin(r.y);
+  const float cz = std::cos(r.z), sz = std::sin(r.z);
+  // glm matrices are built column by column.
+  const glm::mat3 rx(1, 0, 0, 0, cx, sx, 0, -sx, cx);
+  const glm::mat3 ry(cy, 0, -sy, 0, 1, 0, sy, 0, cy);
+  const glm::mat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
+  return rz * ry * rx;
+}
+
+// translate * rotate * scale, as trs() composes them.
+struct Transform {
+  glm::mat3 linear;
+  glm::vec3 translation;
+
+  Transform(const glm::vec3 &center, const glm::vec3 &rotation_deg, const glm::vec3 &scale)
+      : linear(euler_xyz(rotation_deg) * glm::mat3(scale.x, 0, 0, 0, scale.y, 0, 0, 0, scale.z)),
+        translation(center) {}
+  [[nodiscard]] glm::vec3 operator()(const glm::vec3 &p) const { return linear * p + translation; }
+};
+
+std::uint32_t primitive_bits(const Object &o, std::uint32_t kind) {
+  if (o.material < 0 || std::uint32_t(o.material) > PRIM_MATERIAL_MASK)
+    throw std::invalid_argument("object " + o.name + ": material index " +
+                                std::to_string(o.material) + " does not fit the primitive");
+  return std::uint32_t(o.material) | (o.real ? PRIM_REAL_BIT : 0u) | kind << 24;
+}
+
+bool finite(const glm::vec3 &v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Degenerate and non-finite triangles are dropped: a NaN would poison the BVH
+// bounds, and a zero-area triangle should hit nothing, but once transformed
+// in float, collinear vertices keep a sliver of area at rounding level that
+// the kernel's intersection could hit with a noise normal. Hence a relative
+// test: edges less than about 1e-6 rad apart count as collinear.
+void add_triangle(std::vector<gpu::Primitive> &out, const glm::vec3 &a, const glm::vec3 &b,
+                  const glm::vec3 &c, std::uint32_t bits) {
+  const glm::vec3 e1 = b - a, e2 = c - a;
+  const float sine_bound = 1e-6f * glm::length(e1) * glm::length(e2);
+  if (!finite(a) || !finite(e1) || !finite(e2) || !(glm::length(glm::cross(e1, e2)) > sine_bound))
+    return;
+  out.push_back(gpu::Primitive{gpu::vec4(a, glm::uintBitsToFloat(bits)), gpu::vec4(e1, 0.0f),
+                               gpu::vec4(e2, 0.0f)});
+}
+
+// Quads are split along their first diagonal; vertex order keeps the winding,
+// so cross(p1, p2) is the outward normal.
+void add_quad(std::vector<gpu::Primitive> &out, const std::array<glm::vec3, 4> &q,
+              std::uint32_t bits) {
+  add_triangle(out, q[0], q[1], q[2], bits);
+  add_triangle(out, q[0], q[2], q[3], bits);
+}
+
+void add_object(std::vector<gpu::Primitive> &out, const Object &o) {
+  switch (o.type) {
+  case ShapeType::plane: {
+    // XZ plane, normal +Y before rotation; size is (x, unused, z).
+    const Transform xf(o.center, o.rotation_deg, glm::vec3(o.size.x, 1.0f, o.size.z));
+    add_quad(out,
+             {xf({-0.5f, 0.0f, 0.5f}), xf({0.5f, 0.0f, 0.5f}), xf({0.5f, 0.0f, -0.5f}),
+              xf({-0.5f, 0.0f, -0.5f})},
+             primitive_bits(o, PRIM_TRIANGLE));
+    break;
+  }
+  case ShapeType::box: {
+    // Corner i has x, y, z = bits 2, 1, 0 of i; faces as add_object() lists them.
+    const Transform xf(o.center, o.rotation_deg, o.size);
+    std::array<glm::vec3, 8> v;
+    for (int i = 0; i < 8; ++i)
+      v[i] = xf(glm::vec3((i >> 2) & 1, (i >> 1) & 1, i & 1) - glm::vec3(0.5f));
+    constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                  {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+    const std::uint32_t bits = primitive_bits(o, PRIM_TRIANGLE);
+    for (const auto &f : kFaces)
+      add_quad(out, {v[f[0]], v[f[1]], v[f[2]], v[f[3]]}, bits);
+    break;
+  }
+  case ShapeType::sphere:
+    out.push_back(
+        gpu::Primitive{gpu::vec4(o.center, glm::uintBitsToFloat(primitive_bits(o, PRIM_SPHERE))),
+                       gpu::vec4(o.radius, 0.0f, 0.0f, 0.0f), gpu::vec4(0.0f)});
+    break;
+  case ShapeType::mesh: {
+    if (!o.mesh)
+      throw std::invalid_argument("object " + o.name + ": mesh not loaded");
+    const Transform xf(o.center, o.rotation_deg, glm::vec3(o.scale));
+    const TriangleMesh &m = *o.mesh;
+    std::vector<glm::vec3> world;
+    world.reserve(m.positions.size());
+    for (const glm::vec3 &p : m.positions)
+      world.push_back(xf(p));
+    const std::uint32_t bits = primitive_bits(o, PRIM_TRIANGLE);
+    out.reserve(out.size() + m.triangles.size());
+    for (const glm::uvec3 &t : m.triangles) {
+      if (t.x >= world.size() || t.y >= world.size() || t.z >= world.size())
+        throw std::invalid_argument("object " + o.name + ": triangle index out of range");
+      add_triangle(out, world[t.x], world[t.y], world[t.z], bits);
+    }
+    break;
+  }
+  }
+}
+
+gpu::Material compile_material(const Material &m) {
+  std::uint32_t type = MAT_DIFFUSE;
+  switch (m.type) {
+  case MaterialType::diffuse:
+    type = MAT_DIFFUSE;
+    break;
+  case MaterialType::mirror:
+    type = MAT_MIRROR;
+    break;
+  case MaterialType::glass:
+    type = MAT_GLASS;
+    break;
+  case MaterialType::emission:
+    type = MAT_EMISSION;
+    break;
+  }
+  return gpu::Material{gpu::vec4(m.color, 0.0f),
+                       gpu::vec4(m.ior, 0.0f, 0.0f, glm::uintBitsToFloat(type))};
+}
+
+gpu::Light compile_light(const Light &l) {
+  gpu::Light g{};
+  switch (l.type) {
+  case LightType::point:
+    g.position = gpu::vec4(l.position, glm::uintBitsToFloat(LIGHT_POINT));
+    g.emission = gpu::vec4(l.color * (l.power_W / (4.0f * kPi)), 0.0f);
+    break;
+  case LightType::area: {
+    // add_light() orients the rectangle with look_at_matrix(pos, pos + n, a):
+    // local x = normalize(n x a), local y = z x x with z = -n, i.e. u x n.
+    const glm::vec3 n = glm::normalize(l.normal);
+    const glm::vec3 a = std::abs(n.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, -1);
+    const glm::vec3 u = glm::normalize(glm::cross(n, a));
+    const glm::vec3 v = glm::cross(u, n);
+    const float area = l.size.x * l.size.y;
+    g.position = gpu::vec4(l.position, glm::uintBitsToFloat(LIGHT_AREA));
+    g.emission = gpu::vec4(l.color * (l.power_W / (4.0f * area)), 0.0f);
+    g.axis_u = gpu::vec4(u * l.size.x, area);
+    g.axis_v = gpu::vec4(v * l.size.y, 0.0f);
+    g.normal = gpu::vec4(n, 0.0f);
+    break;
+  }
+  case LightType::sun:
+    g.position = gpu::vec4(0.0f, 0.0f, 0.0f, glm::uintBitsToFloat(LIGHT_SUN));
+    g.emission = gpu::vec4(l.color * l.irradiance_W_m2, 0.0f);
+    g.normal = gpu::vec4(glm::normalize(l.direction), 0.0f);
+    break;
+  }
+  return g;
+}
+
+std::vector<glm::vec4> compile_plate(const Scene &scene) {
+  const Image &img = *scene.plate;
+  if (img.width != scene.render.width || img.height != scene.render.height ||
+      (img.channels != 1 && img.channels != 3))
+    throw std::invalid_argument(
+        scene.source.string() + ": plate is " + std::to_string(img.width) + "x" +
+        std::to_string(img.height) + "x" + std::to_string(img.channels) + ", the render " +
+        std::to_string(scene.render.width) + "x" + std::to_string(scene.render.height) + " rgb");
+  std::vector<glm::vec4> rgb(img.pixel_count());
+  for (std::size_t i = 0; i < rgb.size(); ++i) {
+    const float *px = &img.data[i * img.channels];
+    rgb[i] = img.channels == 3 ? glm::vec4(px[0], px[1], px[2], 0.0f)
+                               : glm::vec4(px[0], px[0], px[0], 0.0f);
+  }
+  return rgb;
+}
+
+} // namespace
+
+CompiledScene compile_scene(const Scene &scene) {
+  CompiledScene out;
+  std::vector<gpu::Primitive> prims;
+  for (const Object &o : scene.objects)
+    add_object(prims, o);
+  Bvh bvh = build_bvh(std::move(prims));
+  out.primitives = std::move(bvh.primitives);
+  out.nodes = std::move(bvh.nodes);
+  for (const Material &m : scene.materials)
+    out.materials.push_back(compile_material(m));
+  for (const Light &l : scene.lights)
+    out.lights.push_back(compile_light(l));
+  if (scene.plate)
+    out.plate = compile_plate(scene);
+  out.width = scene.render.width;
+  out.height = scene.render.height;
+  return out;
+}
+
+gpu::FrameParams make_frame_params(const Scene &scene, int samples) {
+  const CameraDesc &cam = scene.camera;
+  const RenderSettings &r = scene.render;
+  // look_at_matrix(): camera -Z toward the target, x = up x z, y = z x x.
+  const glm::vec3 forward = glm::normalize(cam.look_at - cam.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, cam.up));
+  const glm::vec3 up = glm::cross(right, forward);
+
+  const float f_m = cam.focal_length_mm / 1000.0f;
+  const float aperture_radius = cam.f_number > 0.0f ? f_m / (2.0f * cam.f_number) : 0.0f;
+  // A pinhole ignores the focal depth; a positive stand-in keeps any code
+  // that forms the focal point (I = O + d d_f / cos) off the degenerate I = O.
+  const float focus = cam.focus_distance_m > 0.0f ? cam.focus_distance_m : 1.0f;
+  // Cycles' projection: magnification set by the focal length alone.
+  const float focal_px = cam.focal_length_mm * float(r.width) / cam.sensor_width_mm;
+
+  const auto spp = std::uint32_t(samples > 0 ? samples : r.samples);
+  gpu::FrameParams fp{};
+  fp.cam_position = gpu::vec4(cam.position, 0.0f);
+  fp.cam_right = gpu::vec4(right, 0.0f);
+  fp.cam_up = gpu::vec4(up, 0.0f);
+  fp.cam_forward = gpu::vec4(forward, 0.0f);
+  fp.lens = gpu::vec4(aperture_radius, focus, focal_px, r.pixel_filter_width_px);
+  fp.world_color = gpu::vec4(r.world_color, 0.0f);
+  fp.image = gpu::uvec4(std::uint32_t(r.width), std::uint32_t(r.height), scene.plate ? 1u : 0u,
+                        std::uint32_t(scene.lights.size()));
+  fp.sampling = gpu::uvec4(0u, spp, spp, r.seed);
+  fp.tracing = gpu::uvec4(std::uint32_t(r.max_bounces), 0u, 0u, 0u);
+  return fp;
+}
+
+gpu::FrameParams make_frame_params(const Scene &scene, const CompiledScene &compiled, int samples) {
+  gpu::FrameParams fp = make_frame_params(scene, samples);
+  fp.tracing.y = std::uint32_t(compiled.primitives.size());
+  fp.tracing.z = std::uint32_t(compiled.nodes.size());
+  return fp;
+}
+
+} // namespace camhead::renderer

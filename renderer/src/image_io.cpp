@@ -1,1 +1,345 @@
-// placeholder: being written
+// OpenEXR through tinyexr and PNG through stb, both compiled into this file
+// only, so that the renderer links nothing but Vulkan dynamically. Files are
+// read into memory first so that every failure, including open errors, is
+// reported the same way (ImageError naming the file).
+#include "camhead/renderer/image_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <zlib.h>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#pragma GCC diagnostic ignored "-Wtype-limits"
+#pragma GCC diagnostic ignored "-Wunused-but-set-variable"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#define TINYEXR_USE_MINIZ 0
+#define TINYEXR_IMPLEMENTATION
+#include <tinyexr.h>
+// Only PNG is needed; leaving the other decoders out shrinks the attack
+// surface for untrusted plates.
+#define STBI_ONLY_PNG
+#define STBI_NO_STDIO
+#define STB_IMAGE_STATIC // private to this file, whoever else links stb
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+#define STBI_WRITE_NO_STDIO
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#pragma GCC diagnostic pop
+
+namespace camhead::renderer {
+namespace {
+
+// Far beyond any render (65536 x 2048) yet small enough that a corrupt header
+// cannot make us allocate tens of gigabytes.
+constexpr std::size_t kMaxPixels = std::size_t(1) << 27;
+
+[[noreturn]] void fail(const std::filesystem::path &path, const std::string &reason) {
+  throw ImageError(path.string() + ": " + reason);
+}
+
+std::vector<unsigned char> read_file(const std::filesystem::path &path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    fail(path, std::string("cannot open: ") + std::strerror(errno));
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+  if (in.bad())
+    fail(path, "read error");
+  return bytes;
+}
+
+void write_file(const std::filesystem::path &path, const unsigned char *data, std::size_t size) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out)
+    fail(path, std::string("cannot create: ") + std::strerror(errno));
+  out.write(reinterpret_cast<const char *>(data), std::streamsize(size));
+  out.close();
+  if (!out)
+    fail(path, "write error");
+}
+
+std::string lower_extension(const std::filesystem::path &path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+// Double precision so that PNG encoding rounds exactly like the numpy
+// reference (imageio_util.py), which works in float64.
+double srgb_to_linear_d(double v) {
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+double linear_to_srgb_d(double v) {
+  // !(v > 0) also maps NaN to 0, so that the 8-bit conversion never sees it.
+  v = !(v > 0.0) ? 0.0 : std::min(v, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+struct ExrErrorDeleter {
+  void operator()(const char *msg) const { FreeEXRErrorMessage(msg); }
+};
+using ExrMessage = std::unique_ptr<const char, ExrErrorDeleter>;
+
+std::string exr_reason(const char *what, const ExrMessage &msg) {
+  return std::string(what) + (msg ? std::string(": ") + msg.get() : std::string());
+}
+
+struct ExrHeader {
+  EXRHeader h;
+  ExrHeader() { InitEXRHeader(&h); }
+  ~ExrHeader() { FreeEXRHeader(&h); }
+  ExrHeader(const ExrHeader &) = delete;
+  ExrHeader &operator=(const ExrHeader &) = delete;
+};
+
+// tinyexr frees a failed load itself without clearing the pointers, so the
+// image is released only once it has loaded.
+struct ExrImage {
+  EXRImage img;
+  bool loaded = false;
+  ExrImage() { InitEXRImage(&img); }
+  ~ExrImage() {
+    if (loaded)
+      FreeEXRImage(&img);
+  }
+  ExrImage(const ExrImage &) = delete;
+  ExrImage &operator=(const ExrImage &) = delete;
+};
+
+float exr_sample(const unsigned char *plane, int pixel_type, std::size_t i) {
+  if (pixel_type == TINYEXR_PIXELTYPE_UINT)
+    return float(reinterpret_cast<const unsigned int *>(plane)[i]);
+  return reinterpret_cast<const float *>(plane)[i];
+}
+
+Image read_exr(const std::filesystem::path &path) {
+  const std::vector<unsigned char> bytes = read_file(path);
+  EXRVersion version;
+  if (ParseEXRVersionFromMemory(&version, bytes.data(), bytes.size()) != TINYEXR_SUCCESS)
+    fail(path, "not an OpenEXR file");
+  if (version.multipart || version.non_image)
+    fail(path, "multi-part and deep OpenEXR files are not supported");
+  ExrHeader header;
+  const char *raw_err = nullptr;
+  int rc = ParseEXRHeaderFromMemory(&header.h, &version, bytes.data(), bytes.size(), &raw_err);
+  ExrMessage err(raw_err);
+  if (rc != TINYEXR_SUCCESS)
+    fail(path, exr_reason("bad OpenEXR header", err));
+  const EXRBox2i &dw = header.h.data_window;
+  // tinyexr does int arithmetic on the window corners; keep them far from overflow.
+  constexpr int kMaxCoord = 1 << 30;
+  for (const int v : {dw.min_x, dw.min_y, dw.max_x, dw.max_y})
+    if (v < -kMaxCoord || v > kMaxCoord)
+      fail(path, "data window out of range");
+  const long long w = (long long)dw.max_x - dw.min_x + 1;
+  const long long h = (long long)dw.max_y - dw.min_y + 1;
+  if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
+    fail(path, "unsupported data window size");
+
+  int idx[3] = {-1, -1, -1};
+  int luma = -1;
+  for (int c = 0; c < header.h.num_channels; ++c) {
+    const EXRChannelInfo &ch = header.h.channels[c];
+    if (ch.x_sampling != 1 || ch.y_sampling != 1)
+      fail(path, std::string("subsampled channel ") + ch.name + " is not supported");
+    const std::string name = ch.name;
+    if (name == "R" || name == "G" || name == "B")
+      idx[name == "R" ? 0 : name == "G" ? 1 : 2] = c;
+    else if (name == "Y")
+      luma = c;
+    if (header.h.pixel_types[c] == TINYEXR_PIXELTYPE_HALF)
+      header.h.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
+  }
+  const bool rgb = idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0;
+  if (!rgb && luma < 0)
+    fail(path, "needs R, G and B channels or a Y channel");
+  if (!rgb)
+    idx[0] = idx[1] = idx[2] = luma;
+
+  ExrImage image;
+  // tinyexr frees the channels of a failed scanline decode by this count,
+  // which it only fills in on success.
+  image.img.num_channels = header.h.num_channels;
+  raw_err = nullptr;
+  rc = LoadEXRImageFromMemory(&image.img, &header.h, bytes.data(), bytes.size(), &raw_err);
+  err.reset(raw_err);
+  if (rc != TINYEXR_SUCCESS)
+    fail(path, exr_reason("cannot decode pixels", err));
+  image.loaded = true;
+  if (image.img.width != w || image.img.height != h)
+    fail(path, "decoded size does not match the data window");
+
+  Image out(int(w), int(h), 3);
+  const auto put = [&](const unsigned char *const *planes, std::size_t src, int x, int y) {
+    float *px = out.at(x, y);
+    for (int k = 0; k < 3; ++k)
+      px[k] = exr_sample(planes[idx[k]], header.h.requested_pixel_types[idx[k]], src);
+  };
+  if (header.h.tiled) {
+    const int tw = header.h.tile_size_x;
+    const int th = header.h.tile_size_y;
+    for (int t = 0; t < image.img.num_tiles; ++t) {
+      const EXRTile &tile = image.img.tiles[t];
+      for (int j = 0; j < tile.height && j < th; ++j) {
+        for (int i = 0; i < tile.width && i < tw; ++i) {
+          const long long x = (long long)tile.offset_x * tw + i;
+          const long long y = (long long)tile.offset_y * th + j;
+          if (x >= 0 && y >= 0 && x < w && y < h)
+            put(tile.images, std::size_t(j) * std::size_t(tw) + std::size_t(i), int(x), int(y));
+        }
+      }
+    }
+  } else {
+    for (int y = 0; y < int(h); ++y)
+      for (int x = 0; x < int(w); ++x)
+        put(image.img.images, std::size_t(y) * std::size_t(w) + std::size_t(x), x, y);
+  }
+  return out;
+}
+
+void write_exr(const std::filesystem::path &path, const Image &image) {
+  const std::size_t n = image.pixel_count();
+  // EXR viewers expect channels in alphabetical order: B, G, R.
+  const std::vector<std::pair<const char *, int>> layout =
+      image.channels == 1 ? std::vector<std::pair<const char *, int>>{{"Y", 0}}
+                          : std::vector<std::pair<const char *, int>>{{"B", 2}, {"G", 1}, {"R", 0}};
+  std::vector<std::vector<float>> planes(layout.size(), std::vector<float>(n));
+  std::vector<unsigned char *> plane_ptrs;
+  std::vector<EXRChannelInfo> infos(layout.size());
+  for (std::size_t c = 0; c < layout.size(); ++c) {
+    for (std::size_t i = 0; i < n; ++i)
+      planes[c][i] = image.data[i * std::size_t(image.channels) + std::size_t(layout[c].second)];
+    plane_ptrs.push_back(reinterpret_cast<unsigned char *>(planes[c].data()));
+    std::memset(&infos[c], 0, sizeof(EXRChannelInfo));
+    std::strncpy(infos[c].name, layout[c].first, sizeof(infos[c].name) - 1);
+  }
+  std::vector<int> types(layout.size(), TINYEXR_PIXELTYPE_FLOAT);
+
+  EXRHeader header;
+  InitEXRHeader(&header); // owns nothing here: every array below lives in a vector
+  header.num_channels = int(layout.size());
+  header.channels = infos.data();
+  header.pixel_types = types.data();
+  header.requested_pixel_types = types.data();
+  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+  EXRImage exr;
+  InitEXRImage(&exr);
+  exr.num_channels = int(layout.size());
+  exr.images = plane_ptrs.data();
+  exr.width = image.width;
+  exr.height = image.height;
+
+  unsigned char *raw_mem = nullptr;
+  const char *raw_err = nullptr;
+  const std::size_t size = SaveEXRImageToMemory(&exr, &header, &raw_mem, &raw_err);
+  const ExrMessage err(raw_err);
+  const std::unique_ptr<unsigned char, decltype(&std::free)> mem(raw_mem, &std::free);
+  if (size == 0 || !mem)
+    fail(path, exr_reason("cannot encode OpenEXR", err));
+  write_file(path, mem.get(), size);
+}
+
+Image read_png(const std::filesystem::path &path) {
+  const std::vector<unsigned char> bytes = read_file(path);
+  if (bytes.size() > std::size_t(INT_MAX))
+    fail(path, "file too large");
+  const int len = int(bytes.size());
+  int w = 0, h = 0, comp = 0;
+  if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp))
+    fail(path, std::string("not a readable PNG: ") + stbi_failure_reason());
+  if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
+    fail(path, "unsupported image size");
+  const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
+  std::unique_ptr<void, decltype(&stbi_image_free)> pixels(nullptr, &stbi_image_free);
+  if (sixteen)
+    pixels.reset(stbi_load_16_from_memory(bytes.data(), len, &w, &h, &comp, 3));
+  else
+    pixels.reset(stbi_load_from_memory(bytes.data(), len, &w, &h, &comp, 3));
+  if (!pixels)
+    fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
+  Image out(w, h, 3);
+  const double scale = sixteen ? 65535.0 : 255.0;
+  for (std::size_t i = 0; i < out.data.size(); ++i) {
+    const double v = sixteen ? static_cast<const std::uint16_t *>(pixels.get())[i]
+                             : static_cast<const std::uint8_t *>(pixels.get())[i];
+    out.data[i] = float(srgb_to_linear_d(v / scale));
+  }
+  return out;
+}
+
+void append_bytes(void *context, void *data, int size) {
+  auto *out = static_cast<std::vector<unsigned char> *>(context);
+  const auto *bytes = static_cast<const unsigned char *>(data);
+  out->insert(out->end(), bytes, bytes + size);
+}
+
+void write_png(const std::filesystem::path &path, const Image &image) {
+  std::vector<unsigned char> pixels(image.data.size());
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    // nearbyint rounds half to even, as numpy's round does.
+    pixels[i] = (unsigned char)std::nearbyint(linear_to_srgb_d(image.data[i]) * 255.0);
+  }
+  std::vector<unsigned char> encoded;
+  const int stride = image.width * image.channels;
+  if (!stbi_write_png_to_func(&append_bytes, &encoded, image.width, image.height, image.channels,
+                              pixels.data(), stride))
+    fail(path, "cannot encode PNG");
+  write_file(path, encoded.data(), encoded.size());
+}
+
+} // namespace
+
+float srgb_to_linear(float v) {
+  return float(srgb_to_linear_d(v));
+}
+
+float linear_to_srgb(float v) {
+  return float(linear_to_srgb_d(v));
+}
+
+Image read_image(const std::filesystem::path &path) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".exr")
+    return read_exr(path);
+  if (ext == ".png")
+    return read_png(path);
+  fail(path, "unsupported image type (expected .exr or .png)");
+}
+
+void write_image(const std::filesystem::path &path, const Image &image) {
+  if (image.width < 1 || image.height < 1 || (image.channels != 1 && image.channels != 3) ||
+      image.data.size() != image.pixel_count() * std::size_t(image.channels) ||
+      image.pixel_count() > kMaxPixels)
+    fail(path, "invalid image (needs a positive size, 1 or 3 channels and matching data)");
+  const std::string ext = lower_extension(path);
+  if (ext == ".exr")
+    write_exr(path, image);
+  else if (ext == ".png")
+    write_png(path, image);
+  else
+    fail(path, "unsupported image type (expected .exr or .png)");
+}
+
+} // namespace camhead::renderer

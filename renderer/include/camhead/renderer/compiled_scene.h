@@ -22,12 +22,18 @@ struct CompiledScene {
   int height = 0;
 };
 
-// Frame parameters from the scene's camera and settings; samples <= 0 takes
-// the scene's `render.samples`. The sample range covers all samples.
-[[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, int samples = 0);
-
 // Flattens the objects (planes and boxes into triangles, meshes transformed
 // into the world frame, spheres analytic) and builds the BVH.
 [[nodiscard]] CompiledScene compile_scene(const Scene &scene);
+
+// Frame parameters from the scene's camera and settings; samples <= 0 takes
+// the scene's `render.samples`. The sample range covers all samples.
+// tracing.y and .z are the primitive and node counts of `compiled`.
+[[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, const CompiledScene &compiled,
+                                                 int samples = 0);
+
+// As above without the buffer counts (tracing.y and .z stay 0): the tracers
+// take them from the buffers they loaded.
+[[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, int samples = 0);
 
 } // namespace camhead::renderer

@@ -25,6 +25,9 @@ struct GpuDeviceInfo {
 // Lists the Vulkan devices that can run the tracer (compute queue present).
 [[nodiscard]] std::vector<GpuDeviceInfo> list_gpu_devices();
 
+// One line per device, "  <index>: <name> (<type>)", for listings and errors.
+[[nodiscard]] std::string format_gpu_devices(const std::vector<GpuDeviceInfo> &devices);
+
 class GpuTracer {
 public:
   // `device`: empty = the first discrete or integrated GPU, else the first

@@ -16,7 +16,8 @@ struct Image {
   std::vector<float> data;
 
   Image() = default;
-  Image(int w, int h, int c) : width(w), height(h), channels(c), data(std::size_t(w) * h * c, 0.0f) {}
+  Image(int w, int h, int c)
+      : width(w), height(h), channels(c), data(std::size_t(w) * h * c, 0.0f) {}
 
   [[nodiscard]] std::size_t pixel_count() const { return std::size_t(width) * height; }
   [[nodiscard]] float *at(int x, int y) { return &data[(std::size_t(y) * width + x) * channels]; }

@@ -58,10 +58,10 @@ struct Object {
   std::string name;
   ShapeType type = ShapeType::sphere;
   glm::vec3 center{0.0f};
-  glm::vec3 rotation_deg{0.0f}; // XYZ Euler, applied before translation
-  glm::vec3 size{1.0f};         // box: full extents; plane: (x, unused, z)
-  float radius = 1.0f;          // sphere
-  float scale = 1.0f;           // mesh, uniform
+  glm::vec3 rotation_deg{0.0f};             // XYZ Euler, applied before translation
+  glm::vec3 size{1.0f};                     // box: full extents; plane: (x, unused, z)
+  float radius = 1.0f;                      // sphere
+  float scale = 1.0f;                       // mesh, uniform
   std::shared_ptr<const TriangleMesh> mesh; // mesh only
   std::filesystem::path mesh_file;          // mesh only, resolved path
   int material = 0;                         // index into Scene::materials
@@ -73,12 +73,12 @@ enum class LightType { point, area, sun };
 struct Light {
   std::string name;
   LightType type = LightType::point;
-  glm::vec3 position{0.0f};                // point, area
-  glm::vec3 normal{0.0f, -1.0f, 0.0f};     // area: front side (unit)
-  glm::vec3 direction{0.0f, -1.0f, 0.0f};  // sun: direction of travel (unit)
-  glm::vec2 size{1.0f};                    // area: full extents
-  float power_W = 0.0f;                    // point, area
-  float irradiance_W_m2 = 0.0f;            // sun
+  glm::vec3 position{0.0f};               // point, area
+  glm::vec3 normal{0.0f, -1.0f, 0.0f};    // area: front side (unit)
+  glm::vec3 direction{0.0f, -1.0f, 0.0f}; // sun: direction of travel (unit)
+  glm::vec2 size{1.0f};                   // area: full extents
+  float power_W = 0.0f;                   // point, area
+  float irradiance_W_m2 = 0.0f;           // sun
   glm::vec3 color{1.0f};
 };
 

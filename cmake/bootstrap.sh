@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs camhead's build and test dependencies (Debian 12 packages only),
+# configures and builds. Idempotent: a second run only rebuilds what changed.
+#
+#   cmake/bootstrap.sh [BUILD_DIR] [extra cmake -D options...]
+#
+# Environment: CAMHEAD_SKIP_APT=1 skips apt-get (packages already present).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir=${1:-build}
+shift || true
+
+packages=(
+  build-essential cmake ninja-build pkg-config git clang-format
+  libvulkan-dev mesa-vulkan-drivers glslang-tools vulkan-tools
+  libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
+  libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then
+  missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "bootstrap: installing ${missing[*]}" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -q
+    apt-get install -y -q --no-install-recommends "${missing[@]}"
+  fi
+fi
+
+cmake -S . -B "$build_dir" -G Ninja "$@" >/dev/null
+cmake --build "$build_dir" -j "$(nproc)"

@@ -1,0 +1,117 @@
+// camhead bench: frame rate of the GPU tracer at the paper's settings.
+//
+// Kan and Kaufmann (2012) report 59, 12 and 7 fps at 720 x 576 for 1, 25 and
+// 49 rays per pixel on a GTX 590 (method.md section 4). This command measures
+// the same table on whatever device it is given: the median frame time over
+// repeated frames after warm-up, each frame the whole render() call (upload
+// of the frame parameters, tracing, compositing and read-back).
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/scene_loader.h"
+#include "commands.h"
+
+namespace camhead::cli {
+namespace {
+
+struct BenchArgs {
+  std::string scene = "scenes/ar_demo.json";
+  std::vector<int> rpp{1, 25, 49};
+  int width = 720;
+  int height = 576;
+  int frames = 9;
+  int warmup = 2;
+  std::string device;
+};
+
+double paper_fps(int rpp) {
+  switch (rpp) {
+  case 1:
+    return 59.0;
+  case 25:
+    return 12.0;
+  case 49:
+    return 7.0;
+  default:
+    return 0.0;
+  }
+}
+
+int run_bench(const BenchArgs &args) {
+  using namespace camhead::renderer;
+  try {
+    Scene scene = load_scene(args.scene);
+    if (scene.plate && (scene.plate->width != args.width || scene.plate->height != args.height)) {
+      scene.plate.reset(); // the plate only costs one read per pixel
+    }
+    scene.render.width = args.width;
+    scene.render.height = args.height;
+    GpuTracer tracer(args.device);
+    tracer.load(compile_scene(scene));
+    std::printf("scene %s, %dx%d, device %s\n", args.scene.c_str(), args.width, args.height,
+                tracer.device_name().c_str());
+    std::printf("median of %d frames after %d warm-up frames\n\n", args.frames, args.warmup);
+    std::printf("| rpp | camera rays/frame | frame ms (median) | fps   | M camera rays/s | "
+                "paper fps (GTX 590) |\n");
+    std::printf("|-----|-------------------|-------------------|-------|-----------------|"
+                "---------------------|\n");
+    for (int rpp : args.rpp) {
+      const gpu::FrameParams frame = make_frame_params(scene, rpp);
+      std::vector<double> seconds;
+      for (int i = 0; i < args.warmup + args.frames; ++i) {
+        const RenderResult r = tracer.render(frame);
+        if (i >= args.warmup) {
+          seconds.push_back(r.seconds);
+        }
+      }
+      std::sort(seconds.begin(), seconds.end());
+      const double median = seconds[seconds.size() / 2];
+      const double rays = double(args.width) * args.height * rpp;
+      const double paper = paper_fps(rpp);
+      std::printf("| %3d | %15.1f M | %17.2f | %5.1f | %15.1f | %19s |\n", rpp, rays * 1e-6,
+                  median * 1e3, 1.0 / median, rays / median * 1e-6,
+                  paper > 0 ? std::to_string(int(paper)).c_str() : "-");
+      std::fflush(stdout);
+    }
+    return 0;
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "bench: %s\n", e.what());
+    return 1;
+  }
+}
+
+} // namespace
+
+void add_bench_command(CLI::App &app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App *cmd = app.add_subcommand(
+      "bench", "Frame rate and camera-ray throughput of the GPU tracer at the paper's\n"
+               "settings (720x576; 1, 25, 49 rays per pixel). Prints a Markdown table.");
+  cmd->add_option("--scene", args->scene, "Scene file")
+      ->check(CLI::ExistingFile)
+      ->capture_default_str();
+  cmd->add_option("--rpp", args->rpp, "Rays per pixel to measure")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--width", args->width, "Image width")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--height", args->height, "Image height")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--frames", args->frames, "Timed frames per setting")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  cmd->add_option("--warmup", args->warmup, "Untimed frames first")
+      ->check(CLI::Range(0, 10000))
+      ->capture_default_str();
+  cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
+  cmd->callback([args] { set_exit_code(run_bench(*args)); });
+}
+
+} // namespace camhead::cli

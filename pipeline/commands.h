@@ -1,0 +1,16 @@
+// Subcommands of the camhead command line.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace camhead::cli {
+
+void add_render_command(CLI::App &app);  // camhead render
+void add_devices_command(CLI::App &app); // camhead devices
+void add_bench_command(CLI::App &app);   // camhead bench
+
+// The exit status the chosen subcommand left (0 = success).
+[[nodiscard]] int exit_code();
+void set_exit_code(int code);
+
+} // namespace camhead::cli

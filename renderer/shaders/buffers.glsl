@@ -1,0 +1,34 @@
+// The GLSL side of layout.h: buffer declarations and the GLSL spelling of the
+// vocabulary that kernel.glsl shares with C++ (renderer/src/cpu_kernel.h).
+#extension GL_GOOGLE_include_directive : require
+#include "layout.h"
+
+#define INOUT(T) inout T
+#define OUT(T) out T
+#define PRECISE precise
+#define CAMHEAD_PI 3.14159265358979f
+
+layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
+
+layout(std430, binding = BINDING_PRIMITIVES) readonly buffer Primitives { Primitive primitives[]; };
+layout(std430, binding = BINDING_NODES) readonly buffer Nodes { BvhNode nodes[]; };
+layout(std430, binding = BINDING_MATERIALS) readonly buffer Materials { Material materials[]; };
+layout(std430, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };
+layout(std140, binding = BINDING_FRAME) uniform Frame { FrameParams frame; };
+layout(std430, binding = BINDING_ACCUM_MIXED) buffer AccumMixed { vec4 accum_mixed[]; };
+layout(std430, binding = BINDING_ACCUM_REAL) buffer AccumReal { vec4 accum_real[]; };
+layout(std430, binding = BINDING_ACCUM_AUX) buffer AccumAux { vec4 accum_aux[]; };
+layout(std430, binding = BINDING_PLATE) readonly buffer Plate { vec4 plate[]; };
+layout(std430, binding = BINDING_OUT_COMPOSITE) writeonly buffer OutComposite { vec4 out_composite[]; };
+layout(std430, binding = BINDING_OUT_MIXED) writeonly buffer OutMixed { vec4 out_mixed[]; };
+layout(std430, binding = BINDING_OUT_REAL) writeonly buffer OutReal { vec4 out_real[]; };
+layout(std430, binding = BINDING_OUT_AUX) writeonly buffer OutAux { vec4 out_aux[]; };
+
+// Index of this invocation's pixel, or -1 outside the image.
+int pixel_index() {
+  uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= frame.image.x || p.y >= frame.image.y) {
+    return -1;
+  }
+  return int(p.y * frame.image.x + p.x);
+}

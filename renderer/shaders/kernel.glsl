@@ -1,0 +1,308 @@
+// The tracing kernel: thin-lens camera, shading and one-pass differential
+// rendering (method.md sections 1-3), written once for two executors.
+//
+// GLSL includes this from trace.comp / resolve.comp; C++ includes it inside
+// a struct in renderer/src/cpu_kernel.h, where the buffers are member
+// pointers. It therefore keeps to the common subset of GLSL and C++ with glm:
+// no swizzles, explicit float literals (1.0f), struct construction by field,
+// INOUT(T) / OUT(T) for reference parameters, and no names that would hide a
+// glm function inside a C++ class.
+//
+// Expects: primitives[], nodes[], materials[], lights[], frame (FrameParams).
+
+#include "sampling.glsl"
+#include "intersect.glsl"
+
+// ---------------------------------------------------------------- camera
+
+// One camera ray through pixel (x, y) for sample s of n (method.md section 1).
+Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
+  float width = float(frame.image.x);
+  float height = float(frame.image.y);
+  float filter_width = frame.lens.w;
+  // 1. Jitter inside the pixel (box filter of width filter_width pixels),
+  //    and form the pinhole direction; row 0 is the top of the image.
+  vec2 jitter = sample_dimension(s, n, pixel_pattern, DIM_PIXEL);
+  float px = float(x) + 0.5f + (jitter.x - 0.5f) * filter_width;
+  float py = float(y) + 0.5f + (jitter.y - 0.5f) * filter_width;
+  vec3 right = vec3(frame.cam_right);
+  vec3 up = vec3(frame.cam_up);
+  vec3 forward = vec3(frame.cam_forward);
+  vec3 d = normalize(right * (px - 0.5f * width) + up * (0.5f * height - py) +
+                     forward * frame.lens.z);
+  Ray ray;
+  ray.origin = vec3(frame.cam_position);
+  ray.dir = d;
+  float aperture_radius = frame.lens.x;
+  if (aperture_radius <= 0.0f) {
+    return ray; // pinhole
+  }
+  // 2. Where the pinhole ray meets the focal plane (a plane, not a sphere:
+  //    divide by the cosine to the optical axis).
+  vec3 focus_point = ray.origin + d * (frame.lens.y / dot(d, forward));
+  // 3. A point on the aperture disk, stratified separately from the pixel.
+  vec2 disk = aperture_radius * concentric_disk(sample_dimension(s, n, pixel_pattern, DIM_LENS));
+  // 4. The lens ray starts there and aims at the focus point.
+  ray.origin = ray.origin + right * disk.x + up * disk.y;
+  ray.dir = normalize(focus_point - ray.origin);
+  return ray;
+}
+
+// ---------------------------------------------------------------- shading
+
+// Offset scale for new rays leaving a surface at p.
+float ray_epsilon(vec3 p) {
+  return CAMHEAD_RAY_EPSILON * (1.0f + max(abs(p.x), max(abs(p.y), abs(p.z))));
+}
+
+vec3 surface_normal(uint index, vec3 p) {
+  Primitive prim = primitives[index];
+  if ((floatBitsToUint(prim.p0.w) >> 24) == PRIM_SPHERE) {
+    return normalize(p - vec3(prim.p0));
+  }
+  return normalize(cross(vec3(prim.p1), vec3(prim.p2))); // flat face normal
+}
+
+// Unpolarised Fresnel reflectance of a smooth dielectric; eta = n_t / n_i.
+float fresnel_dielectric(float cos_i, float eta) {
+  float sin_t2 = (1.0f - cos_i * cos_i) / (eta * eta);
+  if (sin_t2 >= 1.0f) {
+    return 1.0f; // total internal reflection
+  }
+  float cos_t = sqrt(1.0f - sin_t2);
+  float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return 0.5f * (r_par * r_par + r_perp * r_perp);
+}
+
+// Direct light at a diffuse point from the scene's lights (reference
+// README, "What Cycles does": shadow rays only, no interreflection).
+// Adds to lm the light that reaches p past all geometry, and, when
+// want_real, to lr the light that reaches it past the real proxy alone.
+void direct_light(vec3 p, vec3 n, vec3 brdf_weight, uint surface_dim, uint s, uint count,
+                  uint pixel_pattern, bool want_real, bool real_only, INOUT(vec3) lm,
+                  INOUT(vec3) lr) {
+  float eps = ray_epsilon(p);
+  Ray shadow;
+  shadow.origin = p + n * eps;
+  for (uint li = 0u; li < frame.image.w; ++li) {
+    Light light = lights[li];
+    uint type = floatBitsToUint(light.position.w);
+    vec3 wi;
+    float dist;
+    vec3 irradiance;
+    if (type == LIGHT_SUN) {
+      wi = -vec3(light.normal);
+      dist = CAMHEAD_NO_HIT;
+      irradiance = vec3(light.emission) * max(dot(n, wi), 0.0f);
+    } else {
+      vec3 target = vec3(light.position);
+      float geometry = 1.0f;
+      if (type == LIGHT_AREA) {
+        vec2 u = sample_dimension(s, count, pixel_pattern, surface_dim + 1u + li);
+        target += (u.x - 0.5f) * vec3(light.axis_u) + (u.y - 0.5f) * vec3(light.axis_v);
+      }
+      vec3 to_light = target - shadow.origin;
+      dist = length(to_light);
+      wi = to_light / dist;
+      if (type == LIGHT_AREA) {
+        // Uniform area sampling: pdf 1/A, cosine at the light, front side only.
+        geometry = max(-dot(wi, vec3(light.normal)), 0.0f) * light.axis_u.w;
+      }
+      irradiance = vec3(light.emission) * (geometry * max(dot(n, wi), 0.0f) / (dist * dist));
+    }
+    if (irradiance.x <= 0.0f && irradiance.y <= 0.0f && irradiance.z <= 0.0f) {
+      continue;
+    }
+    shadow.dir = wi;
+    float t_max = dist == CAMHEAD_NO_HIT ? CAMHEAD_NO_HIT : dist * (1.0f - 1e-5f);
+    uint occluded = shadow_query(shadow, 0.0f, t_max, real_only, !want_real);
+    vec3 contribution = brdf_weight * irradiance;
+    if (!real_only && occluded == 0u) {
+      lm += contribution;
+    }
+    if ((want_real || real_only) && (occluded & OCCLUDED_BY_REAL) == 0u) {
+      lr += contribution;
+    }
+  }
+}
+
+// ---------------------------------------------------------------- paths
+
+// Where the real radiance ray splits from the mixed path: at the first
+// virtual surface, the real ray continues the same direction through it.
+struct RealBranch {
+  Ray ray;
+  vec3 weight;
+  uint surface;
+  bool pending;
+};
+
+// What the camera ray's first hit tells the mask and depth layers.
+struct PrimaryHit {
+  bool hit;
+  bool is_virtual;
+  float depth;
+};
+
+// Follows one path, surface by surface, adding to lm (mixed radiance) and lr
+// (real radiance).
+//   real_only = false: the mixed path from the camera. While it has met only
+//     real surfaces it is the real path too (both radiances are shaded at the
+//     same hits, with the mixed and the real shadow ray); at the first virtual
+//     surface the real path is handed back in `branch`.
+//   real_only = true: the real radiance ray, seeing the real proxy alone.
+// Surfaces 1 .. max_bounces + 1 are shaded; the ray leaving the last of them
+// picks up emission only (reference README, "What Cycles does").
+void trace_path(Ray ray, vec3 weight, uint surface, bool real_only, uint s, uint count,
+                uint pixel_pattern, INOUT(vec3) lm, INOUT(vec3) lr, INOUT(RealBranch) branch,
+                INOUT(PrimaryHit) primary) {
+  bool coupled = !real_only;
+  uint last_shaded = frame.tracing.x + 1u;
+  vec3 world = vec3(frame.world_color);
+  float t_min = 0.0f;
+  for (;;) {
+    Hit hit = closest_hit(ray, t_min, CAMHEAD_NO_HIT, real_only);
+    bool is_virtual = hit.t != CAMHEAD_NO_HIT && !prim_is_real(hit.prim);
+    if (surface == 1u && !real_only) {
+      primary.hit = hit.t != CAMHEAD_NO_HIT;
+      primary.is_virtual = is_virtual;
+      primary.depth = hit.t != CAMHEAD_NO_HIT ? hit.t * dot(ray.dir, vec3(frame.cam_forward)) : 0.0f;
+    }
+    if (coupled && is_virtual) {
+      coupled = false;
+      branch.ray = ray;
+      branch.weight = weight;
+      branch.surface = surface;
+      branch.pending = true;
+    }
+    bool add_mixed = !real_only;
+    bool add_real = real_only || coupled;
+    vec3 emitted = vec3(0.0f);
+    if (surface > 1u) {
+      emitted = area_lights_along(ray, hit.t);
+    }
+    if (hit.t == CAMHEAD_NO_HIT) {
+      emitted += world;
+    } else {
+      Material material = materials[prim_material(hit.prim)];
+      if (floatBitsToUint(material.params.w) == MAT_EMISSION) {
+        emitted += vec3(material.color);
+      }
+    }
+    if (add_mixed) {
+      lm += weight * emitted;
+    }
+    if (add_real) {
+      lr += weight * emitted;
+    }
+    if (hit.t == CAMHEAD_NO_HIT || surface > last_shaded) {
+      return;
+    }
+
+    Material material = materials[prim_material(hit.prim)];
+    uint type = floatBitsToUint(material.params.w);
+    vec3 p = ray.origin + hit.t * ray.dir;
+    vec3 n = surface_normal(hit.prim, p);
+    bool entering = dot(n, ray.dir) < 0.0f;
+    vec3 n_facing = entering ? n : -n; // planes and meshes are two-sided
+    uint surface_dim = DIM_SURFACE_BASE + (surface - 1u) * DIM_PER_SURFACE;
+    if (type == MAT_DIFFUSE) {
+      vec3 brdf_weight = weight * vec3(material.color) * (1.0f / CAMHEAD_PI);
+      vec3 dm = vec3(0.0f);
+      vec3 dr = vec3(0.0f);
+      direct_light(p, n_facing, brdf_weight, surface_dim, s, count, pixel_pattern, add_real && !real_only,
+                   real_only, dm, dr);
+      if (add_mixed) {
+        lm += dm;
+      }
+      if (add_real) {
+        lr += dr;
+      }
+      return;
+    }
+    if (type == MAT_EMISSION) {
+      return; // emits (added above), reflects nothing
+    }
+    float eps = ray_epsilon(p);
+    if (type == MAT_MIRROR) {
+      weight *= vec3(material.color); // reflectance = tint at every angle, no Fresnel
+      ray.dir = reflect(ray.dir, n_facing);
+      ray.origin = p + n_facing * eps;
+    } else { // MAT_GLASS: reflect with probability F, else refract; weight 1
+      float eta = entering ? material.params.x : 1.0f / material.params.x;
+      float cos_i = -dot(ray.dir, n_facing);
+      float reflectance = fresnel_dielectric(cos_i, eta);
+      float u = sample_dimension(s, count, pixel_pattern, surface_dim).x;
+      if (u < reflectance) {
+        ray.dir = reflect(ray.dir, n_facing);
+        ray.origin = p + n_facing * eps;
+      } else {
+        ray.dir = normalize(refract(ray.dir, n_facing, 1.0f / eta));
+        ray.origin = p - n_facing * eps;
+      }
+    }
+    ++surface;
+  }
+}
+
+// Adds samples [frame.sampling.x, frame.sampling.y) of pixel (x, y) to the
+// accumulators (layout.h: mixed.rgb + mask, real.rgb, aux = depth sum, hits).
+void trace_pixel(uint x, uint y, INOUT(vec4) acc_mixed, INOUT(vec4) acc_real, INOUT(vec4) acc_aux) {
+  uint count = frame.sampling.z;
+  uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, frame.sampling.w);
+  for (uint s = frame.sampling.x; s < frame.sampling.y; ++s) {
+    Ray ray = camera_ray(x, y, s, count, pixel_pattern);
+    vec3 lm = vec3(0.0f);
+    vec3 lr = vec3(0.0f);
+    RealBranch branch;
+    branch.ray = ray;
+    branch.weight = vec3(1.0f);
+    branch.surface = 1u;
+    branch.pending = false;
+    PrimaryHit primary;
+    primary.hit = false;
+    primary.is_virtual = false;
+    primary.depth = 0.0f;
+    trace_path(ray, vec3(1.0f), 1u, false, s, count, pixel_pattern, lm, lr, branch, primary);
+    if (branch.pending) {
+      RealBranch unused = branch;
+      trace_path(branch.ray, branch.weight, branch.surface, true, s, count, pixel_pattern, lm, lr,
+                 unused, primary);
+    }
+    acc_mixed += vec4(lm, primary.is_virtual ? 1.0f : 0.0f);
+    acc_real += vec4(lr, 0.0f);
+    if (primary.hit) {
+      acc_aux += vec4(primary.depth, 1.0f, 0.0f, 0.0f);
+    }
+  }
+}
+
+// ---------------------------------------------------------------- compositing
+
+struct Resolved {
+  vec3 composite;
+  vec3 mixed;
+  vec3 real;
+  float mask;
+  float depth;
+};
+
+// Layers from the accumulators, and equation (4):
+//   I_f = M I_m + (1 - M)(I_c + I_m - I_r)
+// evaluated as I_c + (I_m - I_r) - M (I_c - I_r), which returns I_c bit for
+// bit where nothing virtual is seen (M = 0 and I_m == I_r). Without a plate
+// the real render stands in for the camera image, so I_f = I_m.
+Resolved resolve_pixel(vec4 acc_mixed, vec4 acc_real, vec4 acc_aux, vec4 plate, bool has_plate) {
+  float inv = 1.0f / float(frame.sampling.z);
+  Resolved r;
+  r.mixed = vec3(acc_mixed) * inv;
+  r.real = vec3(acc_real) * inv;
+  r.mask = acc_mixed.w * inv;
+  r.depth = acc_aux.y > 0.0f ? acc_aux.x / acc_aux.y : 0.0f;
+  vec3 camera = has_plate ? vec3(plate) : r.real;
+  // PRECISE: a reassociating compiler (Mesa does) would break the identity.
+  PRECISE vec3 composite = camera + (r.mixed - r.real) - r.mask * (camera - r.real);
+  r.composite = composite;
+  return r;
+}

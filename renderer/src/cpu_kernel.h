@@ -1,0 +1,48 @@
+// The C++ executor of renderer/shaders/kernel.glsl.
+//
+// The kernel is included inside CpuKernel, so its "global" buffers become
+// member pointers and its functions member functions; glm supplies the GLSL
+// vocabulary. One model, two executors: the CPU reference traces exactly the
+// rays the GPU traces.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "camhead/renderer/gpu_layout.h"
+
+namespace camhead::renderer::cpu {
+
+using namespace glm; // the GLSL built-ins the kernel calls unqualified
+using gpu::BvhNode;
+using gpu::FrameParams;
+using gpu::Light;
+using gpu::Material;
+using gpu::Primitive;
+using uint = std::uint32_t;
+
+#define INOUT(T) T &
+#define OUT(T) T &
+#define PRECISE // C++ without -ffast-math keeps the order as written
+#define CAMHEAD_PI 3.14159265358979f
+
+struct CpuKernel {
+  const Primitive *primitives = nullptr;
+  const BvhNode *nodes = nullptr;
+  const Material *materials = nullptr;
+  const Light *lights = nullptr;
+  FrameParams frame{};
+
+#include "kernel.glsl"
+};
+
+#undef INOUT
+#undef OUT
+#undef PRECISE
+
+} // namespace camhead::renderer::cpu

@@ -1,0 +1,53 @@
+// The GPU tracer and the CPU reference run the same kernel on the same
+// samples; they must agree far more closely than two independent renders.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "camhead/renderer/scene_loader.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead {
+namespace {
+
+class Executors : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Executors, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
+  CAMHEAD_REQUIRE_VULKAN();
+  constexpr int rpp = 16;
+  renderer::Scene scene = test::downscaled(
+      renderer::load_scene(test::shared_dir() / "reference" / (GetParam() + ".json")), 4);
+  const renderer::RenderResult gpu = test::render_gpu(scene, rpp);
+  const renderer::RenderResult cpu = test::render_cpu(scene, rpp);
+  scene.render.seed += 1;
+  const renderer::RenderResult cpu_other_seed = test::render_cpu(scene, rpp);
+
+  struct Layer {
+    const char *name;
+    const renderer::Image &gpu, &cpu, &other;
+  };
+  for (const Layer &layer :
+       {Layer{"composite", gpu.composite, cpu.composite, cpu_other_seed.composite},
+        Layer{"mixed", gpu.mixed, cpu.mixed, cpu_other_seed.mixed},
+        Layer{"real", gpu.real, cpu.real, cpu_other_seed.real},
+        Layer{"mask", gpu.mask, cpu.mask, cpu_other_seed.mask}}) {
+    ASSERT_TRUE(test::all_finite(layer.gpu)) << layer.name;
+    // Two independent renders differ by sqrt(2) times the noise of one.
+    const double noise = test::rmse(layer.cpu, layer.other) / std::sqrt(2.0);
+    const double difference = test::rmse(layer.cpu, layer.gpu);
+    std::printf("%s %s at %d rpp: GPU vs CPU RMSE %.2e, sampling noise %.2e\n", GetParam().c_str(),
+                layer.name, rpp, difference, noise);
+    if (noise == 0.0) {
+      EXPECT_EQ(difference, 0.0) << layer.name << " is noiseless, so must be identical";
+    } else {
+      EXPECT_LT(difference, noise) << layer.name;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ReferenceScenes, Executors, ::testing::Values("boxes", "ar_basic"));
+
+} // namespace
+} // namespace camhead

@@ -1,0 +1,256 @@
+// Image files: float32 EXR round trips bit for bit, PNG within one 8-bit step
+// of sRGB, the half-float reference EXRs load and agree with their PNGs, and
+// damaged files raise ImageError naming the file instead of crashing.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+#include <zlib.h>
+
+#include "camhead/renderer/image_io.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::renderer {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kShared = fs::path(CAMHEAD_SHARED_DIR) / "reference";
+
+std::string read_bytes(const fs::path &path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A 16-bit RGB PNG, which stb_image_write cannot produce.
+std::string png16(int w, int h, const std::vector<std::uint16_t> &rgb) {
+  const auto be32 = [](std::uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  const auto chunk = [&](const std::string &type, const std::string &data) {
+    const std::string body = type + data;
+    const auto crc = crc32(0, reinterpret_cast<const Bytef *>(body.data()), uInt(body.size()));
+    return be32(std::uint32_t(data.size())) + body + be32(std::uint32_t(crc));
+  };
+  std::string raw;
+  for (int y = 0; y < h; ++y) {
+    raw += '\0'; // filter: none
+    for (int i = 0; i < w * 3; ++i)
+      raw += std::string{char(rgb[y * w * 3 + i] >> 8), char(rgb[y * w * 3 + i] & 0xff)};
+  }
+  uLongf size = compressBound(uLong(raw.size()));
+  std::string z(size, '\0');
+  compress(reinterpret_cast<Bytef *>(z.data()), &size, reinterpret_cast<const Bytef *>(raw.data()),
+           uLong(raw.size()));
+  z.resize(size);
+  return "\x89PNG\r\n\x1a\n" + chunk("IHDR", be32(w) + be32(h) + std::string{16, 2, 0, 0, 0}) +
+         chunk("IDAT", z) + chunk("IEND", "");
+}
+
+class ImageIo : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("camhead_image_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path write(const std::string &name, const std::string &bytes) const {
+    std::ofstream(dir_ / name, std::ios::binary) << bytes;
+    return dir_ / name;
+  }
+  // Reading must either work or throw ImageError naming the file.
+  bool read_fails(const fs::path &path) const {
+    try {
+      (void)read_image(path);
+    } catch (const ImageError &e) {
+      EXPECT_EQ(std::string(e.what()).rfind(path.string() + ": ", 0), 0u) << e.what();
+      return true;
+    }
+    return false;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ImageIo, ExrFloat32RoundTripIsBitExact) {
+  Image img(37, 23, 3); // more rows than one ZIP block (16)
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+  for (float &v : img.data)
+    v = u(rng);
+  const float specials[] = {0.0f,  -0.0f,  1e-40f,
+                            3e38f, -1e30f, std::numeric_limits<float>::infinity()};
+  std::copy(std::begin(specials), std::end(specials), img.data.begin());
+  write_image(dir_ / "rt.exr", img);
+  const Image back = read_image(dir_ / "rt.exr");
+  ASSERT_EQ(back.width, 37);
+  ASSERT_EQ(back.height, 23);
+  ASSERT_EQ(back.channels, 3);
+  EXPECT_EQ(std::memcmp(back.data.data(), img.data.data(), img.data.size() * sizeof(float)), 0);
+  // Same file name, different case of extension.
+  write_image(dir_ / "upper.EXR", img);
+  EXPECT_EQ(read_image(dir_ / "upper.EXR").data.size(), img.data.size());
+}
+
+TEST_F(ImageIo, GreyExrIsWrittenAsYAndReadAsThreeChannels) {
+  Image grey(5, 4, 1);
+  for (std::size_t i = 0; i < grey.data.size(); ++i)
+    grey.data[i] = float(i) * 0.25f;
+  write_image(dir_ / "grey.exr", grey);
+  const Image back = read_image(dir_ / "grey.exr");
+  ASSERT_EQ(back.channels, 3);
+  for (std::size_t i = 0; i < grey.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(back.data[i * 3 + c], grey.data[i]);
+}
+
+TEST_F(ImageIo, SrgbTransferMatchesTheReference) {
+  EXPECT_FLOAT_EQ(srgb_to_linear(0.04045f), 0.04045f / 12.92f);
+  EXPECT_NEAR(srgb_to_linear(0.5f), 0.21404114f, 1e-7f);
+  EXPECT_FLOAT_EQ(srgb_to_linear(1.0f), 1.0f);
+  EXPECT_NEAR(linear_to_srgb(0.5f), 0.73535698f, 1e-7f);
+  EXPECT_FLOAT_EQ(linear_to_srgb(0.003f), 0.003f * 12.92f);
+  EXPECT_EQ(linear_to_srgb(-1.0f), 0.0f); // clipped, as imageio_util.py does
+  EXPECT_EQ(linear_to_srgb(7.0f), 1.0f);
+  EXPECT_EQ(linear_to_srgb(std::nanf("")), 0.0f);
+  for (int i = 0; i <= 1000; ++i)
+    EXPECT_NEAR(srgb_to_linear(linear_to_srgb(i / 1000.0f)), i / 1000.0f, 1e-6f);
+}
+
+TEST_F(ImageIo, PngRoundTripIsWithinOneStep) {
+  Image img(64, 3, 3);
+  for (std::size_t i = 0; i < img.data.size(); ++i)
+    img.data[i] = float(i % 193) / 192.0f;
+  img.data[0] = -0.5f; // clipped to 0
+  img.data[1] = 4.0f;  // clipped to 1
+  img.data[2] = std::nanf("");
+  write_image(dir_ / "rt.png", img);
+  const Image back = read_image(dir_ / "rt.png");
+  ASSERT_EQ(back.width, 64);
+  ASSERT_EQ(back.channels, 3);
+  for (std::size_t i = 0; i < img.data.size(); ++i) {
+    const float want = linear_to_srgb(img.data[i]);
+    EXPECT_NEAR(linear_to_srgb(back.data[i]), want, 0.5f / 255.0f + 1e-6f) << i;
+  }
+  EXPECT_EQ(back.data[0], 0.0f);
+  EXPECT_EQ(back.data[1], 1.0f);
+  EXPECT_EQ(back.data[2], 0.0f);
+  // linear 0.5 -> sRGB 0.73536 -> 187.52 -> 188
+  Image half(1, 1, 1);
+  half.data[0] = 0.5f;
+  write_image(dir_ / "half.png", half);
+  EXPECT_FLOAT_EQ(read_image(dir_ / "half.png").data[1], srgb_to_linear(188.0f / 255.0f));
+}
+
+TEST_F(ImageIo, Reads16BitPng) {
+  const fs::path path = write("deep.png", png16(2, 1, {0, 65535, 32768, 1000, 2000, 3000}));
+  const Image img = read_image(path);
+  ASSERT_EQ(img.width, 2);
+  EXPECT_EQ(img.data[0], 0.0f);
+  EXPECT_FLOAT_EQ(img.data[1], 1.0f);
+  EXPECT_FLOAT_EQ(img.data[2], srgb_to_linear(32768.0f / 65535.0f));
+  EXPECT_FLOAT_EQ(img.data[5], srgb_to_linear(3000.0f / 65535.0f));
+}
+
+TEST_F(ImageIo, ReferenceExrLoadsAndAgreesWithItsPng) {
+  const Image exr = read_image(kShared / "boxes_1024.exr"); // half float, ZIP, RGB
+  const Image png = read_image(kShared / "boxes_1024.png");
+  ASSERT_EQ(exr.width, 720);
+  ASSERT_EQ(exr.height, 576);
+  ASSERT_EQ(png.data.size(), exr.data.size());
+  double sum = 0.0;
+  std::size_t off_by_more = 0;
+  for (std::size_t i = 0; i < exr.data.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(exr.data[i]) && exr.data[i] >= 0.0f) << i;
+    sum += exr.data[i];
+    const float a = linear_to_srgb(exr.data[i]) * 255.0f;
+    const float b = linear_to_srgb(png.data[i]) * 255.0f;
+    off_by_more += std::abs(a - b) > 1.0f;
+  }
+  const double mean = sum / double(exr.data.size());
+  EXPECT_GT(mean, 0.01);
+  EXPECT_LT(mean, 0.5);
+  EXPECT_LT(off_by_more, exr.data.size() / 1000);
+
+  const Image plate = read_image(kShared / "ar_basic_plate.exr");
+  EXPECT_EQ(plate.width, 720);
+  const Image mask = read_image(kShared / "ar_basic_mask.exr");
+  for (const float v : mask.data)
+    ASSERT_TRUE(v >= 0.0f && v <= 1.0f) << v;
+}
+
+TEST_F(ImageIo, ReadsTiledExr) {
+  // assets/tiled.exr: 5x3 float RGB in 2x2 tiles (partial ones at the edges),
+  // written by tinyexr; R = x + 10 y, G = R + 100, B = R + 200.
+  const Image img = read_image(fs::path(CAMHEAD_SOURCE_DIR) / "tests" / "assets" / "tiled.exr");
+  ASSERT_EQ(img.width, 5);
+  ASSERT_EQ(img.height, 3);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(img.at(x, y)[c], float(x + 10 * y + 100 * c)) << x << "," << y << "," << c;
+}
+
+TEST_F(ImageIo, DamagedFilesRaiseImageError) {
+  EXPECT_TRUE(read_fails(dir_ / "missing.exr"));
+  EXPECT_TRUE(read_fails(dir_ / "missing.png"));
+  EXPECT_TRUE(read_fails(write("text.exr", "not an image")));
+  EXPECT_TRUE(read_fails(write("text.png", "not an image")));
+  EXPECT_TRUE(read_fails(write("image.bmp", "BM")));
+  const std::string exr = read_bytes(kShared / "ar_basic_mask.exr");
+  for (const std::size_t n : {std::size_t(0), std::size_t(4), std::size_t(8), std::size_t(100),
+                              std::size_t(400), exr.size() / 2, exr.size() - 1})
+    EXPECT_TRUE(read_fails(write("cut.exr", exr.substr(0, n)))) << n;
+  Image img(20, 18, 3);
+  write_image(dir_ / "small.png", img);
+  const std::string png = read_bytes(dir_ / "small.png");
+  // stb_image does not insist on the final IEND chunk (12 bytes); every cut
+  // into the pixel data must fail.
+  for (std::size_t n = 0; n + 12 < png.size(); n += 7)
+    EXPECT_TRUE(read_fails(write("cut.png", png.substr(0, n)))) << n;
+}
+
+TEST_F(ImageIo, CorruptedBytesNeverCrash) {
+  write_image(dir_ / "small.exr", Image(19, 17, 3));
+  const std::string exr = read_bytes(dir_ / "small.exr");
+  std::mt19937 rng(7);
+  for (std::size_t i = 0; i < exr.size(); ++i) {
+    for (const char c : {'\0', '\x7f', '\xff', char(rng())}) {
+      std::string t = exr;
+      t[i] = c;
+      (void)read_fails(write("flip.exr", t));
+    }
+  }
+  write_image(dir_ / "small.png", Image(19, 17, 3));
+  const std::string png = read_bytes(dir_ / "small.png");
+  for (std::size_t i = 0; i < png.size(); ++i) {
+    std::string t = png;
+    t[i] = char(t[i] ^ 0x5a);
+    (void)read_fails(write("flip.png", t));
+  }
+}
+
+TEST_F(ImageIo, WriteRejectsInvalidImagesAndPaths) {
+  EXPECT_THROW(write_image(dir_ / "a.exr", Image()), ImageError);
+  EXPECT_THROW(write_image(dir_ / "a.exr", Image(2, 2, 2)), ImageError);
+  Image short_data(2, 2, 3);
+  short_data.data.pop_back();
+  EXPECT_THROW(write_image(dir_ / "a.png", short_data), ImageError);
+  EXPECT_THROW(write_image(dir_ / "a.tif", Image(2, 2, 3)), ImageError);
+  EXPECT_THROW(write_image(dir_ / "no" / "such" / "dir.exr", Image(2, 2, 3)), ImageError);
+  EXPECT_THROW(write_image(dir_ / "no" / "such" / "dir.png", Image(2, 2, 3)), ImageError);
+}
+
+} // namespace
+} // namespace camhead::renderer

@@ -1,0 +1,55 @@
+#include "test_scenes.h"
+
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+namespace camhead::test {
+
+renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int width, int height) {
+  using namespace renderer;
+  Scene scene;
+  scene.source = "edge_scene";
+  scene.render.width = width;
+  scene.render.height = height;
+  scene.camera.position = {0.0f, 0.0f, 0.0f};
+  scene.camera.look_at = {0.0f, 0.0f, -1.0f};
+  scene.camera.focal_length_mm = 50.0f;
+  scene.camera.sensor_width_mm = 36.0f;
+  scene.camera.f_number = f_number;
+  scene.camera.focus_distance_m = focus_m;
+  scene.materials.push_back({"emitter", MaterialType::emission, glm::vec3(1.0f), 1.5f});
+  Object plane;
+  plane.name = "half_plane";
+  plane.type = ShapeType::plane;
+  // An XZ plane turned to face the camera, reaching from x = 0 far to the
+  // right and far up and down, so that only its left edge is in view.
+  const float extent = 1000.0f * depth_m;
+  plane.center = {0.5f * extent, 0.0f, -depth_m};
+  plane.size = {extent, 1.0f, extent};
+  plane.rotation_deg = {90.0f, 0.0f, 0.0f};
+  plane.material = 0;
+  scene.objects.push_back(plane);
+  return scene;
+}
+
+double coc_px(const renderer::Scene &scene, float depth_m) {
+  const auto &c = scene.camera;
+  const double f_px = double(c.focal_length_mm) * scene.render.width / c.sensor_width_mm;
+  const double f_m = c.focal_length_mm * 1e-3;
+  return f_px * (f_m / c.f_number) * std::abs(1.0 / c.focus_distance_m - 1.0 / depth_m);
+}
+
+glm::vec2 project(const renderer::Scene &scene, glm::vec3 world) {
+  const auto &c = scene.camera;
+  const glm::vec3 forward = glm::normalize(c.look_at - c.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
+  const glm::vec3 up = glm::cross(right, forward);
+  const glm::vec3 d = world - c.position;
+  const float f_px = c.focal_length_mm * float(scene.render.width) / c.sensor_width_mm;
+  const float z = glm::dot(d, forward);
+  return {0.5f * float(scene.render.width) + f_px * glm::dot(d, right) / z,
+          0.5f * float(scene.render.height) - f_px * glm::dot(d, up) / z};
+}
+
+} // namespace camhead::test

@@ -1,0 +1,54 @@
+// Shared helpers of the camhead tests: locating files, rendering on either
+// executor, and image metrics as ../shared/reference/compare.py defines them.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/image.h"
+#include "camhead/renderer/render_result.h"
+#include "camhead/renderer/scene.h"
+
+namespace camhead::test {
+
+// Repository and ../shared folders, fixed at configure time.
+[[nodiscard]] std::filesystem::path source_dir();
+[[nodiscard]] std::filesystem::path shared_dir();
+
+// True when a Vulkan device is present; tests needing one GTEST_SKIP otherwise.
+[[nodiscard]] bool have_vulkan();
+
+// Renders `scene` with `rpp` rays per pixel on the GPU tracer (lavapipe in
+// CI) or on the CPU reference.
+[[nodiscard]] renderer::RenderResult render_gpu(const renderer::Scene &scene, int rpp);
+[[nodiscard]] renderer::RenderResult render_cpu(const renderer::Scene &scene, int rpp);
+
+// The GPU tracer on a hardware GPU; elsewhere the CPU reference, which runs
+// the same kernel several times faster than lavapipe does (bench/RESULTS.md).
+// For long converged renders whose executor does not matter: the executors
+// are held equal by executors_test.cpp.
+[[nodiscard]] renderer::RenderResult render_fastest(const renderer::Scene &scene, int rpp);
+[[nodiscard]] bool have_hardware_gpu();
+
+// Root mean square difference over all pixels and channels.
+[[nodiscard]] double rmse(const renderer::Image &a, const renderer::Image &b);
+// rmse / RMS(reference), as compare.py's relRMSE.
+[[nodiscard]] double relative_rmse(const renderer::Image &reference, const renderer::Image &test);
+
+// Every sample finite: no NaN or Inf reaches an output.
+[[nodiscard]] bool all_finite(const renderer::Image &image);
+
+// A copy of `scene` at a lower resolution with the same field of view.
+[[nodiscard]] renderer::Scene downscaled(renderer::Scene scene, int divisor);
+
+} // namespace camhead::test
+
+// Skips the current test when no Vulkan device exists, saying so.
+#define CAMHEAD_REQUIRE_VULKAN()                                                                   \
+  do {                                                                                             \
+    if (!camhead::test::have_vulkan()) {                                                           \
+      GTEST_SKIP() << "no Vulkan device (install mesa-vulkan-drivers for lavapipe)";               \
+    }                                                                                              \
+  } while (false)
