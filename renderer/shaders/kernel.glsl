@@ -138,36 +138,52 @@ struct RealBranch {
   bool pending;
 };
 
-// What the camera ray's first hit tells the mask and depth layers.
-struct PrimaryHit {
-  bool hit;
-  bool is_virtual;
-  float depth;
+// What one camera sample contributes to the accumulators.
+struct SampleResult {
+  vec3 mixed;      // mixed radiance
+  vec3 real;       // real radiance
+  bool hit;        // the camera ray hit something
+  bool is_virtual; // ... and that was a virtual object (mask)
+  float depth;     // camera-axis depth of that hit
 };
 
-// Follows one path, surface by surface, adding to lm (mixed radiance) and lr
-// (real radiance).
-//   real_only = false: the mixed path from the camera. While it has met only
-//     real surfaces it is the real path too (both radiances are shaded at the
-//     same hits, with the mixed and the real shadow ray); at the first virtual
-//     surface the real path is handed back in `branch`.
-//   real_only = true: the real radiance ray, seeing the real proxy alone.
+// Traces one camera ray, surface by surface, in up to two segments:
+// 1. The mixed path from the camera. While it meets only real surfaces it is
+//    the real path too: both radiances are shaded at the same hits, with the
+//    mixed and the real shadow ray. At its first virtual surface the real
+//    radiance ray is set aside in `branch`.
+// 2. That real radiance ray, which sees the real proxy alone.
+// Both segments run in the same loop: a second copy of the loop would double
+// the code that SIMD executors such as lavapipe run for every lane.
 // Surfaces 1 .. max_bounces + 1 are shaded; the ray leaving the last of them
 // picks up emission only (reference README, "What Cycles does").
-void trace_path(Ray ray, vec3 weight, uint surface, bool real_only, uint s, uint count,
-                uint pixel_pattern, INOUT(vec3) lm, INOUT(vec3) lr, INOUT(RealBranch) branch,
-                INOUT(PrimaryHit) primary) {
-  bool coupled = !real_only;
+SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
+  SampleResult result;
+  result.mixed = vec3(0.0f);
+  result.real = vec3(0.0f);
+  result.hit = false;
+  result.is_virtual = false;
+  result.depth = 0.0f;
+  RealBranch branch;
+  branch.ray = camera;
+  branch.weight = vec3(1.0f);
+  branch.surface = 1u;
+  branch.pending = false;
+
+  Ray ray = camera;
+  vec3 weight = vec3(1.0f);
+  uint surface = 1u;
+  bool real_only = false; // segment 2
+  bool coupled = true;    // segment 1 before any virtual surface
   uint last_shaded = frame.tracing.x + 1u;
-  vec3 world = vec3(frame.world_color);
-  float t_min = 0.0f;
   for (;;) {
-    Hit hit = closest_hit(ray, t_min, CAMHEAD_NO_HIT, real_only);
-    bool is_virtual = hit.t != CAMHEAD_NO_HIT && !prim_is_real(hit.prim);
+    Hit hit = closest_hit(ray, 0.0f, CAMHEAD_NO_HIT, real_only);
+    bool missed = hit.t == CAMHEAD_NO_HIT;
+    bool is_virtual = !missed && !prim_is_real(hit.prim);
     if (surface == 1u && !real_only) {
-      primary.hit = hit.t != CAMHEAD_NO_HIT;
-      primary.is_virtual = is_virtual;
-      primary.depth = hit.t != CAMHEAD_NO_HIT ? hit.t * dot(ray.dir, vec3(frame.cam_forward)) : 0.0f;
+      result.hit = !missed;
+      result.is_virtual = is_virtual;
+      result.depth = missed ? 0.0f : hit.t * dot(ray.dir, vec3(frame.cam_forward));
     }
     if (coupled && is_virtual) {
       coupled = false;
@@ -178,52 +194,51 @@ void trace_path(Ray ray, vec3 weight, uint surface, bool real_only, uint s, uint
     }
     bool add_mixed = !real_only;
     bool add_real = real_only || coupled;
-    vec3 emitted = vec3(0.0f);
-    if (surface > 1u) {
-      emitted = area_lights_along(ray, hit.t);
-    }
-    if (hit.t == CAMHEAD_NO_HIT) {
-      emitted += world;
-    } else {
-      Material material = materials[prim_material(hit.prim)];
-      if (floatBitsToUint(material.params.w) == MAT_EMISSION) {
-        emitted += vec3(material.color);
-      }
-    }
-    if (add_mixed) {
-      lm += weight * emitted;
-    }
-    if (add_real) {
-      lr += weight * emitted;
-    }
-    if (hit.t == CAMHEAD_NO_HIT || surface > last_shaded) {
-      return;
-    }
 
-    Material material = materials[prim_material(hit.prim)];
+    Material material = materials[missed ? 0u : prim_material(hit.prim)];
     uint type = floatBitsToUint(material.params.w);
+    vec3 emitted = surface > 1u ? area_lights_along(ray, hit.t) : vec3(0.0f);
+    if (missed) {
+      emitted += vec3(frame.world_color);
+    } else if (type == MAT_EMISSION) {
+      emitted += vec3(material.color);
+    }
     vec3 p = ray.origin + hit.t * ray.dir;
-    vec3 n = surface_normal(hit.prim, p);
+    vec3 n = missed ? vec3(0.0f, 0.0f, 1.0f) : surface_normal(hit.prim, p);
     bool entering = dot(n, ray.dir) < 0.0f;
     vec3 n_facing = entering ? n : -n; // planes and meshes are two-sided
     uint surface_dim = DIM_SURFACE_BASE + (surface - 1u) * DIM_PER_SURFACE;
-    if (type == MAT_DIFFUSE) {
+    bool path_ends = missed || surface > last_shaded || type == MAT_EMISSION;
+    if (!path_ends && type == MAT_DIFFUSE) {
       vec3 brdf_weight = weight * vec3(material.color) * (1.0f / CAMHEAD_PI);
       vec3 dm = vec3(0.0f);
       vec3 dr = vec3(0.0f);
-      direct_light(p, n_facing, brdf_weight, surface_dim, s, count, pixel_pattern, add_real && !real_only,
-                   real_only, dm, dr);
-      if (add_mixed) {
-        lm += dm;
-      }
-      if (add_real) {
-        lr += dr;
-      }
-      return;
+      direct_light(p, n_facing, brdf_weight, surface_dim, s, count, pixel_pattern,
+                   add_real && !real_only, real_only, dm, dr);
+      emitted = emitted * weight;
+      weight = vec3(0.0f);
+      result.mixed += add_mixed ? emitted + dm : vec3(0.0f);
+      result.real += add_real ? emitted + dr : vec3(0.0f);
+      path_ends = true;
+    } else {
+      result.mixed += add_mixed ? weight * emitted : vec3(0.0f);
+      result.real += add_real ? weight * emitted : vec3(0.0f);
     }
-    if (type == MAT_EMISSION) {
-      return; // emits (added above), reflects nothing
+
+    if (path_ends) {
+      if (!branch.pending) {
+        break;
+      }
+      // Segment 2: the real radiance ray from the first virtual surface on.
+      ray = branch.ray;
+      weight = branch.weight;
+      surface = branch.surface;
+      branch.pending = false;
+      real_only = true;
+      coupled = false;
+      continue;
     }
+
     float eps = ray_epsilon(p);
     if (type == MAT_MIRROR) {
       weight *= vec3(material.color); // reflectance = tint at every angle, no Fresnel
@@ -231,19 +246,16 @@ void trace_path(Ray ray, vec3 weight, uint surface, bool real_only, uint s, uint
       ray.origin = p + n_facing * eps;
     } else { // MAT_GLASS: reflect with probability F, else refract; weight 1
       float eta = entering ? material.params.x : 1.0f / material.params.x;
-      float cos_i = -dot(ray.dir, n_facing);
-      float reflectance = fresnel_dielectric(cos_i, eta);
+      float reflectance = fresnel_dielectric(-dot(ray.dir, n_facing), eta);
       float u = sample_dimension(s, count, pixel_pattern, surface_dim).x;
-      if (u < reflectance) {
-        ray.dir = reflect(ray.dir, n_facing);
-        ray.origin = p + n_facing * eps;
-      } else {
-        ray.dir = normalize(refract(ray.dir, n_facing, 1.0f / eta));
-        ray.origin = p - n_facing * eps;
-      }
+      bool reflects = u < reflectance;
+      ray.dir = reflects ? reflect(ray.dir, n_facing)
+                         : normalize(refract(ray.dir, n_facing, 1.0f / eta));
+      ray.origin = p + (reflects ? n_facing : -n_facing) * eps;
     }
     ++surface;
   }
+  return result;
 }
 
 // Adds samples [frame.sampling.x, frame.sampling.y) of pixel (x, y) to the
@@ -252,28 +264,11 @@ void trace_pixel(uint x, uint y, INOUT(vec4) acc_mixed, INOUT(vec4) acc_real, IN
   uint count = frame.sampling.z;
   uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, frame.sampling.w);
   for (uint s = frame.sampling.x; s < frame.sampling.y; ++s) {
-    Ray ray = camera_ray(x, y, s, count, pixel_pattern);
-    vec3 lm = vec3(0.0f);
-    vec3 lr = vec3(0.0f);
-    RealBranch branch;
-    branch.ray = ray;
-    branch.weight = vec3(1.0f);
-    branch.surface = 1u;
-    branch.pending = false;
-    PrimaryHit primary;
-    primary.hit = false;
-    primary.is_virtual = false;
-    primary.depth = 0.0f;
-    trace_path(ray, vec3(1.0f), 1u, false, s, count, pixel_pattern, lm, lr, branch, primary);
-    if (branch.pending) {
-      RealBranch unused = branch;
-      trace_path(branch.ray, branch.weight, branch.surface, true, s, count, pixel_pattern, lm, lr,
-                 unused, primary);
-    }
-    acc_mixed += vec4(lm, primary.is_virtual ? 1.0f : 0.0f);
-    acc_real += vec4(lr, 0.0f);
-    if (primary.hit) {
-      acc_aux += vec4(primary.depth, 1.0f, 0.0f, 0.0f);
+    SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern), s, count, pixel_pattern);
+    acc_mixed += vec4(r.mixed, r.is_virtual ? 1.0f : 0.0f);
+    acc_real += vec4(r.real, 0.0f);
+    if (r.hit) {
+      acc_aux += vec4(r.depth, 1.0f, 0.0f, 0.0f);
     }
   }
 }

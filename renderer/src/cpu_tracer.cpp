@@ -40,7 +40,10 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
   cpu::CpuKernel kernel;
   kernel.primitives = scene.primitives.data();
   kernel.nodes = scene.nodes.data();
-  kernel.materials = scene.materials.data();
+  // The GPU tracer binds a placeholder for empty arrays; so does this one, as
+  // the kernel reads material 0 for rays that miss.
+  static const gpu::Material placeholder_material{};
+  kernel.materials = scene.materials.empty() ? &placeholder_material : scene.materials.data();
   kernel.lights = scene.lights.data();
   kernel.frame = frame;
   kernel.frame.sampling.x = 0;
