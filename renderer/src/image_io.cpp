@@ -129,9 +129,63 @@ struct ExrImage {
 };
 
 float exr_sample(const unsigned char *plane, int pixel_type, std::size_t i) {
-  if (pixel_type == TINYEXR_PIXELTYPE_UINT)
-    return float(reinterpret_cast<const unsigned int *>(plane)[i]);
-  return reinterpret_cast<const float *>(plane)[i];
+  return pixel_type == TINYEXR_PIXELTYPE_UINT ? float(reinterpret_cast<const unsigned *>(plane)[i])
+                                              : reinterpret_cast<const float *>(plane)[i];
+}
+
+template <typename T> T load_le(const unsigned char *p) {
+  T v = 0;
+  for (std::size_t k = sizeof(T); k-- > 0;)
+    v = T(v << 8 | T(p[k]));
+  return v;
+}
+
+// tinyexr's header parser asserts on (and, without asserts, reads past) a
+// "tiles" attribute that is not 9 bytes and runs strlen() over "name" and
+// "type" values; such attributes are refused before it sees them.
+void check_attributes(const std::filesystem::path &path, const std::vector<unsigned char> &bytes) {
+  const auto *text = reinterpret_cast<const char *>(bytes.data());
+  const auto skip_string = [&](std::size_t at) { // one past its NUL, or past the end
+    return at >= bytes.size() ? bytes.size() + 1 : at + strnlen(text + at, bytes.size() - at) + 1;
+  };
+  std::size_t pos = 8; // magic number and version
+  while (pos < bytes.size() && bytes[pos] != 0) {
+    const std::size_t size_at = skip_string(skip_string(pos));
+    if (size_at > bytes.size() || bytes.size() - size_at < 4)
+      return; // malformed: tinyexr reports it
+    const std::size_t size = load_le<std::uint32_t>(&bytes[size_at]), data = size_at + 4;
+    if (size > bytes.size() - data)
+      return;
+    const std::string attr(text + pos);
+    const bool unterminated = size > 0 && std::memchr(text + data, 0, size) == nullptr;
+    if ((attr == "tiles" && size != 9) || ((attr == "name" || attr == "type") && unterminated))
+      fail(path, "malformed header attribute " + attr);
+    pos = data + size;
+  }
+}
+
+// tinyexr trusts the tile coordinates stored in each chunk (and multiplies
+// them unchecked), so a tiled file's offset table and chunk headers are
+// checked here first: one level, every offset inside the file, every chunk
+// at the tile its table slot names.
+void check_tiles(const std::filesystem::path &path, const std::vector<unsigned char> &bytes,
+                 const EXRHeader &h, long long w, long long hgt) {
+  const long long tx = h.tile_size_x, ty = h.tile_size_y;
+  if (h.tile_level_mode != TINYEXR_TILE_ONE_LEVEL || tx < 1 || ty < 1 || tx > 65536 || ty > 65536)
+    fail(path, "only single-level tiled OpenEXR files with sane tile sizes are supported");
+  const std::size_t nx = std::size_t((w + tx - 1) / tx), ny = std::size_t((hgt + ty - 1) / ty);
+  const std::size_t table = std::size_t(h.header_len) + 8, end = table + 8 * nx * ny;
+  if (end > bytes.size())
+    fail(path, "truncated tile offset table");
+  for (std::size_t i = 0; i < nx * ny; ++i) {
+    const auto offset = load_le<std::uint64_t>(&bytes[table + 8 * i]);
+    if (offset < end || offset > bytes.size() || bytes.size() - offset < 20)
+      fail(path, "bad tile offset");
+    const unsigned char *chunk = &bytes[std::size_t(offset)];
+    if (load_le<std::uint32_t>(chunk) != i % nx || load_le<std::uint32_t>(chunk + 4) != i / nx ||
+        load_le<std::uint32_t>(chunk + 8) != 0 || load_le<std::uint32_t>(chunk + 12) != 0)
+      fail(path, "tile chunk does not match its table slot");
+  }
 }
 
 Image read_exr(const std::filesystem::path &path) {
@@ -141,6 +195,7 @@ Image read_exr(const std::filesystem::path &path) {
     fail(path, "not an OpenEXR file");
   if (version.multipart || version.non_image)
     fail(path, "multi-part and deep OpenEXR files are not supported");
+  check_attributes(path, bytes);
   ExrHeader header;
   const char *raw_err = nullptr;
   int rc = ParseEXRHeaderFromMemory(&header.h, &version, bytes.data(), bytes.size(), &raw_err);
@@ -157,7 +212,6 @@ Image read_exr(const std::filesystem::path &path) {
   const long long h = (long long)dw.max_y - dw.min_y + 1;
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported data window size");
-
   int idx[3] = {-1, -1, -1};
   int luma = -1;
   for (int c = 0; c < header.h.num_channels; ++c) {
@@ -177,7 +231,8 @@ Image read_exr(const std::filesystem::path &path) {
     fail(path, "needs R, G and B channels or a Y channel");
   if (!rgb)
     idx[0] = idx[1] = idx[2] = luma;
-
+  if (header.h.tiled)
+    check_tiles(path, bytes, header.h, w, h);
   ExrImage image;
   // tinyexr frees the channels of a failed scanline decode by this count,
   // which it only fills in on success.
@@ -272,11 +327,10 @@ Image read_png(const std::filesystem::path &path) {
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported image size");
   const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
-  std::unique_ptr<void, decltype(&stbi_image_free)> pixels(nullptr, &stbi_image_free);
-  if (sixteen)
-    pixels.reset(stbi_load_16_from_memory(bytes.data(), len, &w, &h, &comp, 3));
-  else
-    pixels.reset(stbi_load_from_memory(bytes.data(), len, &w, &h, &comp, 3));
+  const std::unique_ptr<void, decltype(&stbi_image_free)> pixels(
+      sixteen ? static_cast<void *>(stbi_load_16_from_memory(bytes.data(), len, &w, &h, &comp, 3))
+              : static_cast<void *>(stbi_load_from_memory(bytes.data(), len, &w, &h, &comp, 3)),
+      &stbi_image_free);
   if (!pixels)
     fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
   Image out(w, h, 3);

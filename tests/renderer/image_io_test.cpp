@@ -1,6 +1,8 @@
 // Image files: float32 EXR round trips bit for bit, PNG within one 8-bit step
 // of sRGB, the half-float reference EXRs load and agree with their PNGs, and
 // damaged files raise ImageError naming the file instead of crashing.
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -53,6 +55,50 @@ std::string png16(int w, int h, const std::vector<std::uint16_t> &rgb) {
   z.resize(size);
   return "\x89PNG\r\n\x1a\n" + chunk("IHDR", be32(w) + be32(h) + std::string{16, 2, 0, 0, 0}) +
          chunk("IDAT", z) + chunk("IEND", "");
+}
+
+// A 5x3 float RGB OpenEXR in 2x2 tiles (partial ones at the edges), written
+// by hand after the file layout spec: R = x + 10 y, G = R + 100, B = R + 200.
+// (tinyexr can write tiles, but the renderer keeps tinyexr private.)
+std::string tiled_exr() {
+  static_assert(std::endian::native == std::endian::little, "EXR fields are little-endian");
+  std::string out("\x76\x2f\x31\x01\x02\x02\x00\x00", 8); // magic; version 2, tiled
+  const auto i32 = [](std::int32_t v) { return std::string(reinterpret_cast<char *>(&v), 4); };
+  const auto f32 = [](float v) { return std::string(reinterpret_cast<char *>(&v), 4); };
+  const auto attr = [&](const std::string &name, const std::string &type, const std::string &v) {
+    out += name + '\0' + type + '\0' + i32(std::int32_t(v.size())) + v;
+  };
+  std::string chlist;
+  for (const char *c : {"B", "G", "R"}) // float, not linear, sampling 1 x 1
+    chlist += std::string(c) + '\0' + i32(2) + std::string(4, '\0') + i32(1) + i32(1);
+  const std::string box = i32(0) + i32(0) + i32(4) + i32(2);
+  attr("channels", "chlist", chlist + '\0');
+  attr("compression", "compression", std::string(1, '\0'));
+  attr("dataWindow", "box2i", box);
+  attr("displayWindow", "box2i", box);
+  attr("lineOrder", "lineOrder", std::string(1, '\0'));
+  attr("pixelAspectRatio", "float", f32(1.0f));
+  attr("screenWindowCenter", "v2f", f32(0.0f) + f32(0.0f));
+  attr("screenWindowWidth", "float", f32(1.0f));
+  attr("tiles", "tiledesc", i32(2) + i32(2) + std::string(1, '\0')); // one level
+  out += '\0';
+  std::string chunks;
+  std::vector<std::uint64_t> offsets;
+  const std::size_t table_end = out.size() + 6 * 8;
+  for (int ty = 0; ty < 2; ++ty) {
+    for (int tx = 0; tx < 3; ++tx) {
+      offsets.push_back(table_end + chunks.size());
+      std::string data;
+      for (int y = 2 * ty; y < std::min(2 * ty + 2, 3); ++y)
+        for (int c = 2; c >= 0; --c) // B, G, R
+          for (int x = 2 * tx; x < std::min(2 * tx + 2, 5); ++x)
+            data += f32(float(x + 10 * y + 100 * c));
+      chunks += i32(tx) + i32(ty) + i32(0) + i32(0) + i32(std::int32_t(data.size())) + data;
+    }
+  }
+  for (const std::uint64_t o : offsets)
+    out += std::string(reinterpret_cast<const char *>(&o), 8);
+  return out + chunks;
 }
 
 class ImageIo : public ::testing::Test {
@@ -191,15 +237,38 @@ TEST_F(ImageIo, ReferenceExrLoadsAndAgreesWithItsPng) {
 }
 
 TEST_F(ImageIo, ReadsTiledExr) {
-  // assets/tiled.exr: 5x3 float RGB in 2x2 tiles (partial ones at the edges),
-  // written by tinyexr; R = x + 10 y, G = R + 100, B = R + 200.
-  const Image img = read_image(fs::path(CAMHEAD_SOURCE_DIR) / "tests" / "assets" / "tiled.exr");
+  const std::string bytes = tiled_exr();
+  const Image img = read_image(write("tiled.exr", bytes));
   ASSERT_EQ(img.width, 5);
   ASSERT_EQ(img.height, 3);
   for (int y = 0; y < 3; ++y)
     for (int x = 0; x < 5; ++x)
       for (int c = 0; c < 3; ++c)
         EXPECT_EQ(img.at(x, y)[c], float(x + 10 * y + 100 * c)) << x << "," << y << "," << c;
+}
+
+TEST_F(ImageIo, DamagedTiledExrIsRefusedBeforeTinyexrTrustsIt) {
+  const std::string good = tiled_exr();
+  const std::size_t size_at = good.find(std::string("tiles\0tiledesc\0", 15)) + 15;
+  const std::size_t table = size_at + 4 + 9 + 1; // "tiles" is the last attribute
+  const auto message = [&](std::string bytes) {
+    try {
+      (void)read_image(write("bad.exr", bytes));
+    } catch (const ImageError &e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  std::string t = good;
+  t[size_at] = 8; // a 'tiles' attribute of the wrong size
+  EXPECT_NE(message(t).find("malformed header attribute tiles"), std::string::npos) << message(t);
+  t = good;
+  t[table] = 5; // the first tile's offset points into the header
+  EXPECT_NE(message(t).find("bad tile offset"), std::string::npos) << message(t);
+  t = good;
+  std::swap_ranges(t.begin() + long(table), t.begin() + long(table) + 8,
+                   t.begin() + long(table) + 8);
+  EXPECT_NE(message(t).find("does not match"), std::string::npos) << message(t);
 }
 
 TEST_F(ImageIo, DamagedFilesRaiseImageError) {
