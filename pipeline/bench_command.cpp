@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "commands.h"
@@ -27,6 +28,7 @@ struct BenchArgs {
   int frames = 9;
   int warmup = 2;
   std::string device;
+  bool cpu_peer = false;
 };
 
 double paper_fps(int rpp) {
@@ -42,6 +44,19 @@ double paper_fps(int rpp) {
   }
 }
 
+// Median wall time of `frames` calls after `warmup` untimed ones.
+template <typename RenderFn> double median_seconds(const BenchArgs &args, RenderFn render) {
+  std::vector<double> seconds;
+  for (int i = 0; i < args.warmup + args.frames; ++i) {
+    const double s = render();
+    if (i >= args.warmup) {
+      seconds.push_back(s);
+    }
+  }
+  std::sort(seconds.begin(), seconds.end());
+  return seconds[seconds.size() / 2];
+}
+
 int run_bench(const BenchArgs &args) {
   using namespace camhead::renderer;
   try {
@@ -52,30 +67,33 @@ int run_bench(const BenchArgs &args) {
     scene.render.width = args.width;
     scene.render.height = args.height;
     GpuTracer tracer(args.device);
-    tracer.load(compile_scene(scene));
+    const CompiledScene compiled = compile_scene(scene);
+    tracer.load(compiled);
     std::printf("scene %s, %dx%d, device %s\n", args.scene.c_str(), args.width, args.height,
                 tracer.device_name().c_str());
     std::printf("median of %d frames after %d warm-up frames\n\n", args.frames, args.warmup);
     std::printf("| rpp | camera rays/frame | frame ms (median) | fps   | M camera rays/s | "
-                "paper fps (GTX 590) |\n");
+                "paper fps (GTX 590) |%s\n",
+                args.cpu_peer ? " CPU reference ms | GPU speed / CPU |" : "");
     std::printf("|-----|-------------------|-------------------|-------|-----------------|"
-                "---------------------|\n");
+                "---------------------|%s\n",
+                args.cpu_peer ? "------------------|-----------------|" : "");
     for (int rpp : args.rpp) {
       const gpu::FrameParams frame = make_frame_params(scene, rpp);
-      std::vector<double> seconds;
-      for (int i = 0; i < args.warmup + args.frames; ++i) {
-        const RenderResult r = tracer.render(frame);
-        if (i >= args.warmup) {
-          seconds.push_back(r.seconds);
-        }
-      }
-      std::sort(seconds.begin(), seconds.end());
-      const double median = seconds[seconds.size() / 2];
+      const double median = median_seconds(args, [&] { return tracer.render(frame).seconds; });
       const double rays = double(args.width) * args.height * rpp;
       const double paper = paper_fps(rpp);
-      std::printf("| %3d | %15.1f M | %17.2f | %5.1f | %15.1f | %19s |\n", rpp, rays * 1e-6,
+      std::printf("| %3d | %15.1f M | %17.2f | %5.1f | %15.1f | %19s |", rpp, rays * 1e-6,
                   median * 1e3, 1.0 / median, rays / median * 1e-6,
                   paper > 0 ? std::to_string(int(paper)).c_str() : "-");
+      if (args.cpu_peer) {
+        // The same kernel on the same frame, compiled as C++: a peer in the
+        // same process, so the ratio holds even on a noisy machine.
+        const double cpu =
+            median_seconds(args, [&] { return render_cpu(compiled, frame).seconds; });
+        std::printf(" %16.2f | %15.2f |", cpu * 1e3, cpu / median);
+      }
+      std::printf("\n");
       std::fflush(stdout);
     }
     return 0;
@@ -111,6 +129,8 @@ void add_bench_command(CLI::App &app) {
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
+  cmd->add_flag("--cpu-peer", args->cpu_peer,
+                "Also time the CPU reference on the same frames and print the ratio");
   cmd->callback([args] { set_exit_code(run_bench(*args)); });
 }
 

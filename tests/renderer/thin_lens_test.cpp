@@ -1,8 +1,10 @@
 // The thin-lens camera against its formula (method.md section 1): the blur of
 // a defocused edge has the diameter the thin-lens equation predicts, and
 // stratified sampling converges faster than independent random sampling.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "test_scenes.h"
@@ -76,7 +78,17 @@ INSTANTIATE_TEST_SUITE_P(Depths, BlurCircle,
                                            LensCase{1.4f, 2.0f, 1.0f},   // 6.4 px
                                            LensCase{8.0f, 0.5f, 4.0f},   // 3.9 px
                                            LensCase{16.0f, 1.0f, 0.3f}   // 2.6 px
-                                           ));
+                                           ),
+                         [](const ::testing::TestParamInfo<LensCase> &info) {
+                           // e.g. f2_0_focus1_00m_edge0_50m
+                           char name[64];
+                           std::snprintf(name, sizeof name, "f%.1f_focus%.2fm_edge%.2fm",
+                                         info.param.f_number, info.param.focus_m,
+                                         info.param.depth_m);
+                           std::string s = name;
+                           std::replace(s.begin(), s.end(), '.', '_');
+                           return s;
+                         });
 
 // method.md section 2: stratified jittered sampling of pixel and aperture.
 // On a defocused edge its error falls faster than the N^-1/2 of independent
