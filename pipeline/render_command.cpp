@@ -1,4 +1,5 @@
 // camhead render: one still of a scene file, on the GPU or the CPU reference.
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -44,8 +45,29 @@ const renderer::Image &pick_layer(const renderer::RenderResult &r, const std::st
   return r.composite;
 }
 
+// Refuses an output that could not be written before spending a long render
+// on it.
+std::optional<std::string> output_problem(const std::filesystem::path &output) {
+  std::string ext = output.extension().string();
+  for (char &c : ext) {
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  }
+  if (ext != ".exr" && ext != ".png") {
+    return "must end in .exr (linear float) or .png (8-bit sRGB)";
+  }
+  const std::filesystem::path dir = output.parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir)) {
+    return "folder " + dir.string() + " does not exist";
+  }
+  return std::nullopt;
+}
+
 int run_render(const RenderArgs &args) {
   using namespace camhead::renderer;
+  if (const auto problem = output_problem(args.output)) {
+    std::fprintf(stderr, "output %s: %s\n", args.output.c_str(), problem->c_str());
+    return 4;
+  }
   try {
     Scene scene = load_scene(args.scene);
     if (args.seed) {

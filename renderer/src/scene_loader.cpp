@@ -7,22 +7,19 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <iterator>
-#include <limits>
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
 #include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
-#include <nlohmann/json.hpp>
 
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/mesh_io.h"
+#include "scene_json.h"
 
 namespace camhead::renderer {
 
@@ -32,144 +29,9 @@ SceneError::SceneError(std::string file, std::string field, std::string reason)
 
 namespace {
 
-// ordered_json keeps the materials in file order; with duplicate keys it
-// keeps the first position and the last value, as Python's dict does.
-using Json = nlohmann::ordered_json;
-using Keys = std::initializer_list<std::string_view>;
-using Vec = std::vector<double>;
-
-std::string child(const std::string &field, std::string_view key) {
-  return field.empty() ? std::string(key) : field + "." + std::string(key);
-}
-
-std::string show(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-// A finite double that overflows float would turn into inf in the model.
-bool fits_float(double v) {
-  return std::abs(v) <= double(std::numeric_limits<float>::max());
-}
-
-bool is_finite_number(const Json &v) {
-  return v.is_number() && std::isfinite(v.get<double>()) &&
-         std::abs(v.get<double>()) != std::numeric_limits<double>::max(); // see kNonFinite
-}
-
-struct Range {
-  Range(std::optional<double> lo_ = {}, std::optional<double> hi_ = {}, bool open = false)
-      : lo(lo_), hi(hi_), lo_open(open) {}
-  std::optional<double> lo, hi;
-  bool lo_open;
-};
-
-class Checker {
-public:
-  explicit Checker(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const std::string &field, const std::string &reason) const {
-    throw SceneError(file_, field, reason);
-  }
-
-  void keys(const Json &d, const std::string &field, Keys required, Keys optional = {}) const {
-    if (!d.is_object())
-      fail(field, "must be an object");
-    for (const std::string_view k : required)
-      if (!d.contains(k))
-        fail(child(field, k), "missing");
-    const auto listed = [](Keys ks, const std::string &k) {
-      return std::find(ks.begin(), ks.end(), k) != ks.end();
-    };
-    for (const auto &[k, v] : d.items())
-      if (!listed(required, k) && !listed(optional, k))
-        fail(child(field, k), "unknown field");
-  }
-
-  double number(const Json &d, std::string_view k, const std::string &field, Range r,
-                std::optional<double> def = std::nullopt) const {
-    const std::string f = child(field, k);
-    if (!d.contains(k))
-      return def ? *def : (fail(f, "missing"), 0.0);
-    const Json &v = d.at(k);
-    if (!is_finite_number(v))
-      fail(f, "must be a finite number");
-    check_range(f, v.get<double>(), r);
-    return v.get<double>();
-  }
-
-  std::int64_t integer(const Json &d, std::string_view k, const std::string &field, std::int64_t lo,
-                       std::int64_t hi, std::optional<std::int64_t> def = std::nullopt) const {
-    const std::string f = child(field, k);
-    if (!d.contains(k))
-      return def ? *def : (fail(f, "missing"), 0);
-    const Json &v = d.at(k);
-    if (!v.is_number_integer())
-      fail(f, "must be an integer");
-    if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(hi))
-      fail(f, "must be <= " + std::to_string(hi));
-    const std::int64_t i = v.get<std::int64_t>();
-    if (i < lo)
-      fail(f, "must be >= " + std::to_string(lo));
-    if (i > hi)
-      fail(f, "must be <= " + std::to_string(hi));
-    return i;
-  }
-
-  Vec vec(const Json &d, std::string_view k, const std::string &field, std::size_t n = 3,
-          Range r = {}, std::optional<Vec> def = std::nullopt, bool nonzero = false) const {
-    const std::string f = child(field, k);
-    if (!d.contains(k))
-      return def ? *def : (fail(f, "missing"), Vec());
-    const Json &v = d.at(k);
-    if (!v.is_array() || v.size() != n || !std::all_of(v.begin(), v.end(), is_finite_number))
-      fail(f, "must be an array of " + std::to_string(n) + " finite numbers");
-    Vec out;
-    for (const Json &x : v)
-      out.push_back(x.get<double>());
-    const auto [mn, mx] = std::minmax_element(out.begin(), out.end());
-    if ((r.lo && *mn < *r.lo) || (r.hi && *mx > *r.hi))
-      fail(f, "components must lie in [" + (r.lo ? show(*r.lo) : "-inf") + ", " +
-                  (r.hi ? show(*r.hi) : "inf") + "]");
-    if (nonzero && std::all_of(out.begin(), out.end(), [](double x) { return x == 0.0; }))
-      fail(f, "must not be zero");
-    if (!std::all_of(out.begin(), out.end(), fits_float))
-      fail(f, "components exceed the float range");
-    return out;
-  }
-
-  std::string string(const Json &d, std::string_view k, const std::string &field,
-                     std::vector<std::string> choices = {},
-                     std::optional<std::string> def = std::nullopt) const {
-    const std::string f = child(field, k);
-    if (!d.contains(k))
-      return def ? *def : (fail(f, "missing"), std::string());
-    const Json &v = d.at(k);
-    if (!v.is_string() || v.get_ref<const std::string &>().empty())
-      fail(f, "must be a non-empty string");
-    const std::string &s = v.get_ref<const std::string &>();
-    if (!choices.empty() && std::find(choices.begin(), choices.end(), s) == choices.end()) {
-      std::string list;
-      for (const std::string &c : choices)
-        list += (list.empty() ? "" : ", ") + c;
-      fail(f, "must be one of " + list);
-    }
-    return s;
-  }
-
-private:
-  void check_range(const std::string &f, double v, const Range &r) const {
-    if (r.lo && (r.lo_open ? v <= *r.lo : v < *r.lo))
-      fail(f, std::string("must be ") + (r.lo_open ? "> " : ">= ") + show(*r.lo));
-    if (r.hi && v > *r.hi)
-      fail(f, "must be <= " + show(*r.hi));
-    if (!fits_float(v))
-      fail(f, "exceeds the float range");
-  }
-
-  std::string file_;
-};
+using detail::Checker;
+using detail::Json;
+using detail::Vec;
 
 glm::vec3 v3(const Vec &v) {
   return {float(v[0]), float(v[1]), float(v[2])};
@@ -181,60 +43,6 @@ glm::vec3 unit(const Vec &v) {
   const double scale = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
   const glm::dvec3 d = glm::dvec3(v[0], v[1], v[2]) / scale;
   return glm::vec3(d / glm::length(d));
-}
-
-// Python's json reads NaN, Infinity, -Infinity and overflowing literals
-// (1e999) as floats, and the reference then rejects them as "must be a finite
-// number" on their field. nlohmann/json rejects all of them as syntax, so they
-// are rewritten to a sentinel, the largest double, which is_finite_number()
-// refuses. (Columns of later syntax errors on such a line shift a little.)
-constexpr std::string_view kNonFinite = "1.7976931348623157e308";
-
-std::string rewrite_non_finite(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  bool in_string = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      out += c;
-      if (c == '\\' && i + 1 < text.size())
-        out += text[++i];
-      else if (c == '"')
-        in_string = false;
-    } else if (text.substr(i, 3) == "NaN" && (i == 0 || text[i - 1] != '-')) {
-      out += kNonFinite;
-      i += 2;
-    } else if (text.substr(i, 8) == "Infinity") {
-      out += kNonFinite;
-      i += 7;
-    } else if (c == '-' || std::isdigit((unsigned char)c)) {
-      const std::size_t end = text.find_first_not_of("0123456789+-.eE", i);
-      const std::string token(text.substr(i, end - i));
-      char *stop = nullptr;
-      const bool overflows =
-          std::isinf(std::strtod(token.c_str(), &stop)) && stop == token.c_str() + token.size();
-      out += overflows ? (c == '-' ? "-" : "") + std::string(kNonFinite) : token;
-      i += token.size() - 1;
-    } else {
-      in_string = c == '"';
-      out += c;
-    }
-  }
-  return out;
-}
-
-Json parse_json(std::string_view text, const std::string &file) {
-  // Python's json refuses a byte order mark; nlohmann would skip it.
-  if (text.substr(0, 3) == "\xEF\xBB\xBF")
-    throw SceneError(file, "", "unexpected UTF-8 byte order mark");
-  try {
-    return Json::parse(rewrite_non_finite(text));
-  } catch (const Json::parse_error &e) {
-    std::string msg = e.what();
-    const std::size_t tag = msg.find("] ");
-    throw SceneError(file, "", tag == std::string::npos ? msg : msg.substr(tag + 2));
-  }
 }
 
 class SceneReader {
@@ -484,7 +292,7 @@ private:
 Scene parse_scene(std::string_view json_text, const std::filesystem::path &source) {
   const std::string file = source.string();
   try {
-    return SceneReader(source).read(parse_json(json_text, file));
+    return SceneReader(source).read(detail::parse_json(json_text, file));
   } catch (const SceneError &) {
     throw;
   } catch (const std::exception &e) {

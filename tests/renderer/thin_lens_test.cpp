@@ -79,12 +79,12 @@ INSTANTIATE_TEST_SUITE_P(Depths, BlurCircle,
                                            LensCase{8.0f, 0.5f, 4.0f},   // 3.9 px
                                            LensCase{16.0f, 1.0f, 0.3f}   // 2.6 px
                                            ),
-                         [](const ::testing::TestParamInfo<LensCase> &info) {
+                         [](const ::testing::TestParamInfo<LensCase> &param_info) {
                            // e.g. f2_0_focus1_00m_edge0_50m
                            char name[64];
                            std::snprintf(name, sizeof name, "f%.1f_focus%.2fm_edge%.2fm",
-                                         info.param.f_number, info.param.focus_m,
-                                         info.param.depth_m);
+                                         param_info.param.f_number, param_info.param.focus_m,
+                                         param_info.param.depth_m);
                            std::string s = name;
                            std::replace(s.begin(), s.end(), '.', '_');
                            return s;
