@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
 #include <zlib.h>
 
 #include "camhead/renderer/image_io.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -103,17 +103,8 @@ std::string tiled_exr() {
 
 class ImageIo : public ::testing::Test {
 protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("camhead_image_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path write(const std::string &name, const std::string &bytes) const {
-    std::ofstream(dir_ / name, std::ios::binary) << bytes;
-    return dir_ / name;
+    return scratch_.write(name, bytes);
   }
   // Reading must either work or throw ImageError naming the file.
   bool read_fails(const fs::path &path) const {
@@ -126,7 +117,8 @@ protected:
     return false;
   }
 
-  fs::path dir_;
+  test::ScratchDir scratch_;
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(ImageIo, ExrFloat32RoundTripIsBitExact) {

@@ -12,9 +12,9 @@
 #include <vector>
 
 #include <glm/common.hpp>
-#include <unistd.h>
 
 #include "camhead/renderer/mesh_io.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -77,17 +77,8 @@ std::string binary_pentagon(bool big_endian) {
 
 class MeshIo : public ::testing::Test {
 protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("camhead_mesh_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path write(const std::string &name, const std::string &bytes) const {
-    std::ofstream(dir_ / name, std::ios::binary) << bytes;
-    return dir_ / name;
+    return scratch_.write(name, bytes);
   }
   // The MeshError message for `bytes` stored as `name`; empty if it loads.
   std::string error_for(const std::string &name, const std::string &bytes) const {
@@ -101,7 +92,8 @@ protected:
     return {};
   }
 
-  fs::path dir_;
+  test::ScratchDir scratch_;
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(MeshIo, LoadsTheBunnyObj) {

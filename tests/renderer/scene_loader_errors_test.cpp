@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "camhead/renderer/scene_loader.h"
+#include "scene_json_fixture.h"
 
 #include <gtest/gtest.h>
 
@@ -18,18 +19,6 @@ namespace camhead::renderer {
 namespace {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::ordered_json;
-
-const fs::path kAssets = fs::path(CAMHEAD_SOURCE_DIR) / "tests" / "assets";
-
-Json base_scene() {
-  std::ifstream in(kAssets / "all_kinds.json");
-  return Json::parse(in);
-}
-
-Scene parse(const Json &j) {
-  return parse_scene(j.dump(), "/virtual/scene.json");
-}
 
 struct BadCase {
   const char *what;

@@ -7,10 +7,11 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/scene_loader.h"
+#include "scene_json_fixture.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -18,20 +19,8 @@ namespace camhead::renderer {
 namespace {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::ordered_json;
 
 const fs::path kShared = fs::path(CAMHEAD_SHARED_DIR) / "reference";
-const fs::path kAssets = fs::path(CAMHEAD_SOURCE_DIR) / "tests" / "assets";
-
-// A small valid scene with every kind of material, object and light.
-Json base_scene() {
-  std::ifstream in(kAssets / "all_kinds.json");
-  return Json::parse(in);
-}
-
-Scene parse(const Json &j) {
-  return parse_scene(j.dump(), "/virtual/scene.json");
-}
 
 TEST(SceneLoader, LoadsBoxesReference) {
   const Scene s = load_scene(kShared / "boxes.json");
@@ -173,16 +162,8 @@ TEST(SceneLoader, ErrorNamesFileFieldAndReason) {
 
 class SceneLoaderFiles : public ::testing::Test {
 protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("camhead_scene_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   void write(const std::string &name, const std::string &text) const {
-    std::ofstream(dir_ / name, std::ios::binary) << text;
+    (void)scratch_.write(name, text);
   }
   SceneError load_error(const Json &j) const {
     write("scene.json", j.dump());
@@ -195,7 +176,8 @@ protected:
     return SceneError("", "", "");
   }
 
-  fs::path dir_;
+  test::ScratchDir scratch_;
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(SceneLoaderFiles, BadMeshFileFailsOnTheFileField) {

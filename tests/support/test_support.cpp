@@ -1,10 +1,15 @@
 #include "test_support.h"
 
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
+
+#include <unistd.h>
 
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/gpu_tracer.h"
+
+#include <gtest/gtest.h>
 
 namespace camhead::test {
 
@@ -85,6 +90,27 @@ bool all_finite(const renderer::Image &image) {
     }
   }
   return true;
+}
+
+ScratchDir::ScratchDir() {
+  const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string("camhead_") + (info ? info->test_suite_name() : "test") + "_" +
+                     (info ? info->name() : "") + "_" + std::to_string(::getpid());
+  for (char &c : name) {
+    c = (c == '/') ? '_' : c;
+  }
+  path_ = std::filesystem::temp_directory_path() / name;
+  std::filesystem::create_directories(path_);
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ignored;
+  std::filesystem::remove_all(path_, ignored);
+}
+
+std::filesystem::path ScratchDir::write(const std::string &name, const std::string &bytes) const {
+  std::ofstream(path_ / name, std::ios::binary) << bytes;
+  return path_ / name;
 }
 
 renderer::Scene downscaled(renderer::Scene scene, int divisor) {

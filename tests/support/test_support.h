@@ -40,6 +40,23 @@ namespace camhead::test {
 // Every sample finite: no NaN or Inf reaches an output.
 [[nodiscard]] bool all_finite(const renderer::Image &image);
 
+// A fresh folder for one test's files, named after the test and the
+// process so that parallel ctest runs never share one; removed afterwards.
+class ScratchDir {
+public:
+  ScratchDir();
+  ~ScratchDir();
+  ScratchDir(const ScratchDir &) = delete;
+  ScratchDir &operator=(const ScratchDir &) = delete;
+
+  [[nodiscard]] const std::filesystem::path &path() const { return path_; }
+  // Writes `bytes` to path() / name and returns that path.
+  std::filesystem::path write(const std::string &name, const std::string &bytes) const;
+
+private:
+  std::filesystem::path path_;
+};
+
 // A copy of `scene` at a lower resolution with the same field of view.
 [[nodiscard]] renderer::Scene downscaled(renderer::Scene scene, int divisor);
 
