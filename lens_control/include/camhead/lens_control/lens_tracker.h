@@ -1,0 +1,64 @@
+// The lens chain in one object: raw encoder samples in, the lens state at a
+// frame's mid-exposure out.
+//
+//   EncoderSample -> per axis: EncoderFilter (spikes, One Euro, in counts)
+//                 -> AxisTimeline (delay correction, history)
+//   frame time    -> counts at mid-exposure -> LensProfile -> LensState
+//
+// Interpolating counts in time and mapping afterwards keeps the timeline
+// independent of the profile, so a profile can be swapped without losing the
+// history, and the nonlinear map is applied once per frame, not per sample.
+//
+// Thread safety: none. The pipeline's lens thread owns it; frames ask for
+// their state through that thread (pipeline/ queues the request).
+#pragma once
+
+#include <cstdint>
+
+#include "camhead/lens_control/encoder_filter.h"
+#include "camhead/lens_control/lens_profile.h"
+#include "camhead/lens_control/lens_state.h"
+#include "camhead/lens_control/time_alignment.h"
+
+namespace camhead::lens_control {
+
+struct AxisConfig {
+  EncoderFilterParams filter;
+  TimelineParams timeline;
+};
+
+struct LensTrackerConfig {
+  AxisConfig focus, iris, zoom;
+};
+
+class LensTracker {
+public:
+  explicit LensTracker(LensProfile profile, LensTrackerConfig config = {});
+
+  // Feeds one raw sample; axes it does not carry are left alone (a dropout
+  // there shows up as staleness when the state is read).
+  void push(const EncoderSample &sample);
+
+  // The lens at physical time t_ns. Axes that never reported take the
+  // profile's rest values, not fresh.
+  [[nodiscard]] LensState state_at(std::int64_t t_ns) const;
+  [[nodiscard]] LensState state_for_frame(std::int64_t frame_start_ns,
+                                          std::int64_t exposure_ns) const {
+    return state_at(mid_exposure_ns(frame_start_ns, exposure_ns));
+  }
+
+  [[nodiscard]] const LensProfile &profile() const { return profile_; }
+
+private:
+  struct Axis {
+    explicit Axis(const AxisConfig &c) : filter(c.filter), timeline(c.timeline) {}
+    void push(std::int64_t t_ns, std::int32_t counts);
+    EncoderFilter filter;
+    AxisTimeline timeline;
+  };
+
+  LensProfile profile_;
+  Axis focus_, iris_, zoom_;
+};
+
+} // namespace camhead::lens_control

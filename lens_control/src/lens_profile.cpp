@@ -1,0 +1,160 @@
+// Table lookups of a loaded profile: the conversions between each quantity
+// and the space it is interpolated in, zoom blending, and the fallback lens.
+// Parsing and validation live in profile_reader.cpp.
+#include "camhead/lens_control/lens_profile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace camhead::lens_control {
+
+ProfileError::ProfileError(std::string file, std::string field, std::string reason)
+    : std::runtime_error(file + ": " + (field.empty() ? "" : field + ": ") + reason),
+      file_(std::move(file)), field_(std::move(field)), reason_(std::move(reason)) {}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double from_diopters(double d) {
+  return d > 0.0 ? 1.0 / d : kInf;
+}
+double from_stops(double s) {
+  return std::exp2(0.5 * s);
+}
+
+} // namespace
+
+LensProfile LensProfile::uncalibrated() {
+  // Constant tables spanning every possible count, so that the generic lookups
+  // apply unchanged and nothing is ever reported as clamped: the single flag
+  // that matters is calibrated == false.
+  const std::vector<double> all{double(std::numeric_limits<std::int32_t>::min()),
+                                double(std::numeric_limits<std::int32_t>::max())};
+  LensProfile p;
+  p.name_ = "uncalibrated: nominal 35 mm f/2.8 focused at infinity, encoders ignored";
+  p.calibrated_ = false;
+  p.focus_diopters_ = MonotoneCurve(all, {0.0, 0.0});
+  const double stops = 2.0 * std::log2(2.8);
+  p.iris_stops_ = MonotoneCurve(all, {stops, stops});
+  p.zoom_counts_ = {0.0};
+  p.zoom_points_ = {ZoomPoint{35.0, 0.0, {}, std::nullopt, false, false}};
+  return p;
+}
+
+LensProfile::Lookup LensProfile::focus_distance_m(double focus_counts) const {
+  const auto r = focus_diopters_(focus_counts);
+  return {from_diopters(r.y), r.clamped};
+}
+
+LensProfile::Lookup LensProfile::f_number(double iris_counts) const {
+  const auto r = iris_stops_(iris_counts);
+  return {from_stops(r.y), r.clamped};
+}
+
+std::optional<LensProfile::Lookup> LensProfile::t_stop(double iris_counts) const {
+  if (t_stop_stops_.empty())
+    return std::nullopt;
+  const auto r = t_stop_stops_(iris_counts);
+  return Lookup{from_stops(r.y), r.clamped};
+}
+
+LensProfile::Lookup LensProfile::focal_length_mm(double zoom_counts) const {
+  if (!is_zoom())
+    return {zoom_points_.front().focal_length_mm, false};
+  const auto r = log_focal_length_(zoom_counts);
+  // At a calibration point (or clamped to an end one) return the file's value
+  // itself: exp(log(f)) can be an ulp off, and "reproduces calibration points
+  // exactly" is a promise.
+  const double z = std::clamp(zoom_counts, zoom_counts_.front(), zoom_counts_.back());
+  const auto it = std::find(zoom_counts_.begin(), zoom_counts_.end(), z);
+  if (it != zoom_counts_.end())
+    return {zoom_points_[std::size_t(it - zoom_counts_.begin())].focal_length_mm, r.clamped};
+  return {std::exp(r.y), r.clamped};
+}
+
+LensProfile::Lookup LensProfile::entrance_pupil_offset_mm(double zoom_counts) const {
+  if (!is_zoom())
+    return {zoom_points_.front().entrance_pupil_offset_mm, false};
+  const auto r = entrance_pupil_mm_(zoom_counts);
+  return {r.y, r.clamped};
+}
+
+double LensProfile::projection_at_point(const ZoomPoint &z, double diopters) const {
+  if (!z.breathing.empty())
+    return z.breathing(diopters).y;
+  return z.projection_focal_length_mm.value_or(z.focal_length_mm);
+}
+
+LensProfile::Lookup LensProfile::projection_focal_length_mm(double zoom_counts,
+                                                            double focus_counts) const {
+  const auto focus = focus_diopters_(focus_counts);
+  if (!is_zoom())
+    return {projection_at_point(zoom_points_.front(), focus.y), focus.clamped};
+
+  // Blend the breathing of the two zoom points around the current zoom as a
+  // ratio to their nominal focal length, then scale by the interpolated focal
+  // length: breathing is a relative change of image scale, and the ratio
+  // varies far more smoothly with zoom than the absolute value does.
+  const Lookup f = focal_length_mm(zoom_counts);
+  const double z = std::clamp(zoom_counts, zoom_counts_.front(), zoom_counts_.back());
+  std::size_t k = std::size_t(std::upper_bound(zoom_counts_.begin(), zoom_counts_.end(), z) -
+                              zoom_counts_.begin());
+  k = std::clamp<std::size_t>(k, 1, zoom_counts_.size() - 1) - 1;
+  const double t = (z - zoom_counts_[k]) / (zoom_counts_[k + 1] - zoom_counts_[k]);
+  const ZoomPoint &a = zoom_points_[k], &b = zoom_points_[k + 1];
+  if (t == 0.0)
+    return {projection_at_point(a, focus.y), f.clamped || focus.clamped};
+  if (t == 1.0)
+    return {projection_at_point(b, focus.y), f.clamped || focus.clamped};
+  const double ratio = (1.0 - t) * projection_at_point(a, focus.y) / a.focal_length_mm +
+                       t * projection_at_point(b, focus.y) / b.focal_length_mm;
+  return {f.value * ratio, f.clamped || focus.clamped};
+}
+
+double LensProfile::rest_counts_focus() const {
+  // The far end: the table end with the smaller diopter value.
+  const auto &xs = focus_diopters_.xs();
+  const auto &ys = focus_diopters_.ys();
+  return ys.front() <= ys.back() ? xs.front() : xs.back();
+}
+
+double LensProfile::rest_counts_iris() const {
+  const auto &xs = iris_stops_.xs();
+  const auto &ys = iris_stops_.ys();
+  return ys.front() <= ys.back() ? xs.front() : xs.back();
+}
+
+LensState LensProfile::evaluate(const LensCounts &counts) const {
+  const AxisReading rest_focus{rest_counts_focus(), 0, false};
+  const AxisReading rest_iris{rest_counts_iris(), 0, false};
+  const AxisReading rest_zoom{zoom_counts_.front(), 0, false};
+  const AxisReading &fo = counts.focus ? *counts.focus : rest_focus;
+  const AxisReading &ir = counts.iris ? *counts.iris : rest_iris;
+  // A prime has no zoom axis: its zoom quantities are as fresh as focus.
+  const AxisReading &zo = !is_zoom()    ? AxisReading{rest_zoom.counts, fo.t_ns, fo.fresh}
+                          : counts.zoom ? *counts.zoom
+                                        : rest_zoom;
+
+  const auto measured = [](Lookup l, const AxisReading &a) {
+    return Measured{l.value, a.t_ns, a.fresh, l.clamped};
+  };
+  LensState s;
+  s.calibrated = calibrated_;
+  s.focus_distance_m = measured(focus_distance_m(fo.counts), fo);
+  s.f_number = measured(f_number(ir.counts), ir);
+  if (const auto t = t_stop(ir.counts))
+    s.t_stop = measured(*t, ir);
+  s.focal_length_mm = measured(focal_length_mm(zo.counts), zo);
+  s.entrance_pupil_offset_mm = measured(entrance_pupil_offset_mm(zo.counts), zo);
+  // Depends on focus and zoom: as old as the older one, fresh only if both are.
+  const Lookup proj = projection_focal_length_mm(zo.counts, fo.counts);
+  s.projection_focal_length_mm =
+      Measured{proj.value, std::min(fo.t_ns, zo.t_ns), fo.fresh && zo.fresh, proj.clamped};
+  s.distortion = distortion_;
+  return s;
+}
+
+} // namespace camhead::lens_control
