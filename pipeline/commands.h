@@ -5,9 +5,10 @@
 
 namespace camhead::cli {
 
-void add_render_command(CLI::App &app);  // camhead render
-void add_devices_command(CLI::App &app); // camhead devices
-void add_bench_command(CLI::App &app);   // camhead bench
+void add_render_command(CLI::App &app);    // camhead render
+void add_devices_command(CLI::App &app);   // camhead devices
+void add_bench_command(CLI::App &app);     // camhead bench
+void add_calibrate_command(CLI::App &app); // camhead calibrate
 
 // The exit status the chosen subcommand left (0 = success).
 [[nodiscard]] int exit_code();

@@ -1,0 +1,253 @@
+// The fit of camhead calibrate: averaging repeats, the monotone fit
+// (pool-adjacent-violators) and the profile JSON writer. Why these spaces and
+// why an isotonic fit: see calibration.h.
+#include "camhead/lens_control/calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace camhead::lens_control {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Into and out of the space the profile interpolates each quantity in
+// (profile_reader.cpp and lens_profile.cpp use the same conversions). A
+// T-stop converts like an f-number.
+double to_linear(CalibrationAxis a, double v) {
+  switch (a) {
+  case CalibrationAxis::focus:
+    return std::isinf(v) ? 0.0 : 1.0 / v;
+  case CalibrationAxis::iris:
+    return 2.0 * std::log2(v);
+  case CalibrationAxis::zoom:
+    return std::log(v);
+  }
+  return v;
+}
+
+double from_linear(CalibrationAxis a, double y) {
+  switch (a) {
+  case CalibrationAxis::focus:
+    return y > 0.0 ? 1.0 / y : kInf;
+  case CalibrationAxis::iris:
+    return std::exp2(0.5 * y);
+  case CalibrationAxis::zoom:
+    return std::exp(y);
+  }
+  return y;
+}
+
+// Adjacent measured counts fitted as one point. Kept as sums so that pooling
+// two blocks is adding them, and the pooled mean is the mean of all the
+// measurements behind it (each measurement weighs the same).
+struct Block {
+  double counts_sum = 0.0;
+  double weight = 0.0;     // number of measurements
+  std::vector<double> sum; // per channel (value, then t_stop), linearised
+  // Per channel, the natural value when every measurement in the block has
+  // that same value: written as measured, so that exact data reproduce
+  // themselves without a round trip through log and exp.
+  std::vector<std::optional<double>> same;
+  std::int32_t first = 0, last = 0;
+  std::size_t distinct = 0;
+
+  [[nodiscard]] double mean(std::size_t c) const { return sum[c] / weight; }
+
+  void absorb(const Block &b) {
+    counts_sum += b.counts_sum;
+    weight += b.weight;
+    for (std::size_t c = 0; c < sum.size(); ++c) {
+      sum[c] += b.sum[c];
+      if (same[c] != b.same[c])
+        same[c].reset();
+    }
+    last = b.last;
+    distinct += b.distinct;
+  }
+};
+
+// Strictly monotone in direction dir[c] in every channel between a and b.
+bool in_order(const Block &a, const Block &b, const std::vector<double> &dir) {
+  for (std::size_t c = 0; c < dir.size(); ++c)
+    if (!((b.mean(c) - a.mean(c)) * dir[c] > 0.0))
+      return false;
+  return true;
+}
+
+// Pool-adjacent-violators with a stack: after each push, merge the top two
+// blocks while they are out of order (ties included, so the result is
+// strictly monotone). Every adjacent pair left on the stack is in order, and
+// a merged mean lies between its parts, so the pairs below stay in order.
+// With one channel this is the least-squares isotonic regression; with two
+// (f-number and T-stop) a pair out of order in either is merged in both.
+std::vector<Block> pool_adjacent_violators(const std::vector<Block> &blocks,
+                                           const std::vector<double> &dir) {
+  std::vector<Block> out;
+  for (const Block &b : blocks) {
+    out.push_back(b);
+    while (out.size() >= 2 && !in_order(out[out.size() - 2], out.back(), dir)) {
+      const Block top = out.back();
+      out.pop_back();
+      out.back().absorb(top);
+    }
+  }
+  return out;
+}
+
+// +1 or -1: the sign of the least-squares slope of channel c over counts, over
+// all measurements (a block's repeats share its counts, hence the weights).
+double trend(const std::vector<Block> &blocks, std::size_t c) {
+  double w = 0.0, x = 0.0, y = 0.0;
+  for (const Block &b : blocks) {
+    w += b.weight;
+    x += b.counts_sum;
+    y += b.sum[c];
+  }
+  x /= w;
+  y /= w;
+  double sxy = 0.0;
+  for (const Block &b : blocks)
+    sxy += (b.counts_sum / b.weight - x) * (b.sum[c] - b.weight * y);
+  return sxy >= 0.0 ? 1.0 : -1.0;
+}
+
+AxisFit fit_axis(const MeasurementSet &m, CalibrationAxis axis, bool prime) {
+  const std::string name = axis_name(axis);
+  const auto fail = [&](const std::string &reason) -> void {
+    throw CalibrationError(m.source, 0, name, reason);
+  };
+  std::vector<const Measurement *> rows;
+  for (const Measurement &r : m.rows)
+    if (r.axis == axis)
+      rows.push_back(&r);
+  if (rows.empty())
+    fail("no measurements (a profile needs focus, iris and zoom rows; for a prime, one zoom "
+         "row with its focal length and --prime)");
+  std::stable_sort(rows.begin(), rows.end(), [](const Measurement *a, const Measurement *b) {
+    return a->counts < b->counts;
+  });
+
+  // Repeats at equal counts: one block each, averaged in the linear space.
+  const std::size_t channels = rows.front()->t_stop ? 2 : 1;
+  std::vector<Block> blocks;
+  for (const Measurement *r : rows) {
+    const double values[2] = {r->value, r->t_stop.value_or(0.0)};
+    if (blocks.empty() || blocks.back().last != r->counts) {
+      blocks.push_back(
+          Block{0.0, 0.0, std::vector<double>(channels, 0.0), {}, r->counts, r->counts, 1});
+      blocks.back().same.assign(values, values + channels);
+    }
+    Block &b = blocks.back();
+    b.counts_sum += r->counts;
+    b.weight += 1.0;
+    for (std::size_t c = 0; c < channels; ++c) {
+      b.sum[c] += to_linear(axis, values[c]);
+      if (b.same[c] != values[c])
+        b.same[c].reset();
+    }
+  }
+
+  AxisFit fit{axis, rows.size(), blocks.size(), {}};
+  const bool one_point = prime && axis == CalibrationAxis::zoom;
+  if (one_point && blocks.size() != 1)
+    fail("--prime needs every zoom row at the same counts (a prime has one focal length); "
+         "found " +
+         std::to_string(blocks.size()) + " distinct counts");
+  if (!one_point && blocks.size() < 2)
+    fail(std::to_string(rows.size()) + " measurement(s), all at counts " +
+         std::to_string(blocks.front().first) + ": a table needs 2 or more distinct counts" +
+         (axis == CalibrationAxis::zoom ? " (for a prime lens, pass --prime)" : ""));
+  if (!one_point) {
+    std::vector<double> dir;
+    for (std::size_t c = 0; c < channels; ++c)
+      dir.push_back(trend(blocks, c));
+    blocks = pool_adjacent_violators(blocks, dir);
+    if (blocks.size() < 2)
+      fail("the monotone fit pools all " + std::to_string(rows.size()) +
+           " measurements into one point: the values show no trend over counts (fewer than 2 "
+           "distinct points remain)");
+  }
+
+  for (const Block &b : blocks) {
+    FittedPoint p;
+    p.counts = std::int32_t(std::llround(b.counts_sum / b.weight));
+    p.value = b.same[0] ? *b.same[0] : from_linear(axis, b.mean(0));
+    if (channels == 2)
+      p.t_stop = b.same[1] ? *b.same[1] : from_linear(axis, b.mean(1));
+    p.first_counts = b.first;
+    p.last_counts = b.last;
+    p.distinct_counts = b.distinct;
+    p.measurements = std::size_t(b.weight);
+    // Averaging infinity with a very far mark can land beyond the largest
+    // finite distance a profile accepts; say so here rather than as a
+    // failed round trip.
+    if (axis == CalibrationAxis::focus && std::isfinite(p.value) && p.value > 1e5) {
+      std::ostringstream r;
+      r << "the point at counts " << p.counts << " averages to " << p.value
+        << " m, beyond the 1e5 m a profile allows (measure that mark as inf or nearer)";
+      fail(r.str());
+    }
+    fit.points.push_back(p);
+  }
+  return fit;
+}
+
+std::string num(double v) {
+  return nlohmann::json(v).dump();
+}
+
+std::string table(const AxisFit &fit, const char *key) {
+  std::string s = "[\n";
+  for (std::size_t i = 0; i < fit.points.size(); ++i) {
+    const FittedPoint &p = fit.points[i];
+    s += "    {\"counts\": " + std::to_string(p.counts) + ", \"" + key +
+         "\": " + (std::isinf(p.value) ? std::string("\"infinity\"") : num(p.value));
+    if (p.t_stop)
+      s += ", \"t_stop\": " + num(*p.t_stop);
+    s += i + 1 < fit.points.size() ? "},\n" : "}\n";
+  }
+  return s + "  ]";
+}
+
+} // namespace
+
+Calibration fit_calibration(const MeasurementSet &measurements, const CalibrationOptions &options) {
+  if (options.name.empty())
+    throw CalibrationError(measurements.source, 0, "name", "the profile needs a non-empty name");
+  Calibration c;
+  c.source = measurements.source;
+  c.prime = options.prime;
+  c.focus = fit_axis(measurements, CalibrationAxis::focus, options.prime);
+  c.iris = fit_axis(measurements, CalibrationAxis::iris, options.prime);
+  c.zoom = fit_axis(measurements, CalibrationAxis::zoom, options.prime);
+  return c;
+}
+
+std::string profile_json(const Calibration &fit, const CalibrationOptions &options) {
+  const std::size_t n = fit.focus.measurements + fit.iris.measurements + fit.zoom.measurements;
+  const std::string description = !options.description.empty()
+                                      ? options.description
+                                      : "Fitted by camhead calibrate from " +
+                                            std::filesystem::path(fit.source).filename().string() +
+                                            " (" + std::to_string(n) + " measurements).";
+  std::string s = "{\n";
+  s += "  \"format\": \"camhead-lens-profile\",\n";
+  s += "  \"version\": 1,\n";
+  s += "  \"name\": " + nlohmann::json(options.name).dump() + ",\n";
+  s += "  \"description\": " + nlohmann::json(description).dump() + ",\n";
+  s += "  \"focus\": " + table(fit.focus, "distance_m") + ",\n";
+  s += "  \"iris\": " + table(fit.iris, "f_number") + ",\n";
+  if (fit.prime)
+    s += "  \"prime\": {\"focal_length_mm\": " + num(fit.zoom.points.front().value) + "}\n";
+  else
+    s += "  \"zoom\": " + table(fit.zoom, "focal_length_mm") + "\n";
+  return s + "}\n";
+}
+
+} // namespace camhead::lens_control
