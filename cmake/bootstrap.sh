@@ -16,6 +16,7 @@ packages=(
   libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
   libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev
 )
 
 if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then
