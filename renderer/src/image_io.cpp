@@ -29,7 +29,9 @@
 #pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
 #pragma GCC diagnostic ignored "-Wtype-limits"
 #pragma GCC diagnostic ignored "-Wunused-but-set-variable"
+#if !defined(__clang__) // GCC only; clang rejects the unknown group
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #define TINYEXR_USE_MINIZ 0
 #define TINYEXR_IMPLEMENTATION
 #include <tinyexr.h>
