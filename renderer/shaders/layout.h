@@ -79,7 +79,7 @@ struct FrameParams {
   vec4 world_color; // rgb
   uvec4 image;      // x: width, y: height, z: has_plate, w: light count
   uvec4 sampling; // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
-  uvec4 tracing;  // x: max_bounces, y: primitive count, z: node count, w: flags
+  uvec4 tracing;  // x: max_bounces; y, z, w: reserved (0)
 };
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.

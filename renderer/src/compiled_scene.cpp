@@ -254,11 +254,4 @@ gpu::FrameParams make_frame_params(const Scene &scene, int samples) {
   return fp;
 }
 
-gpu::FrameParams make_frame_params(const Scene &scene, const CompiledScene &compiled, int samples) {
-  gpu::FrameParams fp = make_frame_params(scene, samples);
-  fp.tracing.y = std::uint32_t(compiled.primitives.size());
-  fp.tracing.z = std::uint32_t(compiled.nodes.size());
-  return fp;
-}
-
 } // namespace camhead::renderer

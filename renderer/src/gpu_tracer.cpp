@@ -203,8 +203,10 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
 
   loaded = false; // until every buffer below exists
   vk::Uploader uploader(device);
-  // Zero-length arrays get one element so that every binding stays valid;
-  // the kernels never read it because the counts in FrameParams are zero.
+  // Zero-length arrays get one element so that every binding stays valid.
+  // Only the material placeholder is ever read (by rays that miss, which
+  // take material 0); the light count is zero and an empty BVH's root bounds
+  // admit no ray.
   const auto upload = [&](int binding, std::span<const std::byte> data, std::size_t element,
                           const char *name) {
     buffers[binding] = vk::Buffer(
@@ -272,8 +274,6 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested,
   gpu::FrameParams frame = requested;
   frame.image.z = requested.image.z != 0 && has_plate ? 1u : 0u;
   frame.image.w = counts.z;
-  frame.tracing.y = counts.x;
-  frame.tracing.z = counts.y;
 
   // One uniform buffer suffices because each batch is waited for before the
   // next one rewrites it.

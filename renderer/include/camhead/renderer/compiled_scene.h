@@ -28,12 +28,6 @@ struct CompiledScene {
 
 // Frame parameters from the scene's camera and settings; samples <= 0 takes
 // the scene's `render.samples`. The sample range covers all samples.
-// tracing.y and .z are the primitive and node counts of `compiled`.
-[[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, const CompiledScene &compiled,
-                                                 int samples = 0);
-
-// As above without the buffer counts (tracing.y and .z stay 0): the tracers
-// take them from the buffers they loaded.
 [[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, int samples = 0);
 
 } // namespace camhead::renderer
