@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "camhead/renderer/bvh.h"
 #include "cpu_kernel.h"
 
 namespace camhead::renderer {
@@ -39,7 +40,9 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
 
   cpu::CpuKernel kernel;
   kernel.primitives = scene.primitives.data();
-  kernel.nodes = scene.nodes.data();
+  // As the GPU tracer: a scene without nodes traverses the empty BVH.
+  const std::vector<gpu::BvhNode> nodes = scene.nodes.empty() ? build_bvh({}).nodes : scene.nodes;
+  kernel.nodes = nodes.data();
   // The GPU tracer binds a placeholder for empty arrays; so does this one, as
   // the kernel reads material 0 for rays that miss.
   static const gpu::Material placeholder_material{};

@@ -13,6 +13,7 @@
 #include <optional>
 #include <span>
 
+#include "camhead/renderer/bvh.h"
 #include "resolve_spv.h"
 #include "trace_spv.h"
 #include "vulkan_context.h"
@@ -216,7 +217,11 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
     uploader.upload(buffers[binding], data);
   };
   upload(BINDING_PRIMITIVES, bytes_of(scene.primitives), sizeof(gpu::Primitive), "primitives");
-  upload(BINDING_NODES, bytes_of(scene.nodes), sizeof(gpu::BvhNode), "BVH nodes");
+  // Traversal starts at nodes[0]; a zeroed placeholder would be an interior
+  // node pointing past the buffer, so a scene without nodes gets the empty
+  // BVH, whose root admits no ray.
+  const std::vector<gpu::BvhNode> nodes = scene.nodes.empty() ? build_bvh({}).nodes : scene.nodes;
+  upload(BINDING_NODES, bytes_of(nodes), sizeof(gpu::BvhNode), "BVH nodes");
   upload(BINDING_MATERIALS, bytes_of(scene.materials), sizeof(gpu::Material), "materials");
   upload(BINDING_LIGHTS, bytes_of(scene.lights), sizeof(gpu::Light), "lights");
   upload(BINDING_PLATE, bytes_of(scene.plate), sizeof(gpu::vec4), "plate");

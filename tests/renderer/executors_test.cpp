@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
+#include "camhead/renderer/cpu_tracer.h"
+#include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "test_support.h"
 
@@ -48,6 +51,31 @@ TEST_P(Executors, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ReferenceScenes, Executors, ::testing::Values("boxes", "ar_basic"));
+
+// A hand-made scene with no BVH at all: both executors traverse the empty BVH
+// instead of reading past a placeholder, and every ray sees the world.
+TEST(Executors, SceneWithoutNodesShowsTheWorldColour) {
+  renderer::Scene scene;
+  scene.render.width = 8;
+  scene.render.height = 4;
+  scene.render.world_color = glm::vec3(0.25f, 0.5f, 0.75f);
+  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  renderer::CompiledScene compiled = renderer::compile_scene(scene);
+  compiled.nodes.clear();
+  const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, 2);
+  std::vector<renderer::RenderResult> results{renderer::render_cpu(compiled, frame)};
+  if (test::have_vulkan()) {
+    renderer::GpuTracer tracer;
+    tracer.load(compiled);
+    results.push_back(tracer.render(frame));
+  }
+  for (const renderer::RenderResult &r : results) {
+    for (std::size_t i = 0; i < r.composite.pixel_count(); ++i) {
+      EXPECT_EQ(r.composite.data[i * 3 + 2], 0.75f);
+      EXPECT_EQ(r.mask.data[i], 0.0f);
+    }
+  }
+}
 
 } // namespace
 } // namespace camhead
