@@ -18,9 +18,7 @@ int list_devices() {
       return 1;
     }
     std::printf("Vulkan devices (camhead render --device INDEX|NAME):\n");
-    for (const auto &d : devices) {
-      std::printf("  %d  %-40s %s\n", d.index, d.name.c_str(), d.type.c_str());
-    }
+    std::fputs(renderer::format_gpu_devices(devices).c_str(), stdout);
     return 0;
   } catch (const std::exception &e) {
     std::fprintf(stderr, "Vulkan error: %s\n", e.what());
