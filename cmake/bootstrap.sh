@@ -15,6 +15,7 @@ packages=(
   libvulkan-dev mesa-vulkan-drivers glslang-tools vulkan-tools
   libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
   libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
+  libgpiod-dev libusb-1.0-0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev
 )
