@@ -4,7 +4,9 @@
 // 49 rays per pixel on a GTX 590 (method.md section 4). This command measures
 // the same table on whatever device it is given: the median frame time over
 // repeated frames after warm-up, each frame the whole render() call (upload
-// of the frame parameters, tracing, compositing and read-back).
+// of the frame parameters, tracing, compositing and read-back of the 8-bit
+// display image a live frame shows; --all-layers reads back the float layers
+// too), and where that time went.
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -29,6 +31,7 @@ struct BenchArgs {
   int warmup = 2;
   std::string device;
   bool cpu_peer = false;
+  bool all_layers = false;
 };
 
 double paper_fps(int rpp) {
@@ -44,17 +47,30 @@ double paper_fps(int rpp) {
   }
 }
 
-// Median wall time of `frames` calls after `warmup` untimed ones.
-template <typename RenderFn> double median_seconds(const BenchArgs &args, RenderFn render) {
-  std::vector<double> seconds;
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// Median wall time of `frames` calls after `warmup` untimed ones, and the
+// median of each phase (each phase's own median, so they need not add up).
+struct FrameMedians {
+  double total_s = 0.0;
+  renderer::FrameTimings phases;
+};
+
+template <typename RenderFn> FrameMedians median_frame(const BenchArgs &args, RenderFn render) {
+  std::vector<double> total, trace, resolve, unpack;
   for (int i = 0; i < args.warmup + args.frames; ++i) {
-    const double s = render();
+    const renderer::RenderResult result = render();
     if (i >= args.warmup) {
-      seconds.push_back(s);
+      total.push_back(result.seconds);
+      trace.push_back(result.timings.trace_s);
+      resolve.push_back(result.timings.resolve_s);
+      unpack.push_back(result.timings.unpack_s);
     }
   }
-  std::sort(seconds.begin(), seconds.end());
-  return seconds[seconds.size() / 2];
+  return {median(total), {median(trace), median(resolve), median(unpack)}};
 }
 
 int run_bench(const BenchArgs &args) {
@@ -71,31 +87,42 @@ int run_bench(const BenchArgs &args) {
     tracer.load(compiled);
     std::printf("scene %s, %dx%d, device %s\n", args.scene.c_str(), args.width, args.height,
                 tracer.device_name().c_str());
-    std::printf("median of %d frames after %d warm-up frames\n\n", args.frames, args.warmup);
+    std::printf("median of %d frames after %d warm-up frames; read back: %s\n\n", args.frames,
+                args.warmup, args.all_layers ? "all layers" : "8-bit display image");
     std::printf("| rpp | camera rays/frame | frame ms (median) | fps   | M camera rays/s | "
                 "paper fps (GTX 590) |%s\n",
                 args.cpu_peer ? " CPU reference ms | GPU speed / CPU |" : "");
     std::printf("|-----|-------------------|-------------------|-------|-----------------|"
                 "---------------------|%s\n",
                 args.cpu_peer ? "------------------|-----------------|" : "");
+    const LayerSelection layers =
+        args.all_layers ? LayerSelection::all() : LayerSelection::display_only();
+    std::vector<FrameTimings> breakdown;
     for (int rpp : args.rpp) {
       const gpu::FrameParams frame = make_frame_params(scene, rpp);
-      const double median = median_seconds(args, [&] { return tracer.render(frame).seconds; });
+      const FrameMedians gpu = median_frame(args, [&] { return tracer.render(frame, {}, layers); });
+      breakdown.push_back(gpu.phases);
+      const double frame_s = gpu.total_s;
       const double rays = double(args.width) * args.height * rpp;
       const double paper = paper_fps(rpp);
       std::printf("| %3d | %15.1f M | %17.2f | %5.1f | %15.1f | %19s |", rpp, rays * 1e-6,
-                  median * 1e3, 1.0 / median, rays / median * 1e-6,
+                  frame_s * 1e3, 1.0 / frame_s, rays / frame_s * 1e-6,
                   paper > 0 ? std::to_string(int(paper)).c_str() : "-");
       if (args.cpu_peer) {
         // The same kernel on the same frame, compiled as C++: a peer in the
         // same process, so the ratio holds even on a noisy machine.
-        const double cpu =
-            median_seconds(args, [&] { return render_cpu(compiled, frame).seconds; });
-        std::printf(" %16.2f | %15.2f |", cpu * 1e3, cpu / median);
+        const double cpu = median_frame(args, [&] { return render_cpu(compiled, frame); }).total_s;
+        std::printf(" %16.2f | %15.2f |", cpu * 1e3, cpu / frame_s);
       }
       std::printf("\n");
       std::fflush(stdout);
     }
+    std::printf("\nWhere the GPU frame goes (medians, ms):\n\n"
+                "| rpp | trace | resolve + copy to host | unpack on host |\n"
+                "|-----|-------|------------------------|----------------|\n");
+    for (std::size_t i = 0; i < breakdown.size(); ++i)
+      std::printf("| %3d | %5.2f | %22.2f | %14.2f |\n", args.rpp[i], breakdown[i].trace_s * 1e3,
+                  breakdown[i].resolve_s * 1e3, breakdown[i].unpack_s * 1e3);
     return 0;
   } catch (const std::exception &e) {
     std::fprintf(stderr, "bench: %s\n", e.what());
@@ -128,6 +155,9 @@ void add_bench_command(CLI::App &app) {
   cmd->add_option("--warmup", args->warmup, "Untimed frames first")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
+  cmd->add_flag("--all-layers", args->all_layers,
+                "Read back every float layer too, not only the 8-bit image a live frame\n"
+                "shows");
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
   cmd->add_flag("--cpu-peer", args->cpu_peer,
                 "Also time the CPU reference on the same frames and print the ratio");

@@ -96,7 +96,8 @@ struct FrameParams {
 #define BINDING_OUT_MIXED 10    // vec4 per pixel: I_m (rgb)
 #define BINDING_OUT_REAL 11     // vec4 per pixel: I_r (rgb)
 #define BINDING_OUT_AUX 12      // vec4 per pixel: x mask M, y mean hit depth (0 if none)
-#define BINDING_COUNT 13
+#define BINDING_OUT_DISPLAY 13  // uint per pixel: RGBA8, sRGB-encoded I_f, alpha = M
+#define BINDING_COUNT 14
 
 // The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to
 // the accumulators (the host clears them before the first batch); the resolve

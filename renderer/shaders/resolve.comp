@@ -4,6 +4,15 @@
 #include "buffers.glsl"
 #include "kernel.glsl"
 
+// The sRGB transfer function (IEC 61966-2-1) as image_io's PNG writer applies
+// it, in float where the writer uses double: the bytes may differ by one.
+vec3 linear_to_srgb(vec3 v) {
+  v = clamp(v, vec3(0.0f), vec3(1.0f));
+  vec3 low = 12.92f * v;
+  vec3 high = 1.055f * pow(v, vec3(1.0f / 2.4f)) - 0.055f;
+  return mix(high, low, lessThanEqual(v, vec3(0.0031308f)));
+}
+
 void main() {
   int i = pixel_index();
   if (i < 0) {
@@ -16,4 +25,7 @@ void main() {
   out_mixed[i] = vec4(r.mixed, 1.0f);
   out_real[i] = vec4(r.real, 1.0f);
   out_aux[i] = vec4(r.mask, r.depth, 0.0f, 0.0f);
+  // The frame as a display or a V4L2 sink takes it: a quarter of the bytes of
+  // out_composite, and no conversion left for the host.
+  out_display[i] = packUnorm4x8(vec4(linear_to_srgb(r.composite), r.mask));
 }

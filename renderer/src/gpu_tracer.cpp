@@ -145,7 +145,8 @@ struct GpuTracer::Impl {
   ~Impl() { device.wait_idle(); }
 
   void load(const CompiledScene &scene);
-  RenderResult render(const gpu::FrameParams &requested, const ProgressFn &progress);
+  RenderResult render(const gpu::FrameParams &requested, const ProgressFn &progress,
+                      LayerSelection layers);
   void dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
 
   // Declaration order is destruction order in reverse: everything made from
@@ -159,7 +160,7 @@ struct GpuTracer::Impl {
   vk::CommandRunner commands;
   vk::Buffer frame_uniform;
   std::array<vk::Buffer, BINDING_COUNT> buffers; // by binding; BINDING_FRAME unused
-  vk::Buffer readback;                           // the kOutputs, one after another
+  vk::Buffer readback; // the kOutputs, one after another, then the display image
 
   bool loaded = false;
   std::uint32_t width = 0;
@@ -237,7 +238,11 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
         device, {.size = layer_bytes,
                  .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                  .name = "output layer"});
-  readback = vk::Buffer(device, {.size = layer_bytes * kOutputs.size(),
+  buffers[BINDING_OUT_DISPLAY] = vk::Buffer(
+      device, {.size = pixels * sizeof(std::uint32_t),
+               .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+               .name = "display output"});
+  readback = vk::Buffer(device, {.size = layer_bytes * kOutputs.size() + pixels * 4,
                                  .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                  .memory = vk::MemoryUse::readback,
                                  .name = "read-back"});
@@ -261,8 +266,8 @@ void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeli
                 (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y, 1);
 }
 
-RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested,
-                                     const ProgressFn &progress) {
+RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const ProgressFn &progress,
+                                     LayerSelection selection) {
   const Clock::time_point start = Clock::now();
   if (!loaded)
     throw GpuError("GpuTracer::render() before a successful load()");
@@ -283,6 +288,8 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested,
   // One uniform buffer suffices because each batch is waited for before the
   // next one rewrites it.
   BatchSizer sizer;
+  FrameTimings timings;
+  Clock::time_point phase = Clock::now();
   for (std::uint32_t done = 0; done < total;) {
     const std::uint32_t batch = std::min(sizer.next(), total - done);
     frame.sampling = gpu::uvec4(done, done + batch, total, requested.sampling.w);
@@ -309,6 +316,9 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested,
       progress(static_cast<int>(done), static_cast<int>(total));
   }
 
+  timings.trace_s = seconds_since(phase);
+  phase = Clock::now();
+
   frame.sampling = gpu::uvec4(0, total, total, requested.sampling.w);
   std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);
   VkCommandBuffer command_buffer = commands.begin();
@@ -317,25 +327,50 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested,
                      VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                      VK_ACCESS_TRANSFER_READ_BIT);
   const VkDeviceSize layer_bytes = buffers[BINDING_OUT_AUX].size();
+  const std::array<bool, kOutputs.size()> wanted = {selection.composite, selection.mixed,
+                                                    selection.real, selection.mask_and_depth};
   for (std::size_t i = 0; i < kOutputs.size(); ++i) {
+    if (!wanted[i])
+      continue;
     const VkBufferCopy region{0, i * layer_bytes, layer_bytes};
     vkCmdCopyBuffer(command_buffer, buffers[kOutputs[i]].get(), readback.get(), 1, &region);
+  }
+  const VkDeviceSize display_offset = kOutputs.size() * layer_bytes;
+  const VkDeviceSize display_bytes = buffers[BINDING_OUT_DISPLAY].size();
+  if (selection.display) {
+    const VkBufferCopy region{0, display_offset, display_bytes};
+    vkCmdCopyBuffer(command_buffer, buffers[BINDING_OUT_DISPLAY].get(), readback.get(), 1, &region);
   }
   vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   commands.submit_and_wait();
+  timings.resolve_s = seconds_since(phase);
+  phase = Clock::now();
 
-  const auto *layers = static_cast<const float *>(readback.mapped());
-  const std::size_t layer_floats = layer_bytes / sizeof(float);
+  const auto *mapped = static_cast<const std::uint8_t *>(readback.mapped());
+  const auto layer = [&](std::size_t slot) {
+    return reinterpret_cast<const float *>(mapped + slot * layer_bytes);
+  };
   const int w = static_cast<int>(width);
   const int h = static_cast<int>(height);
   RenderResult result;
-  result.composite = unpack(layers, w, h, 3, 0);
-  result.mixed = unpack(layers + layer_floats, w, h, 3, 0);
-  result.real = unpack(layers + 2 * layer_floats, w, h, 3, 0);
-  result.mask = unpack(layers + 3 * layer_floats, w, h, 1, 0);  // out_aux.x
-  result.depth = unpack(layers + 3 * layer_floats, w, h, 1, 1); // out_aux.y
+  if (selection.composite)
+    result.composite = unpack(layer(0), w, h, 3, 0);
+  if (selection.mixed)
+    result.mixed = unpack(layer(1), w, h, 3, 0);
+  if (selection.real)
+    result.real = unpack(layer(2), w, h, 3, 0);
+  if (selection.mask_and_depth) {
+    const float *aux = layer(3);
+    result.mask = unpack(aux, w, h, 1, 0);  // out_aux.x
+    result.depth = unpack(aux, w, h, 1, 1); // out_aux.y
+  }
+  if (selection.display) {
+    result.display.assign(mapped + display_offset, mapped + display_offset + display_bytes);
+  }
   result.camera_rays = std::uint64_t(width) * height * total;
+  timings.unpack_s = seconds_since(phase);
+  result.timings = timings;
   result.seconds = seconds_since(start);
   return result;
 }
@@ -352,8 +387,9 @@ void GpuTracer::load(const CompiledScene &scene) {
   impl_->load(scene);
 }
 
-RenderResult GpuTracer::render(const gpu::FrameParams &frame, const ProgressFn &progress) {
-  return impl_->render(frame, progress);
+RenderResult GpuTracer::render(const gpu::FrameParams &frame, const ProgressFn &progress,
+                               LayerSelection layers) {
+  return impl_->render(frame, progress, layers);
 }
 
 } // namespace camhead::renderer

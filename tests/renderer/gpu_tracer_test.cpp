@@ -2,11 +2,14 @@
 // read-back. The physics is compared against the CPU tracer elsewhere.
 #include <bit>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/image_io.h"
 
 #include <gtest/gtest.h>
 
@@ -154,6 +157,41 @@ TEST(GpuTracer, RendersInBatchesWithMonotonicProgress) {
   for (std::size_t i = 1; i < done.size(); ++i)
     EXPECT_GT(done[i], done[i - 1]);
   EXPECT_EQ(done.back(), int(samples));
+}
+
+// The 8-bit display image is the composite as write_png() encodes it, with
+// the mask as alpha, and asking for it alone returns the same bytes.
+TEST(GpuTracer, DisplayImageIsTheSrgbEncodedCompositeWithMaskAlpha) {
+  REQUIRE_VULKAN_DEVICE();
+  GpuTracer tracer;
+  const CompiledScene scene = small_scene(32, 24, true);
+  tracer.load(scene);
+  const gpu::FrameParams frame = small_frame(scene, 8);
+  const RenderResult all = tracer.render(frame);
+  ASSERT_EQ(all.display.size(), std::size_t(32) * 24 * 4);
+  const auto code = [](float linear) {
+    return int(std::nearbyint(linear_to_srgb(linear) * 255.0f));
+  };
+  int largest = 0, exact = 0, partly_virtual = 0;
+  for (std::size_t i = 0; i < std::size_t(32) * 24; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const int difference = std::abs(all.display[4 * i + c] - code(all.composite.data[3 * i + c]));
+      largest = std::max(largest, difference);
+      exact += difference == 0;
+    }
+    const float mask = all.mask.data[i];
+    EXPECT_LE(std::abs(all.display[4 * i + 3] - int(std::nearbyint(mask * 255.0f))), 1) << i;
+    partly_virtual += mask > 0.0f && mask < 1.0f;
+  }
+  std::printf("display vs write_png encoding: %d of %d codes equal, largest difference %d\n", exact,
+              32 * 24 * 3, largest);
+  EXPECT_LE(largest, 1);
+  EXPECT_GT(partly_virtual, 0) << "the scene should have pixels on the sphere's rim";
+
+  const RenderResult alone = tracer.render(frame, {}, LayerSelection::display_only());
+  EXPECT_EQ(alone.display, all.display);
+  EXPECT_TRUE(alone.composite.data.empty());
+  EXPECT_TRUE(alone.mask.data.empty());
 }
 
 TEST(GpuTracer, RendersWithoutLightsPlateOrGeometry) {

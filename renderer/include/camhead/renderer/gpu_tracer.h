@@ -46,7 +46,8 @@ public:
   // Traces frame.sampling.z samples per pixel in batches, calling `progress`
   // after each, resolves the layers and the composite on the GPU and reads
   // them back.
-  [[nodiscard]] RenderResult render(const gpu::FrameParams &frame, const ProgressFn &progress = {});
+  [[nodiscard]] RenderResult render(const gpu::FrameParams &frame, const ProgressFn &progress = {},
+                                    LayerSelection layers = LayerSelection::all());
 
 private:
   struct Impl;
