@@ -18,6 +18,10 @@ packages=(
   libgpiod-dev libusb-1.0-0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev
+  # The hardware lab (tests/vm): QEMU boots Debian's kernel with gpio-sim
+  # built from its source against its headers (all three from one release).
+  qemu-system-x86 linux-image-amd64 linux-headers-amd64 linux-source-6.1
+  busybox-static cpio kmod xz-utils
 )
 
 if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then

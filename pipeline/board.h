@@ -1,0 +1,123 @@
+// Board files: which devices a rig has and how they are wired (architecture.md,
+// board/). One JSON file per board or rig; `sim`, the simulated rig, is the
+// default and needs no hardware.
+//
+//   {
+//     "format": "camhead-board", "version": 1, "name": "sim",
+//     "description": "...",
+//     "lens": {
+//       "profile": "../scenes/lenses/example_35mm.json",
+//       "sources": [ { "type": "trace", "file": "...", "loop": true } ]
+//     }
+//   }
+//
+// Paths inside a board file are relative to the board file. The full field
+// list is in board/README.md; the loader checks every field the way the scene
+// and lens-profile readers do and throws BoardError("FILE: FIELD: REASON").
+//
+// Plain data only: pipeline/lens_sources.h turns a LensSourceConfig into a
+// hal::lens::LensEncoder.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace camhead::pipeline {
+
+class BoardError : public std::runtime_error {
+public:
+  BoardError(const std::string &file, const std::string &field, const std::string &reason)
+      : std::runtime_error(file + ": " + field + ": " + reason) {}
+};
+
+// A recorded lens trace played back in real time (the simulated rig).
+struct TraceSourceConfig {
+  std::filesystem::path file;
+  bool loop = true;
+  double speed = 1.0;
+};
+
+// The camhead USB lens-encoder board (docs/usb-lens-protocol.md).
+struct UsbSourceConfig {
+  std::uint16_t vendor_id = 0;
+  std::uint16_t product_id = 0;
+  std::optional<std::string> serial;
+  // Run the simulated board instead, its encoders following this trace.
+  std::optional<std::filesystem::path> simulate;
+};
+
+// Quadrature encoders on GPIO lines of one chip.
+struct GpioAxisConfig {
+  unsigned line_a = 0, line_b = 0;
+  std::optional<unsigned> line_index;
+  bool index_active_low = false;
+  std::optional<std::int32_t> counts_at_index; // homes the axis on the index pulse
+  bool reverse = false;
+};
+enum class GpioBias { as_is, disable, pull_up, pull_down };
+struct GpioSourceConfig {
+  std::string chip; // "gpiochip0", "/dev/gpiochip0" or a chip label
+  std::optional<GpioAxisConfig> focus, iris, zoom;
+  GpioBias bias = GpioBias::as_is;
+  // Run the simulated chip instead, its encoders following this trace.
+  std::optional<std::filesystem::path> simulate;
+};
+
+// FreeD D1 over UDP.
+struct FreedSourceConfig {
+  std::string bind_address = "0.0.0.0";
+  std::uint16_t port = 40000;
+  std::optional<std::uint8_t> camera_id;
+};
+
+// OpenTrackIO over UDP.
+struct OpenTrackIoSourceConfig {
+  std::string bind_address = "0.0.0.0";
+  std::uint16_t port = 55555;
+  std::optional<std::string> multicast_group;
+};
+
+using LensSourceKind = std::variant<TraceSourceConfig, UsbSourceConfig, GpioSourceConfig,
+                                    FreedSourceConfig, OpenTrackIoSourceConfig>;
+
+struct LensSourceConfig {
+  std::string name; // for messages and the monitor; defaults to the type
+  LensSourceKind kind;
+  // How much later than the physical instant this source stamps its samples
+  // (lens_control's per-source delay). Broadcast tracking users set it.
+  double delay_ms = 0.0;
+};
+
+struct LensConfig {
+  // Empty: the uncalibrated fallback profile, flagged as such.
+  std::optional<std::filesystem::path> profile;
+  std::vector<LensSourceConfig> sources;
+};
+
+struct Board {
+  std::string name;
+  std::string description;
+  std::filesystem::path file; // where it was loaded from
+  LensConfig lens;
+};
+
+// "sim" and the other names in board/ resolve to board/<name>.json next to
+// the binary's source tree (CAMHEAD_BOARD_DIR); anything else is a path.
+[[nodiscard]] std::filesystem::path resolve_board(std::string_view name_or_path);
+
+// Loads and validates a board file. Throws BoardError.
+[[nodiscard]] Board load_board(const std::filesystem::path &file);
+// Parses board JSON text; `file` names it in errors and anchors relative
+// paths. Throws BoardError.
+[[nodiscard]] Board parse_board(std::string_view json_text, const std::filesystem::path &file);
+
+// "trace", "usb", ... as board files spell the type.
+[[nodiscard]] std::string_view source_type(const LensSourceConfig &source);
+
+} // namespace camhead::pipeline

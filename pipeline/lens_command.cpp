@@ -1,0 +1,241 @@
+// camhead lens monitor | record: the lens chain of a board, live.
+//
+// monitor: a text view of every lens source of the board, raw counts and the
+// calibrated lens state, redrawn in place on a terminal and printed as
+// blocks once a second into logs. record: one source's readings into a lens
+// trace (the format the simulated rig replays), through hal's TraceRecorder.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "board.h"
+#include "camhead/hal/lens/monotonic_clock.h"
+#include "camhead/hal/lens/trace/trace_recorder.h"
+#include "camhead/lens_control/lens_profile.h"
+#include "commands.h"
+#include "lens_sources.h"
+
+namespace camhead::cli {
+namespace {
+
+using namespace std::chrono_literals;
+using pipeline::LensChannel;
+
+std::atomic<bool> stop_requested{false};
+
+extern "C" void on_interrupt(int) {
+  stop_requested = true;
+}
+
+// Runs `step` until Ctrl-C or `duration_s` (0: no limit) has passed.
+template <typename Step> void run_until_stopped(double duration_s, Step step) {
+  stop_requested = false;
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  const auto start = std::chrono::steady_clock::now();
+  while (!stop_requested) {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (duration_s > 0.0 && elapsed >= duration_s)
+      break;
+    step(elapsed);
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+}
+
+std::string counts(const std::optional<std::int32_t> &v) {
+  return v ? std::to_string(*v) : "-";
+}
+
+std::string distance(const lens_control::Measured &m) {
+  char text[32];
+  if (std::isinf(m.value))
+    return "infinity";
+  std::snprintf(text, sizeof text, "%.3f m", m.value);
+  return text;
+}
+
+std::string flags(const lens_control::Measured &m) {
+  return std::string(m.fresh ? "" : " (stale)") + (m.clamped ? " (beyond calibration)" : "");
+}
+
+void print_channel(std::FILE *out, const LensChannel &channel, std::int64_t now_ns) {
+  const hal::lens::EncoderStatus status = channel.encoder().status();
+  std::fprintf(out, "%s  [%s]  %s\n", channel.config().name.c_str(),
+               channel.encoder().name().c_str(), status.connected ? "connected" : "NOT CONNECTED");
+  if (!status.detail.empty())
+    std::fprintf(out, "  status  %s\n", status.detail.c_str());
+  std::fprintf(out,
+               "  counts  readings %llu  malformed %llu  lost %llu  missed edges %llu  "
+               "reconnects %llu\n",
+               (unsigned long long)status.readings, (unsigned long long)status.malformed,
+               (unsigned long long)status.lost, (unsigned long long)status.missed_edges,
+               (unsigned long long)status.reconnects);
+  const auto &raw = channel.last_reading();
+  if (!raw) {
+    std::fprintf(out, "  raw     (no reading yet)\n\n");
+    return;
+  }
+  std::fprintf(out, "  raw     focus %s  iris %s  zoom %s  (%.0f ms ago)\n",
+               counts(raw->focus).c_str(), counts(raw->iris).c_str(), counts(raw->zoom).c_str(),
+               double(now_ns - raw->t_ns) * 1e-6);
+  if (raw->focus_distance_m || raw->f_stop || raw->focal_length_mm)
+    std::fprintf(out, "  sent    focus %s  f/%s  focal %s mm (the source's own calibration)\n",
+                 raw->focus_distance_m ? std::to_string(*raw->focus_distance_m).c_str() : "-",
+                 raw->f_stop ? std::to_string(*raw->f_stop).c_str() : "-",
+                 raw->focal_length_mm ? std::to_string(*raw->focal_length_mm).c_str() : "-");
+  const lens_control::LensState s = channel.state_at(now_ns);
+  std::fprintf(out, "  lens    focus %s%s  f/%.2f%s  %.1f mm (projection %.2f mm)%s%s\n\n",
+               distance(s.focus_distance_m).c_str(), flags(s.focus_distance_m).c_str(),
+               s.f_number.value, flags(s.f_number).c_str(), s.focal_length_mm.value,
+               s.projection_focal_length_mm.value, flags(s.focal_length_mm).c_str(),
+               s.calibrated ? "" : "  UNCALIBRATED");
+}
+
+struct LensArgs {
+  std::string board = "sim";
+  double duration_s = 0.0;
+  int interval_ms = 0; // 0: 100 ms on a terminal, 1000 ms otherwise
+  std::string source;
+  std::string output;
+};
+
+// Loads the board and its profile, reporting errors; empty on failure.
+std::optional<pipeline::Board> load(const LensArgs &args) {
+  try {
+    return pipeline::load_board(pipeline::resolve_board(args.board));
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "board error: %s\n", e.what());
+    set_exit_code(2);
+    return std::nullopt;
+  }
+}
+
+void monitor(const LensArgs &args) {
+  const auto board = load(args);
+  if (!board)
+    return;
+  std::vector<LensChannel> channels;
+  try {
+    channels = pipeline::open_lens_channels(*board);
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    set_exit_code(5);
+    return;
+  }
+  const bool terminal = isatty(STDOUT_FILENO) != 0;
+  const auto interval = std::chrono::milliseconds(args.interval_ms > 0 ? args.interval_ms
+                                                  : terminal           ? 100
+                                                                       : 1000);
+  const std::string profile = pipeline::load_board_profile(*board).name();
+  auto next_draw = std::chrono::steady_clock::now();
+  run_until_stopped(args.duration_s, [&](double elapsed) {
+    for (LensChannel &channel : channels)
+      channel.pump(channels.size() > 1 ? 2ms : 10ms);
+    if (std::chrono::steady_clock::now() < next_draw)
+      return;
+    next_draw += interval;
+    if (terminal)
+      std::fputs("\x1b[H\x1b[J", stdout); // home, clear: redraw in place
+    std::printf("camhead lens monitor  board \"%s\" (%s)  profile \"%s\"  t = %.1f s%s\n\n",
+                board->name.c_str(), board->file.c_str(), profile.c_str(), elapsed,
+                terminal ? "  (Ctrl-C stops)" : "");
+    const std::int64_t now = hal::lens::monotonic_ns();
+    for (const LensChannel &channel : channels)
+      print_channel(stdout, channel, now);
+    std::fflush(stdout);
+  });
+}
+
+void record(const LensArgs &args) {
+  const auto board = load(args);
+  if (!board)
+    return;
+  const pipeline::LensSourceConfig *chosen = nullptr;
+  for (const pipeline::LensSourceConfig &s : board->lens.sources)
+    if (args.source.empty() || s.name == args.source) {
+      chosen = &s;
+      break;
+    }
+  if (chosen == nullptr) {
+    std::string names;
+    for (const pipeline::LensSourceConfig &s : board->lens.sources)
+      names += (names.empty() ? "\"" : ", \"") + s.name + "\"";
+    std::fprintf(stderr, "board %s has no lens source \"%s\" (it has %s)\n", board->file.c_str(),
+                 args.source.c_str(), names.c_str());
+    set_exit_code(2);
+    return;
+  }
+  try {
+    auto recorder = std::make_unique<hal::lens::TraceRecorder>(
+        pipeline::open_lens_source(*chosen), args.output,
+        hal::lens::TraceRecorderOptions{.comment = "recorded by camhead lens record from board " +
+                                                   board->name + ", source " + chosen->name});
+    hal::lens::TraceRecorder &file = *recorder;
+    LensChannel channel(*chosen, std::move(recorder), pipeline::load_board_profile(*board));
+    std::fprintf(stderr, "recording %s into %s%s\n", file.name().c_str(), args.output.c_str(),
+                 args.duration_s > 0 ? "" : " (Ctrl-C stops)");
+    double next_report = 1.0;
+    run_until_stopped(args.duration_s, [&](double elapsed) {
+      channel.pump(50ms);
+      if (elapsed >= next_report) {
+        std::fprintf(stderr, "  %.0f s: %llu readings\n", elapsed,
+                     (unsigned long long)file.recorded());
+        next_report += 1.0;
+      }
+    });
+    file.close();
+    std::fprintf(stderr, "%s: %llu readings recorded\n", args.output.c_str(),
+                 (unsigned long long)file.recorded());
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    set_exit_code(5);
+  }
+}
+
+void add_common(CLI::App *cmd, LensArgs &args) {
+  cmd->add_option("--board", args.board,
+                  "Board name in board/ (sim, example-rig, ...) or a board file")
+      ->capture_default_str();
+  cmd->add_option("--duration", args.duration_s, "Stop after this many seconds (0: at Ctrl-C)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+}
+
+} // namespace
+
+void add_lens_command(CLI::App &app) {
+  auto args = std::make_shared<LensArgs>();
+  CLI::App *lens = app.add_subcommand("lens", "The lens chain of a board: watch it or record it");
+  lens->require_subcommand(1);
+
+  CLI::App *mon = lens->add_subcommand(
+      "monitor", "Live view of every lens source of a board: raw encoder counts, source\n"
+                 "health, and the calibrated lens state (focus distance, f-number, focal\n"
+                 "length) through the board's lens profile.");
+  add_common(mon, *args);
+  mon->add_option("--interval", args->interval_ms,
+                  "Milliseconds between views (default 100 on a terminal, 1000 otherwise)")
+      ->check(CLI::Range(10, 60000));
+  mon->callback([args] { monitor(*args); });
+
+  CLI::App *rec = lens->add_subcommand(
+      "record", "Record one lens source of a board to a lens trace (CSV), the format the\n"
+                "simulated rig replays. Written to FILE.partial and renamed when done.");
+  add_common(rec, *args);
+  rec->add_option("--source", args->source, "Source name in the board (default: the first)");
+  rec->add_option("-o,--output", args->output, "Trace file to write")->required();
+  rec->callback([args] { record(*args); });
+}
+
+} // namespace camhead::cli

@@ -1,0 +1,235 @@
+#include "lens_sources.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <type_traits>
+
+#include "camhead/hal/lens/gpio/gpio_quadrature.h"
+#include "camhead/hal/lens/gpio/simulated_quadrature.h"
+#include "camhead/hal/lens/network/freed_receiver.h"
+#include "camhead/hal/lens/network/opentrackio_receiver.h"
+#include "camhead/hal/lens/trace/lens_trace.h"
+#include "camhead/hal/lens/trace/trace_replay.h"
+#include "camhead/hal/lens/usb/simulated_usb_lens.h"
+#include "camhead/hal/lens/usb/usb_lens.h"
+
+namespace camhead::pipeline {
+
+namespace {
+
+namespace hl = hal::lens;
+using Axis = std::optional<std::int32_t> hl::EncoderReading::*;
+
+// Counts of one axis of a trace at trace time t (seconds from its first row),
+// linear between rows, looping over the trace's span; the last known value
+// where the axis has a gap.
+class TraceCurve {
+public:
+  TraceCurve(const hl::LensTrace &trace, Axis axis) {
+    for (const hl::EncoderReading &r : trace.readings)
+      if (r.*axis)
+        points_.push_back(
+            {double(r.t_ns - trace.readings.front().t_ns) * 1e-9, double(*(r.*axis))});
+  }
+  [[nodiscard]] bool empty() const { return points_.empty(); }
+  [[nodiscard]] double span_s() const { return points_.empty() ? 0.0 : points_.back().t; }
+
+  [[nodiscard]] double at(double t) const {
+    if (points_.size() == 1 || span_s() <= 0.0)
+      return points_.front().counts;
+    t = std::fmod(std::max(t, 0.0), span_s());
+    auto hi = std::upper_bound(points_.begin(), points_.end(), t,
+                               [](double v, const Point &p) { return v < p.t; });
+    if (hi == points_.end())
+      return points_.back().counts;
+    const Point &b = *hi, &a = *(hi - 1);
+    return a.counts + (b.counts - a.counts) * (t - a.t) / (b.t - a.t);
+  }
+
+private:
+  struct Point {
+    double t, counts;
+  };
+  std::vector<Point> points_;
+};
+
+std::unique_ptr<hl::LensEncoder> open_trace(const TraceSourceConfig &c) {
+  return hl::TraceReplay::open(c.file, {.loop = c.loop, .speed = c.speed});
+}
+
+std::unique_ptr<hl::LensEncoder> open_usb(const UsbSourceConfig &c) {
+  const hl::UsbLensConfig config{.vid = c.vendor_id, .pid = c.product_id, .serial = c.serial};
+  if (!c.simulate)
+    return hl::open_usb_lens(config);
+  // The simulated board latches its counts from the trace, looping.
+  const hl::LensTrace trace = hl::read_lens_trace(*c.simulate);
+  auto focus = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::focus);
+  auto iris = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::iris);
+  auto zoom = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::zoom);
+  hl::SimulatedUsbLensOptions options;
+  options.rate_hz = 200.0;
+  options.serial = c.serial.value_or("SIM0001");
+  options.trajectory = [focus, iris, zoom](std::uint32_t, double seconds) {
+    const auto counts = [seconds](const TraceCurve &curve) {
+      return curve.empty() ? 0 : std::int32_t(std::lround(curve.at(seconds)));
+    };
+    return hl::LensAxes{counts(*focus), counts(*iris), counts(*zoom)};
+  };
+  return hl::open_simulated_usb_lens(std::make_shared<hl::SimulatedUsbLensBoard>(options), config);
+}
+
+hl::gpio::GpioQuadratureAxis gpio_axis(const GpioAxisConfig &a) {
+  hl::gpio::GpioQuadratureAxis axis;
+  axis.line_a = a.line_a;
+  axis.line_b = a.line_b;
+  axis.line_index = a.line_index;
+  axis.index_active_low = a.index_active_low;
+  axis.decoder.reverse = a.reverse;
+  axis.decoder.counts_at_index = a.counts_at_index;
+  return axis;
+}
+
+// The simulated chip has no loop of its own: its edges are computed ahead,
+// so the trace is repeated this many times (a minute of the bundled trace).
+constexpr int kSimulatedGpioRepeats = 10;
+
+std::optional<hl::gpio::SimulatedQuadratureAxis>
+simulated_axis(const hl::LensTrace &trace, Axis axis, const GpioAxisConfig &a) {
+  const TraceCurve curve(trace, axis);
+  if (curve.empty())
+    return std::nullopt;
+  hl::gpio::SimulatedQuadratureAxis sim;
+  sim.decoder.reverse = a.reverse;
+  // The trace's counts are absolute; the simulated encoder's index sits at
+  // counts_at_index, so the axis homes as a real one does, on passing it.
+  sim.decoder.counts_at_index = a.counts_at_index;
+  sim.index_count = a.counts_at_index;
+  const std::int64_t first = trace.readings.front().t_ns;
+  const std::int64_t span = trace.readings.back().t_ns - first;
+  for (int k = 0; k < kSimulatedGpioRepeats; ++k)
+    for (const hl::EncoderReading &r : trace.readings)
+      if (r.*axis)
+        sim.trajectory.push_back({r.t_ns - first + k * (span + 10'000'000), double(*(r.*axis))});
+  return sim;
+}
+
+std::unique_ptr<hl::LensEncoder> open_gpio(const GpioSourceConfig &c) {
+  if (c.simulate) {
+    const hl::LensTrace trace = hl::read_lens_trace(*c.simulate);
+    hl::gpio::SimulatedQuadratureConfig config;
+    if (c.focus)
+      config.focus = simulated_axis(trace, &hl::EncoderReading::focus, *c.focus);
+    if (c.iris)
+      config.iris = simulated_axis(trace, &hl::EncoderReading::iris, *c.iris);
+    if (c.zoom)
+      config.zoom = simulated_axis(trace, &hl::EncoderReading::zoom, *c.zoom);
+    return hl::gpio::open_simulated_quadrature(config);
+  }
+  hl::gpio::GpioQuadratureConfig config;
+  config.chip = c.chip;
+  if (c.focus)
+    config.focus = gpio_axis(*c.focus);
+  if (c.iris)
+    config.iris = gpio_axis(*c.iris);
+  if (c.zoom)
+    config.zoom = gpio_axis(*c.zoom);
+  switch (c.bias) {
+  case GpioBias::as_is:
+    config.bias = hl::gpio::GpioBias::as_is;
+    break;
+  case GpioBias::disable:
+    config.bias = hl::gpio::GpioBias::disable;
+    break;
+  case GpioBias::pull_up:
+    config.bias = hl::gpio::GpioBias::pull_up;
+    break;
+  case GpioBias::pull_down:
+    config.bias = hl::gpio::GpioBias::pull_down;
+    break;
+  }
+  return hl::gpio::open_gpio_quadrature(config);
+}
+
+std::unique_ptr<hl::LensEncoder> open_freed(const FreedSourceConfig &c) {
+  return std::make_unique<hl::FreedReceiver>(hl::FreedReceiverConfig{
+      .bind_address = c.bind_address, .port = c.port, .camera_id = c.camera_id});
+}
+
+std::unique_ptr<hl::LensEncoder> open_opentrackio(const OpenTrackIoSourceConfig &c) {
+  hl::OpenTrackIoReceiverConfig config;
+  config.bind_address = c.bind_address;
+  config.port = c.port;
+  config.multicast_group = c.multicast_group.value_or("");
+  return std::make_unique<hl::OpenTrackIoReceiver>(config);
+}
+
+} // namespace
+
+std::unique_ptr<hal::lens::LensEncoder> open_lens_source(const LensSourceConfig &source) {
+  try {
+    return std::visit(
+        [](const auto &c) -> std::unique_ptr<hl::LensEncoder> {
+          using T = std::decay_t<decltype(c)>;
+          if constexpr (std::is_same_v<T, TraceSourceConfig>)
+            return open_trace(c);
+          else if constexpr (std::is_same_v<T, UsbSourceConfig>)
+            return open_usb(c);
+          else if constexpr (std::is_same_v<T, GpioSourceConfig>)
+            return open_gpio(c);
+          else if constexpr (std::is_same_v<T, FreedSourceConfig>)
+            return open_freed(c);
+          else
+            return open_opentrackio(c);
+        },
+        source.kind);
+  } catch (const std::exception &e) {
+    throw std::runtime_error("lens source \"" + source.name + "\": " + e.what());
+  }
+}
+
+lens_control::EncoderSample to_encoder_sample(const hal::lens::EncoderReading &r) {
+  return {.t_ns = r.t_ns, .focus = r.focus, .iris = r.iris, .zoom = r.zoom};
+}
+
+lens_control::LensProfile load_board_profile(const Board &board) {
+  return board.lens.profile ? lens_control::LensProfile::load(*board.lens.profile)
+                            : lens_control::LensProfile::uncalibrated();
+}
+
+namespace {
+
+lens_control::LensTrackerConfig tracker_config(const LensSourceConfig &source) {
+  lens_control::LensTrackerConfig config;
+  const auto delay_ns = std::int64_t(std::llround(source.delay_ms * 1e6));
+  for (lens_control::AxisConfig *axis : {&config.focus, &config.iris, &config.zoom})
+    axis->timeline.delay_ns = delay_ns;
+  return config;
+}
+
+} // namespace
+
+LensChannel::LensChannel(LensSourceConfig config, std::unique_ptr<hal::lens::LensEncoder> encoder,
+                         const lens_control::LensProfile &profile)
+    : config_(std::move(config)), encoder_(std::move(encoder)),
+      tracker_(profile, tracker_config(config_)) {}
+
+std::size_t LensChannel::pump(std::chrono::milliseconds timeout) {
+  batch_.clear();
+  encoder_->poll(timeout, batch_);
+  for (const hal::lens::EncoderReading &r : batch_)
+    tracker_.push(to_encoder_sample(r));
+  if (!batch_.empty())
+    last_ = batch_.back();
+  return batch_.size();
+}
+
+std::vector<LensChannel> open_lens_channels(const Board &board) {
+  const lens_control::LensProfile profile = load_board_profile(board);
+  std::vector<LensChannel> channels;
+  for (const LensSourceConfig &source : board.lens.sources)
+    channels.emplace_back(source, open_lens_source(source), profile);
+  return channels;
+}
+
+} // namespace camhead::pipeline
