@@ -25,8 +25,9 @@ class LensSources : public ::testing::Test {
 protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("camhead_lens_sources_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + std::to_string(hal::lens::monotonic_ns()));
+           ("camhead_lens_sources_" +
+            std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            std::to_string(hal::lens::monotonic_ns()));
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -52,7 +53,8 @@ TEST_F(LensSources, EverySimulatedSourceFollowsItsTraceToTheSameLensState) {
       (fs::path(CAMHEAD_SOURCE_DIR) / "scenes" / "lenses" / "example_35mm.json").string();
   const Board board = parse_board(R"({
       "format": "camhead-board", "version": 1, "name": "three twins",
-      "lens": {"profile": ")" + profile + R"(", "sources": [
+      "lens": {"profile": ")" + profile +
+                                      R"(", "sources": [
         {"name": "replay", "type": "trace", "file": "pull.csv", "loop": false},
         {"name": "usb", "type": "usb", "vendor_id": "1209", "product_id": "0001",
          "simulate": "pull.csv"},

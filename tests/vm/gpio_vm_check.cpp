@@ -191,8 +191,8 @@ std::string open_check(Rig &rig) {
   // below it counts from wherever it started: the encoder withholds it, and
   // the connect reading (quadrature_encoder.h) carries nothing.
   const std::vector<EncoderReading> readings = rig.settle();
-  expect(readings.empty(), "expected no reading before homing, got " +
-                               std::to_string(readings.size()));
+  expect(readings.empty(),
+         "expected no reading before homing, got " + std::to_string(readings.size()));
   const auto status = rig.encoder().status();
   expect(status.connected, "not connected: " + status.detail);
   expect(status.detail.find("not homed") != std::string::npos,
