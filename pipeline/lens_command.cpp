@@ -2,16 +2,19 @@
 //
 // monitor: a text view of every lens source of the board, raw counts and the
 // calibrated lens state, redrawn in place on a terminal and printed as
-// blocks once a second into logs. record: one source's readings into a lens
-// trace (the format the simulated rig replays), through hal's TraceRecorder.
+// blocks once a second into logs; optionally the first source's lens state is
+// sent on as OpenTrackIO, so that other tools see the same lens. record: one source's readings into
+// a lens trace (the format the simulated rig replays), through hal's TraceRecorder.
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -19,6 +22,7 @@
 
 #include "board.h"
 #include "camhead/hal/lens/monotonic_clock.h"
+#include "camhead/hal/lens/network/opentrackio_sender.h"
 #include "camhead/hal/lens/trace/trace_recorder.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "commands.h"
@@ -94,6 +98,10 @@ void print_channel(std::FILE *out, const LensChannel &channel, std::int64_t now_
                  raw->focus_distance_m ? std::to_string(*raw->focus_distance_m).c_str() : "-",
                  raw->f_stop ? std::to_string(*raw->f_stop).c_str() : "-",
                  raw->focal_length_mm ? std::to_string(*raw->focal_length_mm).c_str() : "-");
+  if (!raw->focus && !raw->iris && !raw->zoom) {
+    std::fprintf(out, "  lens    (no encoder counts to map through the profile)\n\n");
+    return;
+  }
   const lens_control::LensState s = channel.state_at(now_ns);
   std::fprintf(out, "  lens    focus %s%s  f/%.2f%s  %.1f mm (projection %.2f mm)%s%s\n\n",
                distance(s.focus_distance_m).c_str(), flags(s.focus_distance_m).c_str(),
@@ -108,7 +116,35 @@ struct LensArgs {
   int interval_ms = 0; // 0: 100 ms on a terminal, 1000 ms otherwise
   std::string source;
   std::string output;
+  std::string send_opentrackio; // HOST or HOST:PORT
 };
+
+// The lens state as OpenTrackIO carries it. Infinity has no OpenTrackIO
+// spelling (focusDistance is a finite distance), so it is left out.
+hal::lens::OpenTrackIoLensState opentrackio_state(const lens_control::LensState &s) {
+  hal::lens::OpenTrackIoLensState out;
+  if (std::isfinite(s.focus_distance_m.value))
+    out.focus_distance_m = s.focus_distance_m.value;
+  out.f_stop = s.f_number.value;
+  out.focal_length_mm = s.projection_focal_length_mm.value;
+  return out;
+}
+
+std::unique_ptr<hal::lens::OpenTrackIoSender> open_sender(const std::string &destination) {
+  hal::lens::OpenTrackIoSenderConfig config;
+  const std::size_t colon = destination.rfind(':');
+  config.host = destination.substr(0, colon);
+  if (colon != std::string::npos) {
+    const std::string port = destination.substr(colon + 1);
+    char *end = nullptr;
+    const unsigned long value = std::strtoul(port.c_str(), &end, 10);
+    if (port.empty() || *end != '\0' || value == 0 || value > 65535)
+      throw std::invalid_argument("--send-opentrackio " + destination +
+                                  ": the port must be 1 .. 65535");
+    config.port = static_cast<std::uint16_t>(value);
+  }
+  return std::make_unique<hal::lens::OpenTrackIoSender>(config);
+}
 
 // Loads the board and its profile, reporting errors; empty on failure.
 std::optional<pipeline::Board> load(const LensArgs &args) {
@@ -126,8 +162,11 @@ void monitor(const LensArgs &args) {
   if (!board)
     return;
   std::vector<LensChannel> channels;
+  std::unique_ptr<hal::lens::OpenTrackIoSender> sender;
   try {
     channels = pipeline::open_lens_channels(*board);
+    if (!args.send_opentrackio.empty())
+      sender = open_sender(args.send_opentrackio);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "%s\n", e.what());
     set_exit_code(5);
@@ -139,9 +178,15 @@ void monitor(const LensArgs &args) {
                                                                        : 1000);
   const std::string profile = pipeline::load_board_profile(*board).name();
   auto next_draw = std::chrono::steady_clock::now();
+  auto next_send = next_draw;
   run_until_stopped(args.duration_s, [&](double elapsed) {
     for (LensChannel &channel : channels)
       channel.pump(channels.size() > 1 ? 2ms : 10ms);
+    if (sender && std::chrono::steady_clock::now() >= next_send) {
+      next_send += 10ms; // 100 Hz, a common lens-data rate
+      static_cast<void>(
+          sender->send(opentrackio_state(channels.front().state_at(hal::lens::monotonic_ns()))));
+    }
     if (std::chrono::steady_clock::now() < next_draw)
       return;
     next_draw += interval;
@@ -153,6 +198,11 @@ void monitor(const LensArgs &args) {
     const std::int64_t now = hal::lens::monotonic_ns();
     for (const LensChannel &channel : channels)
       print_channel(stdout, channel, now);
+    if (sender)
+      std::printf(
+          "OpenTrackIO out  %s: %llu samples sent, %llu failed%s%s\n", sender->name().c_str(),
+          (unsigned long long)sender->sent(), (unsigned long long)sender->failed(),
+          sender->last_error().empty() ? "" : "; last error: ", sender->last_error().c_str());
     std::fflush(stdout);
   });
 }
@@ -227,6 +277,9 @@ void add_lens_command(CLI::App &app) {
   mon->add_option("--interval", args->interval_ms,
                   "Milliseconds between views (default 100 on a terminal, 1000 otherwise)")
       ->check(CLI::Range(10, 60000));
+  mon->add_option("--send-opentrackio", args->send_opentrackio,
+                  "Send the first source's lens state on as OpenTrackIO (100 Hz) to\n"
+                  "HOST[:PORT] (IPv4, unicast or multicast; port 55555 by default)");
   mon->callback([args] { monitor(*args); });
 
   CLI::App *rec = lens->add_subcommand(
