@@ -37,6 +37,9 @@ struct ConfigDeleter {
 using ContextPtr = std::unique_ptr<libusb_context, ContextDeleter>;
 using HandlePtr = std::unique_ptr<libusb_device_handle, HandleDeleter>;
 using DevicePtr = std::unique_ptr<libusb_device, DeviceDeleter>; // holds one reference
+// A transfer that has been submitted holds a reference to its device until it
+// is freed (or submitted again): free it before the handle is closed and the
+// context exited, like a DevicePtr.
 using TransferPtr = std::unique_ptr<libusb_transfer, TransferDeleter>;
 using ConfigPtr = std::unique_ptr<libusb_config_descriptor, ConfigDeleter>;
 

@@ -57,6 +57,8 @@ public:
 
 private:
   struct Slot {
+    // Allocated when a device is opened, freed when it is closed (see
+    // close_device): never outlives the handle or the context.
     TransferPtr transfer;
     std::vector<unsigned char> buffer;
     bool in_flight = false;
@@ -385,6 +387,14 @@ void LibusbTransport::close_device(const std::string &reason) {
       (void)slot.transfer.release();
       slot.in_flight = false;
       why += " (a transfer did not return from cancellation)";
+    } else {
+      // Freed now, not kept for the next device: a transfer that has been
+      // submitted holds a reference to its device (libusb >= 1.0.26) until it
+      // is freed or submitted again, and the next device may come in a fresh
+      // context, after drop_context() has exited this one. Dropping that
+      // reference then would touch the freed context (a crash after a
+      // replug). It also points at handle_, which is about to be closed.
+      slot.transfer.reset();
     }
   }
   libusb_release_interface(handle_.get(), lens_.number);
