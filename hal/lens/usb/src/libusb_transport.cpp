@@ -232,7 +232,7 @@ void LibusbTransport::try_open(libusb_device *dev) {
   if (const int rc = libusb_open(dev, &raw); rc < 0) {
     std::string why = "cannot open " + where(dev) + ": " + error_name(rc);
     if (rc == LIBUSB_ERROR_ACCESS) {
-      why += " (no permission on /dev/bus/usb: install camhead's udev rule)";
+      why += " (no permission on /dev/bus/usb: install systemd/70-camhead-lens.rules)";
     }
     link_.waiting(why);
     return;
