@@ -17,6 +17,8 @@ packages=(
   libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
   libgpiod-dev libusb-1.0-0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # bench/embree_peer: Embree 3 as the CPU ceiling for ray throughput.
+  libembree-dev
   clang libclang-rt-14-dev
   # The hardware lab (tests/vm): QEMU boots Debian's kernel with gpio-sim
   # built from its source against its headers (all three from one release).

@@ -17,6 +17,7 @@
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
+#include "chart_command.h"
 #include "commands.h"
 
 namespace camhead::cli {
@@ -161,7 +162,12 @@ void add_bench_command(CLI::App &app) {
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
   cmd->add_flag("--cpu-peer", args->cpu_peer,
                 "Also time the CPU reference on the same frames and print the ratio");
-  cmd->callback([args] { set_exit_code(run_bench(*args)); });
+  add_bench_chart_command(*cmd);
+  // `bench chart ...` runs the chart alone.
+  cmd->callback([args, cmd] {
+    if (!cmd->got_subcommand("chart"))
+      set_exit_code(run_bench(*args));
+  });
 }
 
 } // namespace camhead::cli

@@ -40,6 +40,9 @@ constexpr const char *kFormatHelp = R"(Measurements CSV:
     f_number         iris rows: f-number
     t_stop           iris rows, optional: T-stop (on every iris row or on none)
     focal_length_mm  zoom rows: focal length in mm (a prime: one row and --prime)
+    zoom_counts      focus rows, optional: the zoom counts (of a zoom row) the mark
+                     was measured at; on every focus row or on none. Given, each
+                     zoom point gets its own focus table (profile version 2).
   A row fills only its own axis's value columns. Repeats at the same counts are
   averaged in diopters / stops / log f; points that are not strictly monotone
   (measurement noise) are pooled by an isotonic fit. The residual report goes
@@ -119,9 +122,12 @@ int run_calibrate(const CalibrateArgs &args) {
     std::fputs(format_report(fit, residuals).c_str(), stdout);
     const std::string zoom =
         fit.prime ? "prime" : std::to_string(fit.zoom.points.size()) + " zoom points";
-    std::fprintf(stderr, "%s: profile \"%s\" written (%zu focus, %zu iris points, %s)\n",
-                 args.output.c_str(), args.name.c_str(), fit.focus.points.size(),
-                 fit.iris.points.size(), zoom.c_str());
+    const std::string focus =
+        fit.zoom_focus.empty() ? std::to_string(fit.focus.points.size()) + " focus"
+                               : std::to_string(fit.zoom_focus.size()) + " per-zoom focus tables";
+    std::fprintf(stderr, "%s: profile \"%s\" written (%s, %zu iris points, %s)\n",
+                 args.output.c_str(), args.name.c_str(), focus.c_str(), fit.iris.points.size(),
+                 zoom.c_str());
     return 0;
   } catch (const CalibrationError &e) {
     std::fprintf(stderr, "measurements error: %s\n", e.what());

@@ -117,15 +117,21 @@ double trend(const std::vector<Block> &blocks, std::size_t c) {
   return sxy >= 0.0 ? 1.0 : -1.0;
 }
 
-AxisFit fit_axis(const MeasurementSet &m, CalibrationAxis axis, bool prime) {
-  const std::string name = axis_name(axis);
-  const auto fail = [&](const std::string &reason) -> void {
-    throw CalibrationError(m.source, 0, name, reason);
-  };
+std::vector<const Measurement *> rows_of(const MeasurementSet &m, CalibrationAxis axis) {
   std::vector<const Measurement *> rows;
   for (const Measurement &r : m.rows)
     if (r.axis == axis)
       rows.push_back(&r);
+  return rows;
+}
+
+// One table fitted from `rows` (all of one axis); `name` names it in errors:
+// the axis, or e.g. "focus at zoom counts 900" for a per-zoom focus table.
+AxisFit fit_axis(const std::string &source, const std::string &name, CalibrationAxis axis,
+                 std::vector<const Measurement *> rows, bool prime) {
+  const auto fail = [&](const std::string &reason) -> void {
+    throw CalibrationError(source, 0, name, reason);
+  };
   if (rows.empty())
     fail("no measurements (a profile needs focus, iris and zoom rows; for a prime, one zoom "
          "row with its focal length and --prime)");
@@ -198,19 +204,79 @@ AxisFit fit_axis(const MeasurementSet &m, CalibrationAxis axis, bool prime) {
   return fit;
 }
 
+AxisFit fit_axis(const MeasurementSet &m, CalibrationAxis axis, bool prime) {
+  return fit_axis(m.source, axis_name(axis), axis, rows_of(m, axis), prime);
+}
+
+// Per-zoom focus tables: the focus rows at each fitted zoom point, fitted as
+// that point's table. A zoom point the monotone fit pooled from several zoom
+// marks takes the focus rows of all of them.
+std::vector<AxisFit> fit_zoom_focus(const MeasurementSet &m, const AxisFit &zoom) {
+  std::vector<std::vector<const Measurement *>> groups(zoom.points.size());
+  const std::vector<const Measurement *> zoom_rows = rows_of(m, CalibrationAxis::zoom);
+  for (const Measurement *r : rows_of(m, CalibrationAxis::focus)) {
+    const std::int32_t z = *r->zoom_counts;
+    if (std::none_of(zoom_rows.begin(), zoom_rows.end(),
+                     [&](const Measurement *q) { return q->counts == z; }))
+      throw CalibrationError(m.source, r->line, "zoom_counts",
+                             "no zoom row at counts " + std::to_string(z) +
+                                 " (a focus mark must be measured at a zoom calibration mark, "
+                                 "whose focal length a zoom row gives)");
+    for (std::size_t i = 0; i < zoom.points.size(); ++i)
+      if (z >= zoom.points[i].first_counts && z <= zoom.points[i].last_counts)
+        groups[i].push_back(r);
+  }
+  std::vector<AxisFit> tables;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    const std::string name = "focus at zoom counts " + std::to_string(zoom.points[i].counts);
+    if (groups[i].empty())
+      throw CalibrationError(m.source, 0, name,
+                             "no focus measurements (with a zoom_counts column, every zoom "
+                             "point needs its own focus marks)");
+    tables.push_back(fit_axis(m.source, name, CalibrationAxis::focus, groups[i], false));
+  }
+  // The profile reader's rule: tables that run opposite ways would blend into
+  // a focus that runs backwards between their zoom points.
+  const auto rising = [](const AxisFit &t) {
+    return to_linear(CalibrationAxis::focus, t.points.back().value) >
+           to_linear(CalibrationAxis::focus, t.points.front().value);
+  };
+  for (std::size_t i = 1; i < tables.size(); ++i)
+    if (rising(tables[i]) != rising(tables[0]))
+      throw CalibrationError(
+          m.source, 0, "focus at zoom counts " + std::to_string(zoom.points[i].counts),
+          std::string("the fitted distances ") + (rising(tables[i]) ? "fall" : "rise") +
+              " as counts rise, the other way from the table at zoom counts " +
+              std::to_string(zoom.points[0].counts) +
+              ": every zoom point's focus table must run the same way");
+  return tables;
+}
+
 std::string num(double v) {
   return nlohmann::json(v).dump();
 }
 
-std::string table(const AxisFit &fit, const char *key) {
+std::string table(const AxisFit &fit, const char *key, const std::string &indent = "    ") {
   std::string s = "[\n";
   for (std::size_t i = 0; i < fit.points.size(); ++i) {
     const FittedPoint &p = fit.points[i];
-    s += "    {\"counts\": " + std::to_string(p.counts) + ", \"" + key +
+    s += indent + "{\"counts\": " + std::to_string(p.counts) + ", \"" + key +
          "\": " + (std::isinf(p.value) ? std::string("\"infinity\"") : num(p.value));
     if (p.t_stop)
       s += ", \"t_stop\": " + num(*p.t_stop);
     s += i + 1 < fit.points.size() ? "},\n" : "}\n";
+  }
+  return s + indent.substr(2) + "]";
+}
+
+// The zoom table with a focus table on every point (format version 2).
+std::string zoom_table_with_focus(const Calibration &fit) {
+  std::string s = "[\n";
+  for (std::size_t i = 0; i < fit.zoom.points.size(); ++i) {
+    const FittedPoint &p = fit.zoom.points[i];
+    s += "    {\"counts\": " + std::to_string(p.counts) + ", \"focal_length_mm\": " + num(p.value) +
+         ", \"focus\": " + table(fit.zoom_focus[i], "distance_m", "      ");
+    s += i + 1 < fit.zoom.points.size() ? "},\n" : "}\n";
   }
   return s + "  ]";
 }
@@ -223,9 +289,24 @@ Calibration fit_calibration(const MeasurementSet &measurements, const Calibratio
   Calibration c;
   c.source = measurements.source;
   c.prime = options.prime;
-  c.focus = fit_axis(measurements, CalibrationAxis::focus, options.prime);
+  // Per-zoom focus when the focus rows give the zoom they were measured at
+  // (on all of them or none: the CSV reader checks).
+  const std::vector<const Measurement *> focus = rows_of(measurements, CalibrationAxis::focus);
+  const bool per_zoom = !focus.empty() && focus.front()->zoom_counts;
+  if (per_zoom && options.prime)
+    throw CalibrationError(measurements.source, 0, "focus",
+                           "the zoom_counts column gives per-zoom focus tables, which need a "
+                           "zoom lens: leave the column out for a prime (--prime)");
+  if (!per_zoom)
+    c.focus = fit_axis(measurements, CalibrationAxis::focus, options.prime);
   c.iris = fit_axis(measurements, CalibrationAxis::iris, options.prime);
   c.zoom = fit_axis(measurements, CalibrationAxis::zoom, options.prime);
+  if (per_zoom) {
+    c.zoom_focus = fit_zoom_focus(measurements, c.zoom);
+    c.focus = AxisFit{CalibrationAxis::focus, focus.size(), 0, {}};
+    for (const AxisFit &t : c.zoom_focus)
+      c.focus.distinct_counts += t.distinct_counts;
+  }
   return c;
 }
 
@@ -238,13 +319,18 @@ std::string profile_json(const Calibration &fit, const CalibrationOptions &optio
                                             " (" + std::to_string(n) + " measurements).";
   std::string s = "{\n";
   s += "  \"format\": \"camhead-lens-profile\",\n";
-  s += "  \"version\": 1,\n";
+  const bool per_zoom = !fit.zoom_focus.empty();
+  // Version 2 only when needed: a version 1 reader then still reads the rest.
+  s += per_zoom ? "  \"version\": 2,\n" : "  \"version\": 1,\n";
   s += "  \"name\": " + nlohmann::json(options.name).dump() + ",\n";
   s += "  \"description\": " + nlohmann::json(description).dump() + ",\n";
-  s += "  \"focus\": " + table(fit.focus, "distance_m") + ",\n";
+  if (!per_zoom)
+    s += "  \"focus\": " + table(fit.focus, "distance_m") + ",\n";
   s += "  \"iris\": " + table(fit.iris, "f_number") + ",\n";
   if (fit.prime)
     s += "  \"prime\": {\"focal_length_mm\": " + num(fit.zoom.points.front().value) + "}\n";
+  else if (per_zoom)
+    s += "  \"zoom\": " + zoom_table_with_focus(fit) + "\n";
   else
     s += "  \"zoom\": " + table(fit.zoom, "focal_length_mm") + "\n";
   return s + "}\n";

@@ -18,8 +18,8 @@ namespace camhead::lens_control {
 
 namespace {
 
-constexpr std::array<std::string_view, 6> kColumns = {"axis",     "counts", "distance_m",
-                                                      "f_number", "t_stop", "focal_length_mm"};
+constexpr std::array<std::string_view, 7> kColumns = {
+    "axis", "counts", "distance_m", "f_number", "t_stop", "focal_length_mm", "zoom_counts"};
 
 // The value column each axis needs; t_stop is iris's optional second one.
 std::string_view value_column(CalibrationAxis a) {
@@ -88,6 +88,7 @@ public:
                              "no header row (expected e.g. axis,counts,distance_m,"
                              "f_number,t_stop,focal_length_mm)");
     check_t_stops(out.rows);
+    check_zoom_counts(out.rows);
     return out;
   }
 
@@ -103,7 +104,7 @@ private:
         fail(std::to_string(i + 1), "empty column name in the header");
       if (std::find(kColumns.begin(), kColumns.end(), name) == kColumns.end())
         fail(name, "unknown column (known: axis, counts, distance_m, f_number, t_stop, "
-                   "focal_length_mm)");
+                   "focal_length_mm, zoom_counts)");
       if (index_.count(std::string(name)))
         fail(name, "appears twice in the header");
       index_[std::string(name)] = i;
@@ -136,6 +137,13 @@ private:
     else
       fail("axis", "must be focus, iris or zoom, not \"" + std::string(axis) + "\"");
     m.counts = counts(cell(cells, "counts"));
+    // The zoom position a focus mark was measured at: per-zoom focus tables.
+    if (const std::string_view z = cell(cells, "zoom_counts"); !z.empty()) {
+      if (m.axis != CalibrationAxis::focus)
+        fail("zoom_counts", "not used by " + std::string(axis) +
+                                " rows (only focus rows give the zoom they were measured at)");
+      m.zoom_counts = counts(z, "zoom_counts");
+    }
 
     // Only this axis's value columns may be filled: anything else is a value
     // typed into the wrong column or a row labelled with the wrong axis.
@@ -169,14 +177,14 @@ private:
     return m;
   }
 
-  std::int32_t counts(std::string_view s) const {
+  std::int32_t counts(std::string_view s, std::string_view column = "counts") const {
     std::int64_t v = 0;
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     if (s.empty() || ec != std::errc{} || end != s.data() + s.size())
-      fail("counts", "not an integer");
+      fail(column, "not an integer");
     if (v < std::numeric_limits<std::int32_t>::min() ||
         v > std::numeric_limits<std::int32_t>::max())
-      fail("counts", "outside the 32-bit encoder range");
+      fail(column, "outside the 32-bit encoder range");
     return std::int32_t(v);
   }
 
@@ -216,6 +224,23 @@ private:
                                "give t_stop on every iris row or on none (line " +
                                    std::to_string(first->line) +
                                    (first->t_stop ? " has one)" : " has none)"));
+    }
+  }
+
+  // Per-zoom focus tables need the zoom of every focus mark: on every focus
+  // row or on none.
+  void check_zoom_counts(const std::vector<Measurement> &rows) const {
+    const Measurement *first = nullptr;
+    for (const Measurement &m : rows) {
+      if (m.axis != CalibrationAxis::focus)
+        continue;
+      if (!first)
+        first = &m;
+      else if (m.zoom_counts.has_value() != first->zoom_counts.has_value())
+        throw CalibrationError(source_, m.line, "zoom_counts",
+                               "give zoom_counts on every focus row or on none (line " +
+                                   std::to_string(first->line) +
+                                   (first->zoom_counts ? " has one)" : " has none)"));
     }
   }
 

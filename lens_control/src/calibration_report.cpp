@@ -2,10 +2,12 @@
 // LensProfile's own lookups, not through the fit's arithmetic, so they
 // measure the profile that will actually be used: PCHIP between the written
 // points, clamping outside them, and every conversion on the way.
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
+#include <map>
 
 #include "camhead/lens_control/calibration.h"
 
@@ -84,14 +86,24 @@ std::vector<Residuals> compute_residuals(const MeasurementSet &measurements,
   Accumulator focus_m(format("focus, m (d <= %.3g m)", near_limit));
   Accumulator f_number("iris f-number, stops"), t_stop("iris T-stop, stops");
   Accumulator zoom("zoom focal length, mm");
+  // Per measured zoom counts, for per-zoom focus: which zoom a focus error
+  // comes from.
+  std::map<std::int32_t, Accumulator> focus_at_zoom;
   for (const Measurement &m : measurements.rows) {
     const double c = m.counts;
     switch (m.axis) {
     case CalibrationAxis::focus: {
-      const double d = profile.focus_distance_m(c).value;
-      focus_d.add(diopters(m.value) - diopters(d), m.counts);
+      // At the zoom the mark was measured at, when the file says.
+      const double d = m.zoom_counts ? profile.focus_distance_m(*m.zoom_counts, c).value
+                                     : profile.focus_distance_m(c).value;
+      const double r = diopters(m.value) - diopters(d);
+      focus_d.add(r, m.counts);
       if (m.value <= near_limit)
         focus_m.add(m.value - d, m.counts);
+      if (m.zoom_counts)
+        focus_at_zoom
+            .try_emplace(*m.zoom_counts, format("focus @ zoom %d, diopters", int(*m.zoom_counts)))
+            .first->second.add(r, m.counts);
       break;
     }
     case CalibrationAxis::iris:
@@ -105,7 +117,11 @@ std::vector<Residuals> compute_residuals(const MeasurementSet &measurements,
     }
   }
   std::vector<Residuals> out;
-  for (Accumulator *a : {&focus_d, &focus_m, &f_number, &t_stop, &zoom})
+  focus_d.emit(out);
+  focus_m.emit(out);
+  for (auto &[z, a] : focus_at_zoom)
+    a.emit(out);
+  for (Accumulator *a : {&f_number, &t_stop, &zoom})
     a->emit(out);
   return out;
 }
@@ -113,10 +129,27 @@ std::vector<Residuals> compute_residuals(const MeasurementSet &measurements,
 std::string format_report(const Calibration &fit, const std::vector<Residuals> &residuals) {
   std::string s = "camhead calibrate: " + fit.source + "\n\n";
   s += format("%-6s %12s %16s %15s\n", "axis", "measurements", "distinct counts", "points written");
-  for (const AxisFit *a : {&fit.focus, &fit.iris, &fit.zoom})
+  std::size_t focus_points = fit.focus.points.size();
+  for (const AxisFit &t : fit.zoom_focus)
+    focus_points += t.points.size();
+  for (const AxisFit *a : {&fit.focus, &fit.iris, &fit.zoom}) {
+    const bool focus = a->axis == CalibrationAxis::focus;
     s += format("%-6s %12zu %16zu %15zu%s\n", axis_name(a->axis), a->measurements,
-                a->distinct_counts, a->points.size(),
-                a->axis == CalibrationAxis::zoom && fit.prime ? " (prime)" : "");
+                a->distinct_counts, focus ? focus_points : a->points.size(),
+                a->axis == CalibrationAxis::zoom && fit.prime ? " (prime)"
+                : focus && !fit.zoom_focus.empty()
+                    ? format(" (%zu tables, one per zoom point)", fit.zoom_focus.size()).c_str()
+                    : "");
+    // Per-zoom focus: one row per table, under the focus total.
+    if (focus)
+      for (std::size_t i = 0; i < fit.zoom_focus.size(); ++i) {
+        // Right-aligned under "measurements", as the axis rows are.
+        const std::string label = format("  @ zoom %d", int(fit.zoom.points[i].counts));
+        s += format("%s%*zu %16zu %15zu\n", label.c_str(), std::max(1, 19 - int(label.size())),
+                    fit.zoom_focus[i].measurements, fit.zoom_focus[i].distinct_counts,
+                    fit.zoom_focus[i].points.size());
+      }
+  }
 
   s += format("\n%-30s %5s %11s %11s %10s\n", "residual, measured - profile", "n", "rms", "max",
               "at counts");
@@ -125,13 +158,18 @@ std::string format_report(const Calibration &fit, const std::vector<Residuals> &
                 int(r.max_at_counts));
 
   std::string pooled;
-  for (const AxisFit *a : {&fit.focus, &fit.iris, &fit.zoom})
-    for (const FittedPoint &p : a->points)
+  const auto pooled_in = [&](const AxisFit &a, const std::string &name) {
+    for (const FittedPoint &p : a.points)
       if (p.distinct_counts > 1)
-        pooled +=
-            format("  %s: counts %d..%d (%zu counts, %zu measurements) -> counts %d, %s\n",
-                   axis_name(a->axis), int(p.first_counts), int(p.last_counts), p.distinct_counts,
-                   p.measurements, int(p.counts), show_value(a->axis, p).c_str());
+        pooled += format("  %s: counts %d..%d (%zu counts, %zu measurements) -> counts %d, %s\n",
+                         name.c_str(), int(p.first_counts), int(p.last_counts), p.distinct_counts,
+                         p.measurements, int(p.counts), show_value(a.axis, p).c_str());
+  };
+  pooled_in(fit.focus, "focus");
+  for (std::size_t i = 0; i < fit.zoom_focus.size(); ++i)
+    pooled_in(fit.zoom_focus[i], format("focus @ zoom %d", int(fit.zoom.points[i].counts)));
+  pooled_in(fit.iris, "iris");
+  pooled_in(fit.zoom, "zoom");
   s += pooled.empty()
            ? "\npooled by the monotone fit: none (the averaged points were monotone)\n"
            : "\npooled by the monotone fit (not monotone within measurement noise):\n" + pooled;

@@ -40,13 +40,70 @@ LensProfile LensProfile::uncalibrated() {
   const double stops = 2.0 * std::log2(2.8);
   p.iris_stops_ = MonotoneCurve(all, {stops, stops});
   p.zoom_counts_ = {0.0};
-  p.zoom_points_ = {ZoomPoint{35.0, 0.0, {}, std::nullopt, false, false}};
+  p.zoom_points_ = {ZoomPoint{35.0, 0.0, {}, std::nullopt, false, false, {}}};
   return p;
 }
 
-LensProfile::Lookup LensProfile::focus_distance_m(double focus_counts) const {
-  const auto r = focus_diopters_(focus_counts);
+LensProfile::ZoomSpan LensProfile::zoom_span(double zoom_counts) const {
+  if (!is_zoom())
+    return {};
+  // The weight breathing has always been blended with: linear in zoom counts
+  // between the two calibration points around the zoom. Exactly 0 at a point
+  // and at or before the first, exactly 1 at or beyond the last, so that a
+  // zoom point's own tables come back bit for bit there.
+  const std::size_t n = zoom_counts_.size();
+  if (!(zoom_counts > zoom_counts_.front()))
+    return {0, 0.0, zoom_counts < zoom_counts_.front() || std::isnan(zoom_counts)};
+  if (!(zoom_counts < zoom_counts_.back()))
+    return {n - 2, 1.0, zoom_counts > zoom_counts_.back()};
+  const std::size_t k =
+      std::size_t(std::upper_bound(zoom_counts_.begin(), zoom_counts_.end(), zoom_counts) -
+                  zoom_counts_.begin()) -
+      1;
+  return {k, (zoom_counts - zoom_counts_[k]) / (zoom_counts_[k + 1] - zoom_counts_[k]), false};
+}
+
+MonotoneCurve::Result LensProfile::focus_diopters(double zoom_counts, double focus_counts) const {
+  if (!has_per_zoom_focus())
+    return focus_diopters_(focus_counts);
+  // Each table in diopters, then the diopters blended across zoom. With both
+  // tables non-increasing (or both non-decreasing) in counts, so is
+  // (1 - t) a + t b for a fixed t in [0, 1], and in floating point too: a
+  // product by a fixed non-negative weight and a sum both round monotonically.
+  // Infinity (0 D) blends with 0 D to exactly 0 D, and two non-negative
+  // diopters never blend to a negative one.
+  const ZoomSpan s = zoom_span(zoom_counts);
+  const MonotoneCurve::Result a = zoom_points_[s.k].focus(focus_counts);
+  if (s.t == 0.0)
+    return {a.y, a.clamped || s.clamped};
+  const MonotoneCurve::Result b = zoom_points_[s.k + 1].focus(focus_counts);
+  if (s.t == 1.0)
+    return {b.y, b.clamped || s.clamped};
+  return {(1.0 - s.t) * a.y + s.t * b.y, a.clamped || b.clamped || s.clamped};
+}
+
+MonotoneCurve::Result LensProfile::rest_focus_diopters(double zoom_counts) const {
+  // The far end: the table end with the smaller diopter value.
+  const auto far = [](const MonotoneCurve &c) { return std::min(c.ys().front(), c.ys().back()); };
+  if (!has_per_zoom_focus())
+    return {far(focus_diopters_), false};
+  const ZoomSpan s = zoom_span(zoom_counts);
+  const double a = far(zoom_points_[s.k].focus);
+  if (s.t == 0.0)
+    return {a, s.clamped};
+  const double b = far(zoom_points_[s.k + 1].focus);
+  if (s.t == 1.0)
+    return {b, s.clamped};
+  return {(1.0 - s.t) * a + s.t * b, s.clamped};
+}
+
+LensProfile::Lookup LensProfile::focus_distance_m(double zoom_counts, double focus_counts) const {
+  const auto r = focus_diopters(zoom_counts, focus_counts);
   return {from_diopters(r.y), r.clamped};
+}
+
+LensProfile::Lookup LensProfile::focus_distance_m(double focus_counts) const {
+  return focus_distance_m(zoom_counts_.front(), focus_counts);
 }
 
 LensProfile::Lookup LensProfile::f_number(double iris_counts) const {
@@ -90,7 +147,11 @@ double LensProfile::projection_at_point(const ZoomPoint &z, double diopters) con
 
 LensProfile::Lookup LensProfile::projection_focal_length_mm(double zoom_counts,
                                                             double focus_counts) const {
-  const auto focus = focus_diopters_(focus_counts);
+  return projection_for_focus(zoom_counts, focus_diopters(zoom_counts, focus_counts));
+}
+
+LensProfile::Lookup LensProfile::projection_for_focus(double zoom_counts,
+                                                      MonotoneCurve::Result focus) const {
   if (!is_zoom())
     return {projection_at_point(zoom_points_.front(), focus.y), focus.clamped};
 
@@ -99,26 +160,15 @@ LensProfile::Lookup LensProfile::projection_focal_length_mm(double zoom_counts,
   // length: breathing is a relative change of image scale, and the ratio
   // varies far more smoothly with zoom than the absolute value does.
   const Lookup f = focal_length_mm(zoom_counts);
-  const double z = std::clamp(zoom_counts, zoom_counts_.front(), zoom_counts_.back());
-  std::size_t k = std::size_t(std::upper_bound(zoom_counts_.begin(), zoom_counts_.end(), z) -
-                              zoom_counts_.begin());
-  k = std::clamp<std::size_t>(k, 1, zoom_counts_.size() - 1) - 1;
-  const double t = (z - zoom_counts_[k]) / (zoom_counts_[k + 1] - zoom_counts_[k]);
-  const ZoomPoint &a = zoom_points_[k], &b = zoom_points_[k + 1];
-  if (t == 0.0)
+  const ZoomSpan s = zoom_span(zoom_counts);
+  const ZoomPoint &a = zoom_points_[s.k], &b = zoom_points_[s.k + 1];
+  if (s.t == 0.0)
     return {projection_at_point(a, focus.y), f.clamped || focus.clamped};
-  if (t == 1.0)
+  if (s.t == 1.0)
     return {projection_at_point(b, focus.y), f.clamped || focus.clamped};
-  const double ratio = (1.0 - t) * projection_at_point(a, focus.y) / a.focal_length_mm +
-                       t * projection_at_point(b, focus.y) / b.focal_length_mm;
+  const double ratio = (1.0 - s.t) * projection_at_point(a, focus.y) / a.focal_length_mm +
+                       s.t * projection_at_point(b, focus.y) / b.focal_length_mm;
   return {f.value * ratio, f.clamped || focus.clamped};
-}
-
-double LensProfile::rest_counts_focus() const {
-  // The far end: the table end with the smaller diopter value.
-  const auto &xs = focus_diopters_.xs();
-  const auto &ys = focus_diopters_.ys();
-  return ys.front() <= ys.back() ? xs.front() : xs.back();
 }
 
 double LensProfile::rest_counts_iris() const {
@@ -128,7 +178,7 @@ double LensProfile::rest_counts_iris() const {
 }
 
 LensState LensProfile::evaluate(const LensCounts &counts) const {
-  const AxisReading rest_focus{rest_counts_focus(), 0, false};
+  const AxisReading rest_focus{0.0, 0, false}; // its value: rest_focus_diopters
   const AxisReading rest_iris{rest_counts_iris(), 0, false};
   const AxisReading rest_zoom{zoom_counts_.front(), 0, false};
   const AxisReading &fo = counts.focus ? *counts.focus : rest_focus;
@@ -143,14 +193,21 @@ LensState LensProfile::evaluate(const LensCounts &counts) const {
   };
   LensState s;
   s.calibrated = calibrated_;
-  s.focus_distance_m = measured(focus_distance_m(fo.counts), fo);
+  const MonotoneCurve::Result focus =
+      counts.focus ? focus_diopters(zo.counts, fo.counts) : rest_focus_diopters(zo.counts);
+  const Lookup focus_m{from_diopters(focus.y), focus.clamped};
+  // With per-zoom tables focus depends on zoom too: as old as the older
+  // reading, fresh only if both are (like the projection focal length).
+  s.focus_distance_m = has_per_zoom_focus() ? Measured{focus_m.value, std::min(fo.t_ns, zo.t_ns),
+                                                       fo.fresh && zo.fresh, focus_m.clamped}
+                                            : measured(focus_m, fo);
   s.f_number = measured(f_number(ir.counts), ir);
   if (const auto t = t_stop(ir.counts))
     s.t_stop = measured(*t, ir);
   s.focal_length_mm = measured(focal_length_mm(zo.counts), zo);
   s.entrance_pupil_offset_mm = measured(entrance_pupil_offset_mm(zo.counts), zo);
   // Depends on focus and zoom: as old as the older one, fresh only if both are.
-  const Lookup proj = projection_focal_length_mm(zo.counts, fo.counts);
+  const Lookup proj = projection_for_focus(zo.counts, focus);
   s.projection_focal_length_mm =
       Measured{proj.value, std::min(fo.t_ns, zo.t_ns), fo.fresh && zo.fresh, proj.clamped};
   s.distortion = distortion_;

@@ -4,6 +4,11 @@
 // problem found is thrown as ProfileError("FILE: FIELD: REASON"). A profile
 // that would make the renderer's focus run backwards between two calibration
 // marks is a configuration error, not something to smooth over.
+//
+// The version names the focus layout, one layout per version, so that an
+// older reader refuses what it cannot read instead of misreading it: version 1
+// has one top-level focus table, version 2 one table on every zoom point and
+// none at the top (README.md, "Profile format").
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -23,7 +28,8 @@ using Json = nlohmann::json;
 using Keys = std::initializer_list<std::string_view>;
 
 constexpr std::string_view kFormat = "camhead-lens-profile";
-constexpr std::int64_t kVersion = 1;
+constexpr std::int64_t kVersionOneFocus = 1;     // one top-level focus table
+constexpr std::int64_t kVersionPerZoomFocus = 2; // a focus table on every zoom point
 
 std::string child(const std::string &field, std::string_view key) {
   return field.empty() ? std::string(key) : field + "." + std::string(key);
@@ -58,13 +64,15 @@ public:
   explicit ProfileReader(std::string file) : file_(std::move(file)) {}
 
   LensProfile read(const Json &root) {
-    keys(root, "", {"format", "version", "name", "focus", "iris"},
-         {"description", "zoom", "prime", "distortion"});
+    keys(root, "", {"format", "version", "name", "iris"},
+         {"description", "focus", "zoom", "prime", "distortion"});
     if (!root.at("format").is_string() || root.at("format").get<std::string>() != kFormat)
       fail("format", "must be \"" + std::string(kFormat) + "\"");
     const Json &version = root.at("version");
-    if (!version.is_number_integer() || version.get<std::int64_t>() != kVersion)
-      fail("version", "unsupported version (this reader understands 1)");
+    if (!version.is_number_integer() || (version.get<std::int64_t>() != kVersionOneFocus &&
+                                         version.get<std::int64_t>() != kVersionPerZoomFocus))
+      fail("version", "unsupported version (this reader understands 1 and 2)");
+    per_zoom_focus_ = version.get<std::int64_t>() == kVersionPerZoomFocus;
     if (!root.at("name").is_string() || root.at("name").get<std::string>().empty())
       fail("name", "must be a non-empty string");
     if (root.contains("description") && !root.at("description").is_string())
@@ -72,13 +80,22 @@ public:
 
     LensProfile p;
     p.name_ = root.at("name").get<std::string>();
-    read_focus(root.at("focus"), p);
+    if (per_zoom_focus_ && root.contains("focus"))
+      fail("version", "2 means a focus table on every zoom point (zoom[i].focus) and no "
+                      "top-level focus; a profile with one focus table is version 1");
+    if (!per_zoom_focus_ && !root.contains("focus"))
+      fail("focus", "missing");
+    if (!per_zoom_focus_)
+      p.focus_diopters_ = read_focus(root.at("focus"), "focus");
     read_iris(root.at("iris"), p);
     const bool zoom = root.contains("zoom"), prime = root.contains("prime");
     if (zoom == prime)
       fail(zoom ? "prime" : "zoom", zoom
                                         ? "a profile has either zoom or prime, not both"
                                         : "missing (give zoom for a zoom lens, prime for a prime)");
+    if (per_zoom_focus_ && prime)
+      fail("version", "2 means per-zoom focus tables, which need a zoom table; a prime has "
+                      "one top-level focus table and is version 1");
     if (zoom)
       read_zoom(root.at("zoom"), p);
     else
@@ -174,16 +191,17 @@ private:
                                             " table must rise or fall throughout, no repeats)");
   }
 
-  void read_focus(const Json &t, LensProfile &p) const {
-    table(t, "focus");
+  // A focus table, top-level ("focus") or of one zoom point ("zoom[2].focus").
+  MonotoneCurve read_focus(const Json &t, const std::string &field) const {
+    table(t, field);
     for (std::size_t i = 0; i < t.size(); ++i)
-      keys(t[i], index("focus", i), {"counts", "distance_m"});
-    const std::vector<double> xs = count_column(t, "focus");
+      keys(t[i], index(field, i), {"counts", "distance_m"});
+    const std::vector<double> xs = count_column(t, field);
     std::vector<double> d;
     for (std::size_t i = 0; i < t.size(); ++i)
-      d.push_back(diopters(t[i].at("distance_m"), child(index("focus", i), "distance_m")));
-    require_monotone(d, "focus", "distance_m");
-    p.focus_diopters_ = MonotoneCurve(xs, d);
+      d.push_back(diopters(t[i].at("distance_m"), child(index(field, i), "distance_m")));
+    require_monotone(d, field, "distance_m");
+    return MonotoneCurve(xs, d);
   }
 
   void read_iris(const Json &t, LensProfile &p) const {
@@ -223,7 +241,7 @@ private:
                                          const LensProfile::ZoomPoint *first) const {
     if (in_table)
       keys(d, field, {"counts", "focal_length_mm"},
-           {"projection_focal_length_mm", "entrance_pupil_offset_mm"});
+           {"projection_focal_length_mm", "entrance_pupil_offset_mm", "focus"});
     else
       keys(d, field, {"focal_length_mm"},
            {"projection_focal_length_mm", "entrance_pupil_offset_mm"});
@@ -248,6 +266,16 @@ private:
         z.breathing = read_breathing(v, f);
       else
         z.projection_focal_length_mm = number(v, f, 0.0, 1e4, true);
+    }
+    if (in_table) {
+      const std::string f = child(field, "focus");
+      if (d.contains("focus") && !per_zoom_focus_)
+        fail(f, "per-zoom focus tables need \"version\": 2 (then one on every zoom point, and "
+                "no top-level focus)");
+      if (!d.contains("focus") && per_zoom_focus_)
+        fail(f, "missing (a version 2 profile gives a focus table on every zoom point)");
+      if (per_zoom_focus_)
+        z.focus = read_focus(d.at("focus"), f);
     }
     return z;
   }
@@ -286,8 +314,28 @@ private:
       pupil.push_back(z.entrance_pupil_offset_mm);
     }
     require_monotone(logf, "zoom", "focal_length_mm");
+    if (per_zoom_focus_)
+      require_same_direction(p.zoom_points_);
     p.log_focal_length_ = MonotoneCurve(p.zoom_counts_, logf);
     p.entrance_pupil_mm_ = MonotoneCurve(p.zoom_counts_, pupil);
+  }
+
+  // Blending two focus tables keeps the direction they share (lens_profile.cpp,
+  // focus_diopters); two tables of opposite directions would blend into a
+  // focus that runs backwards somewhere between their zoom points.
+  void require_same_direction(const std::vector<LensProfile::ZoomPoint> &zs) const {
+    const auto rising = [](const MonotoneCurve &c) { return c.ys().back() > c.ys().front(); };
+    const auto how = [](bool r) {
+      return std::string(r ? "distance falls as counts rise" : "distance rises as counts rise");
+    };
+    const bool first = rising(zs.front().focus);
+    for (std::size_t i = 1; i < zs.size(); ++i)
+      if (rising(zs[i].focus) != first)
+        fail(child(index("zoom", i), "focus"),
+             "runs the other way from zoom[0].focus (" + how(rising(zs[i].focus)) + " here, " +
+                 how(first) +
+                 " there): every zoom point's focus table must run the same way, or the "
+                 "blend between them would run backwards");
   }
 
   Distortion read_distortion(const Json &d, const std::string &field) const {
@@ -306,6 +354,7 @@ private:
   }
 
   std::string file_;
+  bool per_zoom_focus_ = false; // version 2
 };
 
 LensProfile LensProfile::parse(std::string_view json_text, const std::filesystem::path &source) {

@@ -4,6 +4,7 @@
 // that camhead and the Cycles references see the same scene.
 #include "camhead/renderer/compiled_scene.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -84,11 +85,14 @@ void add_quad(std::vector<gpu::Primitive> &out, const std::array<glm::vec3, 4> &
   add_triangle(out, q[0], q[2], q[3], bits);
 }
 
-void add_object(std::vector<gpu::Primitive> &out, const Object &o) {
+// `origin`: the compiled frame's zero (CompiledScene::origin), taken off the
+// translation before the vertices are formed, where float has the most bits.
+void add_object(std::vector<gpu::Primitive> &out, const Object &o, const glm::vec3 &origin) {
+  const glm::vec3 center = o.center - origin;
   switch (o.type) {
   case ShapeType::plane: {
     // XZ plane, normal +Y before rotation; size is (x, unused, z).
-    const Transform xf(o.center, o.rotation_deg, glm::vec3(o.size.x, 1.0f, o.size.z));
+    const Transform xf(center, o.rotation_deg, glm::vec3(o.size.x, 1.0f, o.size.z));
     add_quad(out,
              {xf({-0.5f, 0.0f, 0.5f}), xf({0.5f, 0.0f, 0.5f}), xf({0.5f, 0.0f, -0.5f}),
               xf({-0.5f, 0.0f, -0.5f})},
@@ -97,7 +101,7 @@ void add_object(std::vector<gpu::Primitive> &out, const Object &o) {
   }
   case ShapeType::box: {
     // Corner i has x, y, z = bits 2, 1, 0 of i; faces as add_object() lists them.
-    const Transform xf(o.center, o.rotation_deg, o.size);
+    const Transform xf(center, o.rotation_deg, o.size);
     std::array<glm::vec3, 8> v;
     for (int i = 0; i < 8; ++i)
       v[i] = xf(glm::vec3((i >> 2) & 1, (i >> 1) & 1, i & 1) - glm::vec3(0.5f));
@@ -110,13 +114,13 @@ void add_object(std::vector<gpu::Primitive> &out, const Object &o) {
   }
   case ShapeType::sphere:
     out.push_back(
-        gpu::Primitive{gpu::vec4(o.center, glm::uintBitsToFloat(primitive_bits(o, PRIM_SPHERE))),
+        gpu::Primitive{gpu::vec4(center, glm::uintBitsToFloat(primitive_bits(o, PRIM_SPHERE))),
                        gpu::vec4(o.radius, 0.0f, 0.0f, 0.0f), gpu::vec4(0.0f)});
     break;
   case ShapeType::mesh: {
     if (!o.mesh)
       throw std::invalid_argument("object " + o.name + ": mesh not loaded");
-    const Transform xf(o.center, o.rotation_deg, glm::vec3(o.scale));
+    const Transform xf(center, o.rotation_deg, glm::vec3(o.scale));
     const TriangleMesh &m = *o.mesh;
     std::vector<glm::vec3> world;
     world.reserve(m.positions.size());
@@ -154,11 +158,11 @@ gpu::Material compile_material(const Material &m) {
                        gpu::vec4(m.ior, 0.0f, 0.0f, glm::uintBitsToFloat(type))};
 }
 
-gpu::Light compile_light(const Light &l) {
+gpu::Light compile_light(const Light &l, const glm::vec3 &origin) {
   gpu::Light g{};
   switch (l.type) {
   case LightType::point:
-    g.position = gpu::vec4(l.position, glm::uintBitsToFloat(LIGHT_POINT));
+    g.position = gpu::vec4(l.position - origin, glm::uintBitsToFloat(LIGHT_POINT));
     g.emission = gpu::vec4(l.color * (l.power_W / (4.0f * kPi)), 0.0f);
     break;
   case LightType::area: {
@@ -169,7 +173,7 @@ gpu::Light compile_light(const Light &l) {
     const glm::vec3 u = glm::normalize(glm::cross(n, a));
     const glm::vec3 v = glm::cross(u, n);
     const float area = l.size.x * l.size.y;
-    g.position = gpu::vec4(l.position, glm::uintBitsToFloat(LIGHT_AREA));
+    g.position = gpu::vec4(l.position - origin, glm::uintBitsToFloat(LIGHT_AREA));
     g.emission = gpu::vec4(l.color * (l.power_W / (4.0f * area)), 0.0f);
     g.axis_u = gpu::vec4(u * l.size.x, area);
     g.axis_v = gpu::vec4(v * l.size.y, 0.0f);
@@ -206,16 +210,21 @@ std::vector<glm::vec4> compile_plate(const Scene &scene) {
 
 CompiledScene compile_scene(const Scene &scene) {
   CompiledScene out;
+  // Far from the world origin a float coordinate of the scene has lost most
+  // of its bits, and the kernel's ray offsets (CAMHEAD_RAY_EPSILON) grow with
+  // it: at 1 km they lift shadow rays 10 cm off the surface.
+  constexpr float kOriginGridM = 64.0f;
+  out.origin = glm::round(scene.camera.position / kOriginGridM) * kOriginGridM;
   std::vector<gpu::Primitive> prims;
   for (const Object &o : scene.objects)
-    add_object(prims, o);
+    add_object(prims, o, out.origin);
   Bvh bvh = build_bvh(std::move(prims));
   out.primitives = std::move(bvh.primitives);
   out.nodes = std::move(bvh.nodes);
   for (const Material &m : scene.materials)
     out.materials.push_back(compile_material(m));
   for (const Light &l : scene.lights)
-    out.lights.push_back(compile_light(l));
+    out.lights.push_back(compile_light(l, out.origin));
   if (scene.plate)
     out.plate = compile_plate(scene);
   out.width = scene.render.width;
@@ -235,7 +244,13 @@ gpu::FrameParams make_frame_params(const Scene &scene, int samples) {
   const float aperture_radius = cam.f_number > 0.0f ? f_m / (2.0f * cam.f_number) : 0.0f;
   // A pinhole ignores the focal depth; a positive stand-in keeps any code
   // that forms the focal point (I = O + d d_f / cos) off the degenerate I = O.
-  const float focus = cam.focus_distance_m > 0.0f ? cam.focus_distance_m : 1.0f;
+  // Focus at infinity (lens_control reports +inf) and beyond the scene
+  // loader's limit is put at that limit: an infinite focal point makes every
+  // lens ray NaN (a blank frame), and at 1e6 m the lens rays are parallel to
+  // the pinhole ray to within a micro-radian.
+  constexpr float kFarthestFocusM = 1e6f;
+  const float focus = cam.focus_distance_m > 0.0f ? std::min(cam.focus_distance_m, kFarthestFocusM)
+                                                  : 1.0f; // also NaN
   // Cycles' projection: magnification set by the focal length alone.
   const float focal_px = cam.focal_length_mm * float(r.width) / cam.sensor_width_mm;
 

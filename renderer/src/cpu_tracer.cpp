@@ -49,6 +49,7 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
   kernel.materials = scene.materials.empty() ? &placeholder_material : scene.materials.data();
   kernel.lights = scene.lights.data();
   kernel.frame = frame;
+  kernel.frame.cam_position -= glm::vec4(scene.origin, 0.0f); // into the compiled frame
   kernel.frame.sampling.x = 0;
   kernel.frame.sampling.y = total;
 

@@ -166,7 +166,8 @@ struct GpuTracer::Impl {
   std::uint32_t width = 0;
   std::uint32_t height = 0;
   bool has_plate = false;
-  gpu::uvec4 counts{}; // primitives, nodes, lights
+  gpu::uvec4 counts{};    // primitives, nodes, lights
+  glm::vec3 origin{0.0f}; // CompiledScene::origin of the loaded scene
 };
 
 GpuTracer::Impl::Impl(const std::string &wanted)
@@ -254,6 +255,7 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   height = std::uint32_t(scene.height);
   has_plate = !scene.plate.empty();
   counts = gpu::uvec4(scene.primitives.size(), scene.nodes.size(), scene.lights.size(), 0);
+  origin = scene.origin;
   loaded = true;
 }
 
@@ -282,6 +284,7 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   // The kernels index the buffers with these, so they come from what load()
   // uploaded: a stale or hand-made FrameParams must not read out of bounds.
   gpu::FrameParams frame = requested;
+  frame.cam_position -= gpu::vec4(origin, 0.0f); // into the compiled scene's frame
   frame.image.z = requested.image.z != 0 && has_plate ? 1u : 0u;
   frame.image.w = counts.z;
 

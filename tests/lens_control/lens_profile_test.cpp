@@ -177,6 +177,40 @@ TEST(LensProfile, ZoomLensReversedFocusAndBreathingBlend) {
   EXPECT_TRUE(p.projection_focal_length_mm(9000, 100).clamped);
 }
 
+TEST(LensProfile, Version1LookupsAreBitIdenticalToBeforePerZoomFocus) {
+  // Values printed (%a) by the lookups as they were before per-zoom focus
+  // tables (format version 2) were added: a version 1 profile must not move
+  // by a single bit. Only lookups made of + - * / (no exp or log), so that the
+  // figures do not depend on the C library's rounding.
+  const LensProfile p = LensProfile::load(kExample);
+  const struct {
+    double counts, distance, projection;
+    bool clamped;
+  } prime[] = {
+      {-50, 0x1.3333333333333p-2, 0x1.3733333333333p+5, true},
+      {1234.5, 0x1.68790e1b9869ap-2, 0x1.326eac3c5e53p+5, false},
+      {7777, 0x1.3d838ce309586p+0, 0x1.1f930a7255952p+5, false},
+      {13600.25, 0x1.400cb1b7d0a03p+4, 0x1.187b37b5008cp+5, false},
+      {16382, 0x1.b2f4fddb51249p+15, 0x1.18000b4ce9abcp+5, false},
+      {17000, kInf, 0x1.18p+5, true},
+  };
+  for (const auto &c : prime) {
+    EXPECT_EQ(p.focus_distance_m(c.counts).value, c.distance) << c.counts;
+    EXPECT_EQ(p.focus_distance_m(c.counts).clamped, c.clamped) << c.counts;
+    EXPECT_EQ(p.projection_focal_length_mm(0, c.counts).value, c.projection) << c.counts;
+  }
+  const LensProfile z = parse(zoom_lens());
+  EXPECT_EQ(z.focus_distance_m(640.5).value, 0x1.1c2e6a9167f68p+2);
+  EXPECT_EQ(z.focus_distance_m(4321).value, 0x1.0faa1531b31fep-1);
+  EXPECT_EQ(z.focus_distance_m(6000).value, 0x1.cccccccccccccp-2);
+  // Whatever the zoom: one focus table.
+  EXPECT_EQ(z.focus_distance_m(1750, 4321).value, 0x1.0faa1531b31fep-1);
+  EXPECT_FALSE(z.focus_distance_m(9000, 4321).clamped);
+  EXPECT_EQ(z.projection_focal_length_mm(0, 640.5).value, 0x1.7e8a6809d4951p+4);
+  EXPECT_EQ(z.projection_focal_length_mm(2500, 4321).value, 0x1.a42f6dfdb7521p+5);
+  EXPECT_FALSE(z.has_per_zoom_focus());
+}
+
 TEST(LensProfile, EvaluateCarriesTimestampsFreshnessAndRestValues) {
   const LensProfile p = parse(zoom_lens());
   LensCounts c;

@@ -40,11 +40,27 @@ Json zoom_base() {
   return j;
 }
 
+// The same zoom with a focus table per zoom point (format version 2), each
+// the example's table shifted by 100 counts per zoom point.
+Json per_zoom_base() {
+  Json j = zoom_base();
+  j["version"] = 2;
+  for (std::size_t i = 0; i < j["zoom"].size(); ++i) {
+    j["zoom"][i]["focus"] = j["focus"];
+    for (Json &pt : j["zoom"][i]["focus"])
+      pt["counts"] = pt["counts"].get<int>() + 100 * int(i);
+  }
+  j.erase("focus");
+  return j;
+}
+
+enum class Base { prime, zoom, per_zoom };
+
 struct BadCase {
   const char *what;
   std::function<void(Json &)> edit;
   const char *field;
-  bool zoom = false;
+  Base base = Base::prime;
 };
 
 const std::vector<BadCase> kCases = {
@@ -52,7 +68,8 @@ const std::vector<BadCase> kCases = {
     {"missing format", [](Json &j) { j.erase("format"); }, "format"},
     {"wrong format", [](Json &j) { j["format"] = "camhead-scene"; }, "format"},
     {"format not a string", [](Json &j) { j["format"] = 1; }, "format"},
-    {"version 2", [](Json &j) { j["version"] = 2; }, "version"},
+    {"version 2 with a top-level focus", [](Json &j) { j["version"] = 2; }, "version"},
+    {"version 3", [](Json &j) { j["version"] = 3; }, "version"},
     {"version as string", [](Json &j) { j["version"] = "1"; }, "version"},
     {"version as float", [](Json &j) { j["version"] = 1.0; }, "version"},
     {"empty name", [](Json &j) { j["name"] = ""; }, "name"},
@@ -144,20 +161,56 @@ const std::vector<BadCase> kCases = {
      [](Json &j) { j["prime"]["projection_focal_length_mm"][0]["counts"] = 3; },
      "prime.projection_focal_length_mm[0].counts"},
     // Zoom table.
-    {"zoom with one point", [](Json &j) { j["zoom"] = Json::array({j["zoom"][0]}); }, "zoom", true},
-    {"zoom counts missing", [](Json &j) { j["zoom"][1].erase("counts"); }, "zoom[1].counts", true},
+    {"zoom with one point", [](Json &j) { j["zoom"] = Json::array({j["zoom"][0]}); }, "zoom",
+     Base::zoom},
+    {"zoom counts missing", [](Json &j) { j["zoom"][1].erase("counts"); }, "zoom[1].counts",
+     Base::zoom},
     {"zoom counts not increasing", [](Json &j) { j["zoom"][2]["counts"] = 500; }, "zoom[2].counts",
-     true},
+     Base::zoom},
     {"zoom focal length not monotone", [](Json &j) { j["zoom"][2]["focal_length_mm"] = 40; },
-     "zoom[2].focal_length_mm", true},
+     "zoom[2].focal_length_mm", Base::zoom},
     {"zoom focal length repeated", [](Json &j) { j["zoom"][1]["focal_length_mm"] = 24; },
-     "zoom[1].focal_length_mm", true},
+     "zoom[1].focal_length_mm", Base::zoom},
     {"zoom pupil on some points only",
      [](Json &j) { j["zoom"][2].erase("entrance_pupil_offset_mm"); },
-     "zoom[2].entrance_pupil_offset_mm", true},
+     "zoom[2].entrance_pupil_offset_mm", Base::zoom},
     {"zoom projection on some points only",
      [](Json &j) { j["zoom"][1]["projection_focal_length_mm"] = 50.1; },
-     "zoom[1].projection_focal_length_mm", true},
+     "zoom[1].projection_focal_length_mm", Base::zoom},
+    // Per-zoom focus tables (version 2).
+    {"version 1 zoom point with a focus table", [](Json &j) { j["zoom"][1]["focus"] = j["focus"]; },
+     "zoom[1].focus", Base::zoom},
+    {"version 2 with a top-level focus too", [](Json &j) { j["focus"] = example()["focus"]; },
+     "version", Base::per_zoom},
+    {"version 2 prime",
+     [](Json &j) {
+       j["version"] = 2;
+       j.erase("focus");
+     },
+     "version"},
+    {"version 2 zoom point without focus", [](Json &j) { j["zoom"][2].erase("focus"); },
+     "zoom[2].focus", Base::per_zoom},
+    {"version 2 focus not an array", [](Json &j) { j["zoom"][0]["focus"] = 3; }, "zoom[0].focus",
+     Base::per_zoom},
+    {"version 2 focus with one point",
+     [](Json &j) { j["zoom"][1]["focus"] = Json::array({j["zoom"][1]["focus"][0]}); },
+     "zoom[1].focus", Base::per_zoom},
+    {"version 2 focus counts not increasing",
+     [](Json &j) { j["zoom"][2]["focus"][3]["counts"] = 100; }, "zoom[2].focus[3].counts",
+     Base::per_zoom},
+    {"version 2 focus distance turns back",
+     [](Json &j) { j["zoom"][1]["focus"][5]["distance_m"] = 1.5; }, "zoom[1].focus[5].distance_m",
+     Base::per_zoom},
+    {"version 2 focus unknown field", [](Json &j) { j["zoom"][0]["focus"][1]["f_number"] = 2; },
+     "zoom[0].focus[1].f_number", Base::per_zoom},
+    {"version 2 focus tables of opposite directions",
+     [](Json &j) {
+       Json &t = j["zoom"][2]["focus"];
+       const Json d = t;
+       for (std::size_t i = 0; i < t.size(); ++i)
+         t[i]["distance_m"] = d[t.size() - 1 - i]["distance_m"];
+     },
+     "zoom[2].focus", Base::per_zoom},
     // Distortion.
     {"distortion not an object",
      [](Json &j) {
@@ -173,7 +226,9 @@ const std::vector<BadCase> kCases = {
 
 TEST(ProfileErrors, EachRuleNamesFileAndField) {
   for (const BadCase &c : kCases) {
-    Json j = c.zoom ? zoom_base() : example();
+    Json j = c.base == Base::zoom       ? zoom_base()
+             : c.base == Base::per_zoom ? per_zoom_base()
+                                        : example();
     c.edit(j);
     try {
       (void)LensProfile::parse(j.dump(), kSource);
@@ -192,6 +247,25 @@ TEST(ProfileErrors, EachRuleNamesFileAndField) {
 TEST(ProfileErrors, BaseProfilesAreValid) {
   EXPECT_NO_THROW((void)LensProfile::parse(example().dump(), kSource));
   EXPECT_NO_THROW((void)LensProfile::parse(zoom_base().dump(), kSource));
+  EXPECT_NO_THROW((void)LensProfile::parse(per_zoom_base().dump(), kSource));
+}
+
+TEST(ProfileErrors, OppositeFocusDirectionsAreExplained) {
+  Json j = per_zoom_base();
+  Json &t = j["zoom"][1]["focus"];
+  const Json d = t;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    t[i]["distance_m"] = d[t.size() - 1 - i]["distance_m"];
+  try {
+    (void)LensProfile::parse(j.dump(), kSource);
+    FAIL() << "accepted";
+  } catch (const ProfileError &e) {
+    EXPECT_STREQ(e.what(),
+                 "/virtual/bad_lens.json: zoom[1].focus: runs the other way from zoom[0].focus "
+                 "(distance falls as counts rise here, distance rises as counts rise there): "
+                 "every zoom point's focus table must run the same way, or the blend between "
+                 "them would run backwards");
+  }
 }
 
 TEST(ProfileErrors, SyntaxErrorsAndMissingFiles) {

@@ -59,7 +59,10 @@ struct Measurement {
   std::int32_t counts = 0;
   double value = 0.0;
   std::optional<double> t_stop; // iris rows, when the file has T-stops
-  int line = 0;                 // 1-based line in the CSV, for messages
+  // Focus rows, when the file has a zoom_counts column: the zoom encoder
+  // counts the mark was measured at (per-zoom focus tables).
+  std::optional<std::int32_t> zoom_counts;
+  int line = 0; // 1-based line in the CSV, for messages
 };
 
 struct MeasurementSet {
@@ -98,8 +101,13 @@ struct CalibrationOptions {
 
 struct Calibration {
   std::string source;
+  // With per-zoom focus, `focus` only counts all focus measurements (no
+  // points); the tables are in zoom_focus.
   AxisFit focus, iris, zoom;
   bool prime = false;
+  // Per-zoom focus tables (profile format version 2), one per zoom.points
+  // entry, when the focus rows give zoom_counts; empty otherwise.
+  std::vector<AxisFit> zoom_focus;
 };
 
 // Averages repeats at equal counts in the linearising space, then pools
@@ -108,10 +116,16 @@ struct Calibration {
 // their counts, so a point pooled for either is pooled for both. Throws
 // CalibrationError when an axis has no measurements or keeps fewer than 2
 // points (exactly 1 zoom point, at one counts value, with options.prime).
+// When the focus rows give zoom_counts, each must be the counts of a zoom row,
+// and the focus rows at each fitted zoom point (a point the monotone fit
+// pooled from several zoom marks takes the focus rows of all of them) are
+// fitted as that point's own table; every zoom point needs one, and all must
+// run the same way (the profile reader's rule for per-zoom focus tables).
 [[nodiscard]] Calibration fit_calibration(const MeasurementSet &measurements,
                                           const CalibrationOptions &options);
 
-// Profile JSON (format version 1) of a fit; LensProfile::parse reads it.
+// Profile JSON of a fit: format version 1, or version 2 with a focus table on
+// every zoom point when the fit has per-zoom focus. LensProfile::parse reads it.
 [[nodiscard]] std::string profile_json(const Calibration &fit, const CalibrationOptions &options);
 
 // Residuals of the measurements against a profile, measured minus profile,
@@ -126,8 +140,10 @@ struct Residuals {
 
 // Focus in diopters (all rows) and in metres (near end only: measured
 // distances up to twice the closest one, where a metre is a meaningful unit;
-// further out the same focus error grows as distance squared), iris f-number
-// and T-stop in stops, zoom in mm.
+// further out the same focus error grows as distance squared), then, when the
+// focus rows give zoom_counts, focus in diopters per measured zoom counts
+// (each row evaluated at its own zoom), iris f-number and T-stop in stops,
+// zoom in mm.
 [[nodiscard]] std::vector<Residuals> compute_residuals(const MeasurementSet &measurements,
                                                        const LensProfile &profile);
 

@@ -8,14 +8,20 @@
 //   iris, T-stop stops, 2*log2(N)
 //   focal length log(f)
 // Focus breathing (projection focal length) is a table over focus distance
-// (in diopters) per zoom calibration point, blended linearly between the two
-// zoom points around the current zoom. The focus table itself is one table for
-// all zoom positions (see README.md, "Limits").
+// (in diopters) per zoom calibration point, blended linearly in zoom counts
+// between the two zoom points around the current zoom. The focus table is
+// either one table for all zoom positions (format version 1) or, on a zoom
+// whose focus scale shifts with focal length, one table per zoom point
+// (version 2): the focus counts go through the two tables around the current
+// zoom and their diopters are blended with the same weight as breathing.
+// Tables that all run the same way (profile_reader checks) blend into a curve
+// that runs that way too, so the focus never runs backwards at any zoom.
 //
 // Thread safety: immutable after construction; any thread may call const
 // members concurrently.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -64,8 +70,16 @@ public:
   [[nodiscard]] bool calibrated() const { return calibrated_; }
   [[nodiscard]] bool has_t_stop() const { return !t_stop_stops_.empty(); }
   [[nodiscard]] bool is_zoom() const { return zoom_counts_.size() > 1; }
+  // One focus table per zoom point (format version 2) rather than one for all.
+  [[nodiscard]] bool has_per_zoom_focus() const { return !zoom_points_.front().focus.empty(); }
 
   // Single lookups, for tests and calibration tools.
+  // Focus at a zoom position. With per-zoom focus tables, `clamped` is also
+  // set when the zoom is outside its calibrated range (the end table is used),
+  // as for projection_focal_length_mm.
+  [[nodiscard]] Lookup focus_distance_m(double zoom_counts, double focus_counts) const;
+  // Focus at the first zoom point: the whole lens for a profile with one
+  // focus table; with per-zoom tables, use the form above.
   [[nodiscard]] Lookup focus_distance_m(double focus_counts) const;
   [[nodiscard]] Lookup f_number(double iris_counts) const;
   [[nodiscard]] std::optional<Lookup> t_stop(double iris_counts) const;
@@ -75,8 +89,10 @@ public:
   [[nodiscard]] const std::optional<Distortion> &distortion() const { return distortion_; }
 
   // The full lens state for aligned counts. An axis without a reading takes
-  // the lens's rest value, not fresh: focus at the far end of the table, iris
-  // wide open, zoom at its first calibration point.
+  // the lens's rest value, not fresh: focus at the far end of the table (of
+  // each table, at the current zoom), iris wide open, zoom at its first
+  // calibration point. With per-zoom focus tables the focus distance depends
+  // on zoom too: as old as the older reading, fresh only if both are.
   [[nodiscard]] LensState evaluate(const LensCounts &counts) const;
 
 private:
@@ -90,15 +106,33 @@ private:
     MonotoneCurve breathing;
     std::optional<double> projection_focal_length_mm; // when given as one value
     bool has_pupil = false, has_projection = false;   // as given in the file
+    // Focus counts -> 1/m at this zoom (version 2); empty = the one
+    // focus_diopters_ table serves every zoom.
+    MonotoneCurve focus;
   };
 
-  [[nodiscard]] double rest_counts_focus() const;
+  // The two zoom points around a zoom position and the blending weight of the
+  // second: zoom_points_[k] * (1 - t) + zoom_points_[k + 1] * t. Linear in
+  // zoom counts; t is exactly 0 or 1 at a calibration point and at or beyond
+  // the ends. For a prime, k = 0 and t = 0.
+  struct ZoomSpan {
+    std::size_t k = 0;
+    double t = 0.0;
+    bool clamped = false; // zoom counts outside the zoom table
+  };
+  [[nodiscard]] ZoomSpan zoom_span(double zoom_counts) const;
+
+  // Focus in diopters at a zoom position, and the far end of the focus range
+  // there (the rest value without a focus reading, never clamped).
+  [[nodiscard]] MonotoneCurve::Result focus_diopters(double zoom_counts, double focus_counts) const;
+  [[nodiscard]] MonotoneCurve::Result rest_focus_diopters(double zoom_counts) const;
+  [[nodiscard]] Lookup projection_for_focus(double zoom_counts, MonotoneCurve::Result focus) const;
   [[nodiscard]] double rest_counts_iris() const;
   [[nodiscard]] double projection_at_point(const ZoomPoint &z, double diopters) const;
 
   std::string name_;
   bool calibrated_ = true;
-  MonotoneCurve focus_diopters_;            // counts -> 1/m
+  MonotoneCurve focus_diopters_;            // counts -> 1/m; empty with per-zoom focus
   MonotoneCurve iris_stops_, t_stop_stops_; // counts -> 2*log2(N)
   std::vector<double> zoom_counts_;         // one entry for a prime
   std::vector<ZoomPoint> zoom_points_;

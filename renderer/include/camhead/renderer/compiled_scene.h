@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 #include "camhead/renderer/gpu_layout.h"
@@ -20,6 +21,12 @@ struct CompiledScene {
   std::vector<glm::vec4> plate; // width x height, rgb; empty when the scene has none
   int width = 0;
   int height = 0;
+  // The world point that primitives and lights are stored relative to: the
+  // camera position rounded to a multiple of 64 m, so that a scene far from
+  // the world origin keeps float precision (and small ray offsets) near the
+  // camera, and a scene near it compiles exactly as given. FrameParams stay in
+  // world coordinates; the tracers subtract this from cam_position.
+  glm::vec3 origin{0.0f};
 };
 
 // Flattens the objects (planes and boxes into triangles, meshes transformed
@@ -27,7 +34,9 @@ struct CompiledScene {
 [[nodiscard]] CompiledScene compile_scene(const Scene &scene);
 
 // Frame parameters from the scene's camera and settings; samples <= 0 takes
-// the scene's `render.samples`. The sample range covers all samples.
+// the scene's `render.samples`. The sample range covers all samples. A focus
+// distance beyond 1e6 m, +infinity included, is focus at 1e6 m (the scene
+// loader's limit); one that is not > 0 (or NaN) is a 1 m stand-in.
 [[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, int samples = 0);
 
 } // namespace camhead::renderer

@@ -1,0 +1,53 @@
+// The chart's drawing and CSV (pipeline/chart_plot.h): every label the chart
+// writes has glyphs, series land in their colours, CSV fields are quoted.
+#include <string>
+#include <vector>
+
+#include "chart_plot.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::cli::chart {
+namespace {
+
+TEST(ChartPlot, FontCoversTheChartsText) {
+  for (const std::string s :
+       {"frame time (ms)", "relative RMSE", "pinhole+gather", "uniform", "1e-05", "0.001",
+        "depth edges (12% of pixels, 8 px)", "ar_basic 720x576, NVIDIA H100: labels/rpp"})
+    for (char c : s)
+      EXPECT_TRUE(font_has(c)) << "'" << c << "' in " << s;
+}
+
+TEST(ChartPlot, DrawsSeriesAxesAndLegend) {
+  Panel panel;
+  panel.title = "all pixels";
+  panel.x_label = "frame time (ms)";
+  panel.y_label = "relative RMSE";
+  const Rgb red{214, 39, 40}, blue{31, 119, 180};
+  panel.series.push_back({"a", red, Marker::square, {1.0, 10.0, 100.0}, {0.1, 0.03, 0.01}, {}});
+  panel.series.push_back({"b", blue, Marker::circle, {2.0, 0.0}, {0.2, 0.1}, {"1", "2"}});
+  const std::vector<Panel> panels = {panel, panel};
+  const Canvas canvas = plot_log_log("title", panels, 320, 240);
+  EXPECT_EQ(canvas.width, 640);
+  EXPECT_GT(canvas.height, 240);
+  ASSERT_EQ(canvas.rgb.size(), std::size_t(canvas.width) * canvas.height * 3);
+  int reds = 0, blues = 0, blacks = 0;
+  for (int y = 0; y < canvas.height; ++y)
+    for (int x = 0; x < canvas.width; ++x) {
+      const Rgb p = canvas.pixel(x, y);
+      reds += p == red;
+      blues += p == blue;
+      blacks += p == Rgb{0, 0, 0};
+    }
+  EXPECT_GT(reds, 200);    // lines and markers in both panels
+  EXPECT_GT(blues, 40);    // one valid point (x = 0 has no log) and its legend entry
+  EXPECT_GT(blacks, 2000); // axes, ticks, text
+}
+
+TEST(ChartPlot, CsvQuotesWhereNeeded) {
+  const std::vector<std::string> fields = {"plain", "a,b", "say \"hi\"", ""};
+  EXPECT_EQ(csv_row(fields), "plain,\"a,b\",\"say \"\"hi\"\"\",");
+}
+
+} // namespace
+} // namespace camhead::cli::chart
