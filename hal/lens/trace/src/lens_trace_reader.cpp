@@ -178,12 +178,7 @@ private:
         dot == std::string_view::npos ? std::string_view{} : v.substr(dot + 1);
     if (whole.empty() || !all_digits(whole) || !all_digits(fraction) ||
         (dot != std::string_view::npos && fraction.empty())) {
-      // Appended, not `"\"" + std::string(v) + ...`: GCC 12 at -O3 reports a
-      // false -Wrestrict overlap in that concatenation.
-      std::string message = "\"";
-      message += v;
-      message += "\" is not a decimal number of seconds (e.g. 0.01)";
-      fail("t_s", message);
+      fail("t_s", "\"" + std::string(v) + "\" is not a decimal number of seconds (e.g. 0.01)");
     }
     if (whole.size() > kMaxSecondDigits) {
       fail("t_s", "too large (at most " + std::to_string(kMaxSecondDigits) + " digits of seconds)");
