@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "stability_support.h"
+#include "test_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -47,9 +48,8 @@ struct Measured {
 };
 
 Measured measure(const RenderResult &r) {
-  return {stability::row_average(r.mask), stability::row_average(r.mixed),
-          stability::row_average(r.real), stability::row_average(r.depth),
-          stability::row_average(r.composite)};
+  return {test::row_average(r.mask), test::row_average(r.mixed), test::row_average(r.real),
+          test::row_average(r.depth), test::row_average(r.composite)};
 }
 
 double max_abs_diff(const std::vector<double> &a, const std::vector<double> &b) {

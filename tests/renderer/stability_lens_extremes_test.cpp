@@ -55,7 +55,7 @@ void check_blur(const std::vector<LensCase> &cases, bool gpu) {
     const RenderResult r = gpu ? test::render_gpu(scene, 256) : test::render_cpu(scene, 256);
     ASSERT_TRUE(all_layers_finite(r)) << c.what;
     const double expected = expected_coc(scene, c.depth_m);
-    const double measured = stability::measured_blur_diameter(stability::row_average(r.composite));
+    const double measured = test::measured_blur_diameter(test::row_average(r.composite));
     const double tolerance = std::max(0.25, 0.02 * expected);
     std::printf("%-26s f/%-5.2f focus %8.3f m, edge %6.3f m: CoC formula %7.3f px, measured "
                 "%7.3f px (%s)\n",

@@ -194,38 +194,6 @@ template <typename F> double pixel_average(int i, F f, int steps = 256) {
   return sum / double(steps);
 }
 
-// Mean over the rows of channel c: the profile of an image of vertical edges.
-inline std::vector<double> row_average(const renderer::Image &image, int c = 0) {
-  std::vector<double> profile(image.width, 0.0);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      profile[x] += image.at(x, y)[c] / image.height;
-    }
-  }
-  return profile;
-}
-
-// Blur diameter from the edge profile of a uniform disk (as thin_lens_test.cpp
-// measures it): the differences of the profile are the disk's line spread
-// function (variance D^2/16) convolved with a triangle of variance 1/6.
-inline double measured_blur_diameter(const std::vector<double> &profile) {
-  double sum = 0.0;
-  double mean = 0.0;
-  for (std::size_t i = 0; i + 1 < profile.size(); ++i) {
-    const double lsf = profile[i + 1] - profile[i];
-    sum += lsf;
-    mean += lsf * double(i + 1);
-  }
-  mean /= sum;
-  double variance = 0.0;
-  for (std::size_t i = 0; i + 1 < profile.size(); ++i) {
-    const double lsf = profile[i + 1] - profile[i];
-    variance += lsf * (double(i + 1) - mean) * (double(i + 1) - mean);
-  }
-  variance = variance / sum - 1.0 / 6.0;
-  return 4.0 * std::sqrt(std::max(variance, 0.0));
-}
-
 // Mean absolute difference over all samples of two images of one size.
 inline double mean_abs_diff(const renderer::Image &a, const renderer::Image &b) {
   double sum = 0.0;

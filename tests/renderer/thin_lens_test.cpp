@@ -15,39 +15,6 @@
 namespace camhead {
 namespace {
 
-// Mean of the rows of a 3-channel image, red channel: the edge profile.
-std::vector<double> row_average(const renderer::Image &image) {
-  std::vector<double> profile(image.width, 0.0);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      profile[x] += image.at(x, y)[0] / image.height;
-    }
-  }
-  return profile;
-}
-
-// Blur diameter from the edge profile of a uniform disk. The differences of
-// the pixel values are the line spread function of the disk (variance D^2/16)
-// convolved with the pixel box filter twice over, i.e. with a triangle of
-// half-width 1 px (variance 1/6): D = 4 sqrt(var - 1/6).
-double measured_blur_diameter(const std::vector<double> &profile) {
-  double sum = 0.0;
-  double mean = 0.0;
-  for (std::size_t i = 0; i + 1 < profile.size(); ++i) {
-    const double lsf = profile[i + 1] - profile[i];
-    sum += lsf;
-    mean += lsf * double(i + 1);
-  }
-  mean /= sum;
-  double variance = 0.0;
-  for (std::size_t i = 0; i + 1 < profile.size(); ++i) {
-    const double lsf = profile[i + 1] - profile[i];
-    variance += lsf * (double(i + 1) - mean) * (double(i + 1) - mean);
-  }
-  variance = variance / sum - 1.0 / 6.0;
-  return 4.0 * std::sqrt(std::max(variance, 0.0));
-}
-
 struct LensCase {
   float f_number;
   float focus_m;
@@ -63,7 +30,7 @@ TEST_P(BlurCircle, DiameterMatchesThinLensFormula) {
   const renderer::RenderResult result = test::render_gpu(scene, 256);
   ASSERT_TRUE(test::all_finite(result.composite));
   const double expected = test::coc_px(scene, c.depth_m);
-  const double measured = measured_blur_diameter(row_average(result.composite));
+  const double measured = test::measured_blur_diameter(test::row_average(result.composite));
   std::printf("f/%.1f focus %.2f m, edge at %.2f m: CoC formula %.3f px, measured %.3f px\n",
               c.f_number, c.focus_m, c.depth_m, expected, measured);
   EXPECT_NEAR(measured, expected, 0.25);
@@ -128,7 +95,7 @@ TEST(ThinLens, PinholeKeepsEveryDepthSharp) {
   for (float depth : {0.3f, 1.0f, 50.0f}) {
     const renderer::Scene scene = test::edge_scene(0.0f, 1.0f, depth);
     const double measured =
-        measured_blur_diameter(row_average(test::render_gpu(scene, 64).composite));
+        test::measured_blur_diameter(test::row_average(test::render_gpu(scene, 64).composite));
     EXPECT_NEAR(measured, 0.0, 0.25) << "edge at " << depth << " m";
   }
 }

@@ -1,5 +1,6 @@
 #include "test_scenes.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -50,6 +51,34 @@ glm::vec2 project(const renderer::Scene &scene, glm::vec3 world) {
   const float z = glm::dot(d, forward);
   return {0.5f * float(scene.render.width) + f_px * glm::dot(d, right) / z,
           0.5f * float(scene.render.height) - f_px * glm::dot(d, up) / z};
+}
+
+std::vector<double> row_average(const renderer::Image &image, int c) {
+  std::vector<double> profile(image.width, 0.0);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      profile[x] += image.at(x, y)[c] / image.height;
+    }
+  }
+  return profile;
+}
+
+double measured_blur_diameter(const std::vector<double> &profile) {
+  double sum = 0.0;
+  double mean = 0.0;
+  for (std::size_t i = 0; i + 1 < profile.size(); ++i) {
+    const double lsf = profile[i + 1] - profile[i];
+    sum += lsf;
+    mean += lsf * double(i + 1);
+  }
+  mean /= sum;
+  double variance = 0.0;
+  for (std::size_t i = 0; i + 1 < profile.size(); ++i) {
+    const double lsf = profile[i + 1] - profile[i];
+    variance += lsf * (double(i + 1) - mean) * (double(i + 1) - mean);
+  }
+  variance = variance / sum - 1.0 / 6.0;
+  return 4.0 * std::sqrt(std::max(variance, 0.0));
 }
 
 } // namespace camhead::test

@@ -1,9 +1,12 @@
 // Small scenes built in code for the physics tests.
 #pragma once
 
+#include <vector>
+
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "camhead/renderer/image.h"
 #include "camhead/renderer/scene.h"
 
 namespace camhead::test {
@@ -20,5 +23,14 @@ namespace camhead::test {
 
 // Pixel position of a world point through the pinhole of the scene camera.
 [[nodiscard]] glm::vec2 project(const renderer::Scene &scene, glm::vec3 world);
+
+// Mean over the rows of channel `c`: the profile across a vertical edge.
+[[nodiscard]] std::vector<double> row_average(const renderer::Image &image, int c = 0);
+
+// Blur diameter (px) from the edge profile of a uniform disk. The
+// differences of the profile are the disk's line spread function (variance
+// D^2/16) convolved with the pixel box filter twice over, a triangle of
+// half-width 1 px (variance 1/6): D = 4 sqrt(var - 1/6).
+[[nodiscard]] double measured_blur_diameter(const std::vector<double> &profile);
 
 } // namespace camhead::test
