@@ -136,6 +136,18 @@ Measurement run_pinhole_gather(ChartContext &c, int rpp) {
   return m;
 }
 
+// 3. Adaptive ray budget (renderer adaptive.h): `rpp` rays per pixel on
+//    average, a pilot then each pixel's share by its variance and blur.
+Measurement run_adaptive(ChartContext &c, int rpp) {
+  const gpu::FrameParams frame = make_frame_params(c.scene, rpp);
+  Measurement m;
+  m.frame_s = median_seconds(c.args, [&] {
+    return c.tracer.render_adaptive(frame, {}, {}, LayerSelection::display_only()).seconds;
+  });
+  m.composite = c.tracer.render_adaptive(frame).composite;
+  return m;
+}
+
 // The method table: a new sampler (low-discrepancy, adaptive) is one more
 // entry here with its own run function; the chart, CSV and legend follow.
 const std::vector<Method> &methods() {
@@ -152,6 +164,12 @@ const std::vector<Method> &methods() {
        {214, 39, 40},
        chart::Marker::square,
        run_pinhole_gather},
+      {"adaptive",
+       "thin-lens tracer, adaptive ray budget per pixel from a pilot (renderer adaptive.h)",
+       {4, 9, 16, 25, 49},
+       {44, 160, 44},
+       chart::Marker::diamond,
+       run_adaptive},
   };
   return table;
 }

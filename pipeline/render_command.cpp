@@ -24,6 +24,7 @@ struct RenderArgs {
   int rpp = 0;
   std::optional<std::uint32_t> seed;
   bool cpu = false;
+  bool adaptive = false;
   int threads = 0;
   std::string layer = "composite";
   std::string device;
@@ -85,16 +86,18 @@ int run_render(const RenderArgs &args) {
     if (args.cpu) {
       executor = "CPU reference";
       ProgressLine progress("render (CPU)");
-      result = render_cpu(
-          compiled, frame, [&](int done, int total) { progress.update(done, total); },
-          args.threads);
+      const ProgressFn report = [&](int done, int total) { progress.update(done, total); };
+      result = args.adaptive ? render_cpu_adaptive(compiled, frame, {}, report, args.threads)
+                             : render_cpu(compiled, frame, report, args.threads);
       progress.finish();
     } else {
       GpuTracer tracer(args.device);
       executor = tracer.device_name();
       ProgressLine progress("render (" + executor + ")");
       tracer.load(compiled);
-      result = tracer.render(frame, [&](int done, int total) { progress.update(done, total); });
+      const ProgressFn report = [&](int done, int total) { progress.update(done, total); };
+      result =
+          args.adaptive ? tracer.render_adaptive(frame, {}, report) : tracer.render(frame, report);
       progress.finish();
     }
     write_image(args.output, pick_layer(result, args.layer));
@@ -141,6 +144,9 @@ void add_render_command(CLI::App &app) {
                   "mask: M, virtual coverage; depth: mean camera-axis depth (m)")
       ->check(CLI::IsMember({"composite", "mixed", "real", "mask", "depth"}));
   cmd->add_flag("--cpu", args->cpu, "Use the CPU reference tracer instead of Vulkan");
+  cmd->add_flag("--adaptive", args->adaptive,
+                "Adaptive ray budget: --rpp on average, shared out per pixel by a pilot's\n"
+                "variance and circle of confusion (renderer adaptive.h)");
   cmd->add_option("--threads", args->threads, "CPU threads for --cpu (default: all)");
   cmd->add_option("--device", args->device,
                   "Vulkan device by index or name substring (see camhead devices);\n"

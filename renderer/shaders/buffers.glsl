@@ -24,6 +24,7 @@ layout(std430, binding = BINDING_OUT_MIXED) writeonly buffer OutMixed { vec4 out
 layout(std430, binding = BINDING_OUT_REAL) writeonly buffer OutReal { vec4 out_real[]; };
 layout(std430, binding = BINDING_OUT_AUX) writeonly buffer OutAux { vec4 out_aux[]; };
 layout(std430, binding = BINDING_OUT_DISPLAY) writeonly buffer OutDisplay { uint out_display[]; };
+layout(std430, binding = BINDING_SAMPLE_COUNTS) readonly buffer SampleCounts { uint sample_counts[]; };
 
 // Index of this invocation's pixel, or -1 outside the image.
 int pixel_index() {

@@ -259,17 +259,34 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
 }
 
 // Adds samples [frame.sampling.x, frame.sampling.y) of pixel (x, y) to the
-// accumulators (layout.h: mixed.rgb + mask, real.rgb, aux = depth sum, hits).
-void trace_pixel(uint x, uint y, INOUT(vec4) acc_mixed, INOUT(vec4) acc_real, INOUT(vec4) acc_aux) {
+// accumulators (layout.h: mixed.rgb + mask, real.rgb, aux = depth sum, hits,
+// and the sum and sum of squares of the luminance of each sample's composite,
+// for adaptive sampling). `camera` is the plate's pixel (has_plate only).
+// With frame.tracing.y = k > 0 (adaptive second pass) the samples are those
+// of the pixel's own pattern of sample_counts[pixel] - k samples.
+void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mixed,
+                 INOUT(vec4) acc_real, INOUT(vec4) acc_aux) {
   uint count = frame.sampling.z;
-  uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, frame.sampling.w);
-  for (uint s = frame.sampling.x; s < frame.sampling.y; ++s) {
+  uint end = frame.sampling.y;
+  uint seed = frame.sampling.w;
+  if (frame.tracing.y != 0u) {
+    count = sample_counts[y * frame.image.x + x] - frame.tracing.y;
+    end = min(end, count);
+    seed = hash_u32(seed ^ 0xad5a3c1bu); // independent of the pilot's pattern
+  }
+  uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, seed);
+  for (uint s = frame.sampling.x; s < end; ++s) {
     SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern), s, count, pixel_pattern);
-    acc_mixed += vec4(r.mixed, r.is_virtual ? 1.0f : 0.0f);
+    float m = r.is_virtual ? 1.0f : 0.0f;
+    acc_mixed += vec4(r.mixed, m);
     acc_real += vec4(r.real, 0.0f);
     if (r.hit) {
       acc_aux += vec4(r.depth, 1.0f, 0.0f, 0.0f);
     }
+    // This sample's composite (equation 4, linear in the sample).
+    vec3 f = has_plate ? r.mixed + (1.0f - m) * (vec3(camera) - r.real) : r.mixed;
+    float lum = dot(f, vec3(0.2126f, 0.7152f, 0.0722f));
+    acc_aux += vec4(0.0f, 0.0f, lum, lum * lum);
   }
 }
 
@@ -288,8 +305,10 @@ struct Resolved {
 // evaluated as I_c + (I_m - I_r) - M (I_c - I_r), which returns I_c bit for
 // bit where nothing virtual is seen (M = 0 and I_m == I_r). Without a plate
 // the real render stands in for the camera image, so I_f = I_m.
-Resolved resolve_pixel(vec4 acc_mixed, vec4 acc_real, vec4 acc_aux, vec4 plate, bool has_plate) {
-  float inv = 1.0f / float(frame.sampling.z);
+// `samples`: the pixel's sample count (frame.sampling.z, or its adaptive n_i).
+Resolved resolve_pixel(vec4 acc_mixed, vec4 acc_real, vec4 acc_aux, vec4 plate, bool has_plate,
+                       uint samples) {
+  float inv = 1.0f / float(samples);
   Resolved r;
   r.mixed = vec3(acc_mixed) * inv;
   r.real = vec3(acc_real) * inv;

@@ -79,7 +79,7 @@ struct FrameParams {
   vec4 world_color; // rgb
   uvec4 image;      // x: width, y: height, z: has_plate, w: light count
   uvec4 sampling; // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
-  uvec4 tracing;  // x: max_bounces; y, z, w: reserved (0)
+  uvec4 tracing;  // x: max_bounces; y: adaptive pilot samples (0 = uniform); z, w: reserved (0)
 };
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.
@@ -87,21 +87,32 @@ struct FrameParams {
 #define BINDING_NODES 1
 #define BINDING_MATERIALS 2
 #define BINDING_LIGHTS 3
-#define BINDING_FRAME 4         // uniform FrameParams
-#define BINDING_ACCUM_MIXED 5   // vec4 per pixel: sum of mixed radiance (rgb), sum of mask (a)
-#define BINDING_ACCUM_REAL 6    // vec4 per pixel: sum of real radiance (rgb)
-#define BINDING_ACCUM_AUX 7     // vec4 per pixel: x sum of hit depth, y number of hits
-#define BINDING_PLATE 8         // vec4 per pixel: camera image I_c (rgb); unused without plate
-#define BINDING_OUT_COMPOSITE 9 // vec4 per pixel: I_f (rgb)
-#define BINDING_OUT_MIXED 10    // vec4 per pixel: I_m (rgb)
-#define BINDING_OUT_REAL 11     // vec4 per pixel: I_r (rgb)
-#define BINDING_OUT_AUX 12      // vec4 per pixel: x mask M, y mean hit depth (0 if none)
-#define BINDING_OUT_DISPLAY 13  // uint per pixel: RGBA8, sRGB-encoded I_f, alpha = M
-#define BINDING_COUNT 14
+#define BINDING_FRAME 4       // uniform FrameParams
+#define BINDING_ACCUM_MIXED 5 // vec4 per pixel: sum of mixed radiance (rgb), sum of mask (a)
+#define BINDING_ACCUM_REAL 6  // vec4 per pixel: sum of real radiance (rgb)
+// BINDING_ACCUM_AUX: x sum of hit depth, y number of hits, z sum and w sum of
+// squares of each sample's composite luminance (adaptive sampling's variance).
+#define BINDING_ACCUM_AUX 7      // vec4 per pixel, see above
+#define BINDING_PLATE 8          // vec4 per pixel: camera image I_c (rgb); unused without plate
+#define BINDING_OUT_COMPOSITE 9  // vec4 per pixel: I_f (rgb)
+#define BINDING_OUT_MIXED 10     // vec4 per pixel: I_m (rgb)
+#define BINDING_OUT_REAL 11      // vec4 per pixel: I_r (rgb)
+#define BINDING_OUT_AUX 12       // vec4 per pixel: x mask M, y mean hit depth (0 if none)
+#define BINDING_OUT_DISPLAY 13   // uint per pixel: RGBA8, sRGB-encoded I_f, alpha = M
+#define BINDING_SAMPLE_COUNTS 14 // uint per pixel: samples of the pixel (adaptive only)
+#define BINDING_COUNT 15
 
 // The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to
 // the accumulators (the host clears them before the first batch); the resolve
 // kernel divides by sampling.z and composites.
+//
+// Adaptive sampling (tracing.y = k > 0, renderer/include/camhead/renderer/
+// adaptive.h): a pilot of k samples per pixel runs as above (tracing.y = 0,
+// sampling.z = k); the host then sets each pixel's total n_i >= k in
+// sample_counts. With tracing.y = k the trace kernel adds samples
+// [sampling.x, sampling.y) of the pixel's own second pattern of n_i - k
+// samples (another seed), stopping at n_i - k, and the resolve kernel divides
+// by n_i.
 
 // Workgroup shape of both kernels (pixels).
 #define CAMHEAD_TILE_X 8

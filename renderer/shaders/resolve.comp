@@ -20,7 +20,8 @@ void main() {
   }
   bool has_plate = frame.image.z != 0u;
   vec4 camera = has_plate ? plate[i] : vec4(0.0f);
-  Resolved r = resolve_pixel(accum_mixed[i], accum_real[i], accum_aux[i], camera, has_plate);
+  uint samples = frame.tracing.y != 0u ? sample_counts[i] : frame.sampling.z;
+  Resolved r = resolve_pixel(accum_mixed[i], accum_real[i], accum_aux[i], camera, has_plate, samples);
   out_composite[i] = vec4(r.composite, 1.0f);
   out_mixed[i] = vec4(r.mixed, 1.0f);
   out_real[i] = vec4(r.real, 1.0f);

@@ -12,7 +12,10 @@ void main() {
   vec4 acc_mixed = accum_mixed[i];
   vec4 acc_real = accum_real[i];
   vec4 acc_aux = accum_aux[i];
-  trace_pixel(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y, acc_mixed, acc_real, acc_aux);
+  bool has_plate = frame.image.z != 0u;
+  vec4 camera = has_plate ? plate[i] : vec4(0.0f);
+  trace_pixel(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y, camera, has_plate, acc_mixed,
+              acc_real, acc_aux);
   accum_mixed[i] = acc_mixed;
   accum_real[i] = acc_real;
   accum_aux[i] = acc_aux;

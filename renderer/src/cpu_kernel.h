@@ -36,6 +36,7 @@ struct CpuKernel {
   const BvhNode *nodes = nullptr;
   const Material *materials = nullptr;
   const Light *lights = nullptr;
+  const uint *sample_counts = nullptr; // adaptive second pass only (tracing.y > 0)
   FrameParams frame{};
 
 #include "kernel.glsl"

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <mutex>
+#include <numeric>
 #include <thread>
 #include <vector>
 
+#include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/bvh.h"
 #include "cpu_kernel.h"
 
@@ -30,18 +33,24 @@ private:
 
 } // namespace
 
-RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &frame,
-                        const ProgressFn &progress, int threads) {
-  const auto start = std::chrono::steady_clock::now();
-  const int width = int(frame.image.x);
-  const int height = int(frame.image.y);
-  const std::size_t pixels = std::size_t(width) * height;
-  const uint32_t total = frame.sampling.z;
+namespace {
 
+// The three accumulators of every pixel.
+struct Accumulators {
+  explicit Accumulators(std::size_t pixels)
+      : mixed(pixels, glm::vec4(0.0f)), real(pixels, glm::vec4(0.0f)),
+        aux(pixels, glm::vec4(0.0f)) {}
+  std::vector<glm::vec4> mixed, real, aux;
+};
+
+// A kernel for `scene` with `frame` in the compiled scene's frame. `nodes`
+// keeps the empty BVH alive for a scene without nodes.
+cpu::CpuKernel make_kernel(const CompiledScene &scene, const gpu::FrameParams &frame,
+                           std::vector<gpu::BvhNode> &nodes) {
   cpu::CpuKernel kernel;
   kernel.primitives = scene.primitives.data();
   // As the GPU tracer: a scene without nodes traverses the empty BVH.
-  const std::vector<gpu::BvhNode> nodes = scene.nodes.empty() ? build_bvh({}).nodes : scene.nodes;
+  nodes = scene.nodes.empty() ? build_bvh({}).nodes : scene.nodes;
   kernel.nodes = nodes.data();
   // The GPU tracer binds a placeholder for empty arrays; so does this one, as
   // the kernel reads material 0 for rays that miss.
@@ -50,13 +59,18 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
   kernel.lights = scene.lights.data();
   kernel.frame = frame;
   kernel.frame.cam_position -= glm::vec4(scene.origin, 0.0f); // into the compiled frame
-  kernel.frame.sampling.x = 0;
-  kernel.frame.sampling.y = total;
+  kernel.frame.tracing.y = 0u;                                // uniform unless set below
+  return kernel;
+}
 
-  std::vector<glm::vec4> acc_mixed(pixels, glm::vec4(0.0f));
-  std::vector<glm::vec4> acc_real(pixels, glm::vec4(0.0f));
-  std::vector<glm::vec4> acc_aux(pixels, glm::vec4(0.0f));
-
+// Runs kernel.trace_pixel over every pixel on `threads` threads; `report`
+// gets the fraction of rows done.
+void trace_all(cpu::CpuKernel &kernel, const CompiledScene &scene, Accumulators &acc, int threads,
+               const std::function<void(double)> &report) {
+  const int width = int(kernel.frame.image.x);
+  const int height = int(kernel.frame.image.y);
+  const std::size_t pixels = std::size_t(width) * height;
+  const bool has_plate = kernel.frame.image.z != 0;
   if (threads <= 0) {
     threads = int(std::max(1u, std::thread::hardware_concurrency()));
   }
@@ -67,13 +81,15 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
     for (int y = queue.next(); y >= 0; y = queue.next()) {
       for (int x = 0; x < width; ++x) {
         const std::size_t i = std::size_t(y) * width + x;
-        kernel.trace_pixel(uint32_t(x), uint32_t(y), acc_mixed[i], acc_real[i], acc_aux[i]);
+        const glm::vec4 plate =
+            has_plate && scene.plate.size() == pixels ? scene.plate[i] : glm::vec4(0.0f);
+        kernel.trace_pixel(uint32_t(x), uint32_t(y), plate, has_plate, acc.mixed[i], acc.real[i],
+                           acc.aux[i]);
       }
       const int done = rows_done.fetch_add(1) + 1;
-      if (progress) {
-        // Report in samples per pixel, as the GPU tracer does.
+      if (report) {
         std::lock_guard lock(progress_mutex);
-        progress(int(std::uint64_t(total) * done / height), int(total));
+        report(double(done) / height);
       }
     }
   };
@@ -85,17 +101,27 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
   for (auto &thread : pool) {
     thread.join();
   }
+}
 
+// Resolves the accumulators into the layers; `counts` per pixel, or empty
+// for frame.sampling.z everywhere.
+RenderResult resolve_all(cpu::CpuKernel &kernel, const CompiledScene &scene,
+                         const Accumulators &acc, const std::vector<std::uint32_t> &counts) {
+  const int width = int(kernel.frame.image.x);
+  const int height = int(kernel.frame.image.y);
+  const std::size_t pixels = std::size_t(width) * height;
   RenderResult result;
   result.composite = Image(width, height, 3);
   result.mixed = Image(width, height, 3);
   result.real = Image(width, height, 3);
   result.mask = Image(width, height, 1);
   result.depth = Image(width, height, 1);
-  const bool has_plate = frame.image.z != 0 && scene.plate.size() == pixels;
+  const bool has_plate = kernel.frame.image.z != 0 && scene.plate.size() == pixels;
   for (std::size_t i = 0; i < pixels; ++i) {
     const glm::vec4 plate = has_plate ? scene.plate[i] : glm::vec4(0.0f);
-    const auto r = kernel.resolve_pixel(acc_mixed[i], acc_real[i], acc_aux[i], plate, has_plate);
+    const std::uint32_t samples = counts.empty() ? kernel.frame.sampling.z : counts[i];
+    const auto r =
+        kernel.resolve_pixel(acc.mixed[i], acc.real[i], acc.aux[i], plate, has_plate, samples);
     for (int c = 0; c < 3; ++c) {
       result.composite.data[i * 3 + c] = r.composite[c];
       result.mixed.data[i * 3 + c] = r.mixed[c];
@@ -104,8 +130,62 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
     result.mask.data[i] = r.mask;
     result.depth.data[i] = r.depth;
   }
+  return result;
+}
+
+} // namespace
+
+RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &frame,
+                        const ProgressFn &progress, int threads) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t pixels = std::size_t(frame.image.x) * frame.image.y;
+  const uint32_t total = frame.sampling.z;
+  std::vector<gpu::BvhNode> nodes;
+  cpu::CpuKernel kernel = make_kernel(scene, frame, nodes);
+  kernel.frame.sampling.x = 0;
+  kernel.frame.sampling.y = total;
+  Accumulators acc(pixels);
+  // Report in samples per pixel, as the GPU tracer does.
+  trace_all(kernel, scene, acc, threads, [&](double done) {
+    if (progress)
+      progress(int(double(total) * done), int(total));
+  });
+  RenderResult result = resolve_all(kernel, scene, acc, {});
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.camera_rays = std::uint64_t(pixels) * total;
+  return result;
+}
+
+RenderResult render_cpu_adaptive(const CompiledScene &scene, const gpu::FrameParams &frame,
+                                 const AdaptiveSampling &settings, const ProgressFn &progress,
+                                 int threads) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t pixels = std::size_t(frame.image.x) * frame.image.y;
+  const uint32_t total = frame.sampling.z;
+  const uint32_t pilot = adaptive_pilot(settings, total);
+  std::vector<gpu::BvhNode> nodes;
+  cpu::CpuKernel kernel = make_kernel(scene, frame, nodes);
+  Accumulators acc(pixels);
+  const auto report = [&](double done) {
+    if (progress)
+      progress(int(double(total) * done), int(total));
+  };
+  // 1. The pilot, a uniform frame of `pilot` samples.
+  kernel.frame.sampling = gpu::uvec4(0u, pilot, pilot, frame.sampling.w);
+  trace_all(kernel, scene, acc, threads, [&](double done) { report(done * pilot / total); });
+  // 2. The budget.
+  const std::vector<std::uint32_t> counts = allocate_samples(acc.aux, frame, pilot, settings);
+  // 3. Each pixel's share.
+  const std::uint32_t most = *std::max_element(counts.begin(), counts.end());
+  kernel.sample_counts = counts.data();
+  kernel.frame.tracing.y = pilot;
+  kernel.frame.sampling = gpu::uvec4(0u, most - pilot, total, frame.sampling.w);
+  trace_all(kernel, scene, acc, threads,
+            [&](double done) { report((pilot + done * (total - pilot)) / total); });
+  RenderResult result = resolve_all(kernel, scene, acc, counts);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.camera_rays = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
+  result.sample_counts = counts;
   return result;
 }
 

@@ -10,9 +10,11 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <optional>
 #include <span>
 
+#include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/bvh.h"
 #include "resolve_spv.h"
 #include "trace_spv.h"
@@ -146,7 +148,13 @@ struct GpuTracer::Impl {
 
   void load(const CompiledScene &scene);
   RenderResult render(const gpu::FrameParams &requested, const ProgressFn &progress,
-                      LayerSelection layers);
+                      LayerSelection layers, const AdaptiveSampling *adaptive);
+  // Adds samples [0, end) to the accumulators in batches (clearing them
+  // first if `clear`); `report` gets the samples done.
+  void trace_batches(gpu::FrameParams &frame, std::uint32_t end, bool clear,
+                     const std::function<void(std::uint32_t)> &report);
+  // The accumulated aux layer (layout.h), through the read-back buffer.
+  std::vector<glm::vec4> read_accum_aux();
   void dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
 
   // Declaration order is destruction order in reverse: everything made from
@@ -230,10 +238,15 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   uploader.flush(commands);
 
   for (const int binding : kAccumulators)
-    buffers[binding] = vk::Buffer(
-        device, {.size = layer_bytes,
-                 .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                 .name = "accumulator"});
+    buffers[binding] = vk::Buffer(device, {.size = layer_bytes,
+                                           .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                           .name = "accumulator"});
+  buffers[BINDING_SAMPLE_COUNTS] = vk::Buffer(
+      device, {.size = pixels * sizeof(std::uint32_t),
+               .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+               .name = "sample counts"});
   for (const int binding : kOutputs)
     buffers[binding] = vk::Buffer(
         device, {.size = layer_bytes,
@@ -269,7 +282,7 @@ void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeli
 }
 
 RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const ProgressFn &progress,
-                                     LayerSelection selection) {
+                                     LayerSelection selection, const AdaptiveSampling *adaptive) {
   const Clock::time_point start = Clock::now();
   if (!loaded)
     throw GpuError("GpuTracer::render() before a successful load()");
@@ -288,37 +301,42 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   frame.image.z = requested.image.z != 0 && has_plate ? 1u : 0u;
   frame.image.w = counts.z;
 
-  // One uniform buffer suffices because each batch is waited for before the
-  // next one rewrites it.
-  BatchSizer sizer;
   FrameTimings timings;
   Clock::time_point phase = Clock::now();
-  for (std::uint32_t done = 0; done < total;) {
-    const std::uint32_t batch = std::min(sizer.next(), total - done);
-    frame.sampling = gpu::uvec4(done, done + batch, total, requested.sampling.w);
-    std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);
-
-    VkCommandBuffer command_buffer = commands.begin();
-    if (done == 0) {
-      for (const int binding : kAccumulators)
-        vkCmdFillBuffer(command_buffer, buffers[binding].get(), 0, VK_WHOLE_SIZE, 0);
-      vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    }
-    dispatch(command_buffer, trace.get());
-    // Orders this batch's accumulation before the next batch or the resolve.
-    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    const Clock::time_point submitted = Clock::now();
-    commands.submit_and_wait();
-    sizer.measured(batch, seconds_since(submitted));
-    done += batch;
-    if (progress)
-      progress(static_cast<int>(done), static_cast<int>(total));
+  std::vector<std::uint32_t> shares;
+  std::uint64_t rays = std::uint64_t(width) * height * total;
+  if (adaptive == nullptr) {
+    frame.tracing.y = 0u;
+    trace_batches(frame, total, true, [&](std::uint32_t done) {
+      if (progress)
+        progress(static_cast<int>(done), static_cast<int>(total));
+    });
+  } else {
+    // adaptive.h: a pilot, the budget from what it saw, each pixel's share.
+    const std::uint32_t pilot = adaptive_pilot(*adaptive, total);
+    const auto report = [&](double done) {
+      if (progress)
+        progress(static_cast<int>(done), static_cast<int>(total));
+    };
+    frame.tracing.y = 0u;
+    frame.sampling.z = pilot;
+    trace_batches(frame, pilot, true, report);
+    gpu::FrameParams budget_frame = requested;
+    budget_frame.image = frame.image;
+    shares = allocate_samples(read_accum_aux(), budget_frame, pilot, *adaptive);
+    vk::Uploader uploader(device);
+    uploader.upload(buffers[BINDING_SAMPLE_COUNTS], bytes_of(shares));
+    uploader.flush(commands);
+    const std::uint32_t most = *std::max_element(shares.begin(), shares.end());
+    frame.tracing.y = pilot;
+    frame.sampling.z = total;
+    trace_batches(frame, most - pilot, false, [&](std::uint32_t done) {
+      report(pilot + double(done) * (total - pilot) / std::max(most - pilot, 1u));
+    });
+    rays = 0;
+    for (const std::uint32_t n : shares)
+      rays += n;
   }
-
   timings.trace_s = seconds_since(phase);
   phase = Clock::now();
 
@@ -371,11 +389,66 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   if (selection.display) {
     result.display.assign(mapped + display_offset, mapped + display_offset + display_bytes);
   }
-  result.camera_rays = std::uint64_t(width) * height * total;
+  result.camera_rays = rays;
+  result.sample_counts = std::move(shares);
   timings.unpack_s = seconds_since(phase);
   result.timings = timings;
   result.seconds = seconds_since(start);
   return result;
+}
+
+void GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, bool clear,
+                                    const std::function<void(std::uint32_t)> &report) {
+  // One uniform buffer suffices because each batch is waited for before the
+  // next one rewrites it.
+  BatchSizer sizer;
+  if (clear && end == 0) {
+    VkCommandBuffer command_buffer = commands.begin();
+    for (const int binding : kAccumulators)
+      vkCmdFillBuffer(command_buffer, buffers[binding].get(), 0, VK_WHOLE_SIZE, 0);
+    commands.submit_and_wait();
+  }
+  for (std::uint32_t done = 0; done < end;) {
+    const std::uint32_t batch = std::min(sizer.next(), end - done);
+    frame.sampling.x = done;
+    frame.sampling.y = done + batch;
+    std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);
+
+    VkCommandBuffer command_buffer = commands.begin();
+    if (done == 0 && clear) {
+      for (const int binding : kAccumulators)
+        vkCmdFillBuffer(command_buffer, buffers[binding].get(), 0, VK_WHOLE_SIZE, 0);
+      vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    }
+    dispatch(command_buffer, trace.get());
+    // Orders this batch's accumulation before the next batch or the resolve.
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    const Clock::time_point submitted = Clock::now();
+    commands.submit_and_wait();
+    sizer.measured(batch, seconds_since(submitted));
+    done += batch;
+    if (report)
+      report(done);
+  }
+}
+
+std::vector<glm::vec4> GpuTracer::Impl::read_accum_aux() {
+  const VkDeviceSize layer_bytes = buffers[BINDING_ACCUM_AUX].size();
+  VkCommandBuffer command_buffer = commands.begin();
+  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                     VK_ACCESS_TRANSFER_READ_BIT);
+  const VkBufferCopy region{0, 0, layer_bytes};
+  vkCmdCopyBuffer(command_buffer, buffers[BINDING_ACCUM_AUX].get(), readback.get(), 1, &region);
+  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+  commands.submit_and_wait();
+  const auto *values = static_cast<const glm::vec4 *>(readback.mapped());
+  return std::vector<glm::vec4>(values, values + std::size_t(width) * height);
 }
 
 GpuTracer::GpuTracer(const std::string &device) : impl_(std::make_unique<Impl>(device)) {}
@@ -392,7 +465,13 @@ void GpuTracer::load(const CompiledScene &scene) {
 
 RenderResult GpuTracer::render(const gpu::FrameParams &frame, const ProgressFn &progress,
                                LayerSelection layers) {
-  return impl_->render(frame, progress, layers);
+  return impl_->render(frame, progress, layers, nullptr);
+}
+
+RenderResult GpuTracer::render_adaptive(const gpu::FrameParams &frame,
+                                        const AdaptiveSampling &settings,
+                                        const ProgressFn &progress, LayerSelection layers) {
+  return impl_->render(frame, progress, layers, &settings);
 }
 
 } // namespace camhead::renderer

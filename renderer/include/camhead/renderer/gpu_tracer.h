@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/render_result.h"
 
@@ -48,6 +49,14 @@ public:
   // them back.
   [[nodiscard]] RenderResult render(const gpu::FrameParams &frame, const ProgressFn &progress = {},
                                     LayerSelection layers = LayerSelection::all());
+
+  // Adaptive sampling (adaptive.h): frame.sampling.z samples per pixel on
+  // average, shared out by what a pilot saw; result.sample_counts holds the
+  // shares. The same steps as render_cpu_adaptive().
+  [[nodiscard]] RenderResult render_adaptive(const gpu::FrameParams &frame,
+                                             const AdaptiveSampling &settings = {},
+                                             const ProgressFn &progress = {},
+                                             LayerSelection layers = LayerSelection::all());
 
 private:
   struct Impl;

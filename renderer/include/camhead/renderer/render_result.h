@@ -27,8 +27,10 @@ struct RenderResult {
   // A = round(255 M). GPU tracer only; the CPU reference leaves it empty.
   std::vector<std::uint8_t> display;
   double seconds = 0.0;          // wall time of the render, excluding scene upload
-  std::uint64_t camera_rays = 0; // width x height x samples
-  FrameTimings timings;          // GPU tracer only
+  std::uint64_t camera_rays = 0; // width x height x samples (adaptive: the sum of sample_counts)
+  // Adaptive sampling only: samples traced per pixel, row by row; else empty.
+  std::vector<std::uint32_t> sample_counts;
+  FrameTimings timings; // GPU tracer only
 };
 
 // Which layers a caller wants back from the GPU tracer. Reading a float

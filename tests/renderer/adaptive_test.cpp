@@ -1,0 +1,171 @@
+// Adaptive ray budget per pixel (renderer/include/camhead/renderer/adaptive.h):
+// the allocation, the two executors' agreement, and the quality claim.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "camhead/renderer/adaptive.h"
+#include "camhead/renderer/cpu_tracer.h"
+#include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/scene_loader.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead {
+namespace {
+
+using renderer::AdaptiveSampling;
+
+std::uint64_t sum(const std::vector<std::uint32_t> &counts) {
+  return std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
+}
+
+renderer::Scene reference_scene(const std::string &name, int divisor) {
+  return test::downscaled(renderer::load_scene(test::shared_dir() / "reference" / (name + ".json")),
+                          divisor);
+}
+
+TEST(AdaptiveAllocation, NoisyPixelsGetMoreAndTheTotalIsTheBudget) {
+  renderer::gpu::FrameParams frame{};
+  frame.image = {16u, 8u, 0u, 0u};
+  frame.sampling = {0u, 9u, 9u, 1u};
+  frame.lens = {0.0f, 1.0f, 16.0f, 1.0f}; // pinhole: no circle of confusion
+  const std::uint32_t pilot = 2;
+  std::vector<glm::vec4> aux(16 * 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) {
+      // Left half: both pilot samples 0.5; right half: 0 and 1.
+      const bool noisy = x >= 8;
+      aux[y * 16 + x] = glm::vec4(2.0f, 2.0f, 1.0f, noisy ? 1.0f : 0.5f);
+    }
+  const auto counts = renderer::allocate_samples(aux, frame, pilot, AdaptiveSampling{});
+  EXPECT_EQ(sum(counts), 16u * 8u * 9u);
+  for (int y = 0; y < 8; ++y) {
+    EXPECT_EQ(counts[y * 16 + 0], pilot) << "a quiet pixel away from the noise gets the pilot";
+    EXPECT_GT(counts[y * 16 + 15], 9u);
+    EXPECT_GE(counts[y * 16 + 15], counts[y * 16 + 0]);
+  }
+  EXPECT_EQ(renderer::allocate_samples(aux, frame, pilot, AdaptiveSampling{}), counts);
+}
+
+TEST(AdaptiveAllocation, PilotLeavesRaysToShare) {
+  EXPECT_EQ(renderer::adaptive_pilot(AdaptiveSampling{}, 1), 1u);
+  EXPECT_EQ(renderer::adaptive_pilot(AdaptiveSampling{}, 4), 1u);
+  EXPECT_EQ(renderer::adaptive_pilot(AdaptiveSampling{}, 12), 3u);
+  EXPECT_EQ(renderer::adaptive_pilot(AdaptiveSampling{}, 49), 4u);
+}
+
+class Adaptive : public ::testing::TestWithParam<std::string> {};
+
+// The shares on a reference scene: the budget exactly, at least the pilot
+// everywhere, and the mean share in and out of focus printed.
+TEST_P(Adaptive, SharesAddUpToTheBudget) {
+  constexpr int rpp = 16;
+  const renderer::Scene scene = reference_scene(GetParam(), 8);
+  const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, rpp);
+  const renderer::RenderResult r =
+      renderer::render_cpu_adaptive(renderer::compile_scene(scene), frame);
+  ASSERT_TRUE(test::all_finite(r.composite));
+  ASSERT_TRUE(test::all_finite(r.mask));
+  const std::size_t pixels = r.composite.pixel_count();
+  ASSERT_EQ(r.sample_counts.size(), pixels);
+  EXPECT_EQ(sum(r.sample_counts), std::uint64_t(pixels) * rpp);
+  EXPECT_EQ(r.camera_rays, std::uint64_t(pixels) * rpp);
+  const std::uint32_t pilot = renderer::adaptive_pilot(AdaptiveSampling{}, rpp);
+  double sharp = 0.0, blurred = 0.0;
+  int sharp_n = 0, blurred_n = 0;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    EXPECT_GE(r.sample_counts[i], pilot);
+    const float z = r.depth.data[i];
+    const double coc_px =
+        z > 0.0f ? frame.lens.x * frame.lens.z * std::abs(1.0 / z - 1.0 / frame.lens.y) : 1e9;
+    if (coc_px < 0.5) {
+      sharp += r.sample_counts[i];
+      ++sharp_n;
+    } else if (coc_px > 2.0) {
+      blurred += r.sample_counts[i];
+      ++blurred_n;
+    }
+  }
+  std::printf("%s: mean share in focus (CoC < 0.5 px) %.1f over %d px, defocused (> 2 px) %.1f "
+              "over %d px, largest %u\n",
+              GetParam().c_str(), sharp / std::max(sharp_n, 1), sharp_n,
+              blurred / std::max(blurred_n, 1), blurred_n,
+              *std::max_element(r.sample_counts.begin(), r.sample_counts.end()));
+  // Not asserted: which pixels get more. On the reference scenes the
+  // in-focus pixels do (their shadows and edges are noisy; the lens averages
+  // the defocused ones into smooth, low-variance regions).
+  EXPECT_GT(sharp_n + blurred_n, 0);
+}
+
+// As executors_test.cpp for the uniform path: the GPU tracer runs the same
+// three steps on the same samples.
+TEST_P(Adaptive, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
+  CAMHEAD_REQUIRE_VULKAN();
+  constexpr int rpp = 16;
+  renderer::Scene scene = reference_scene(GetParam(), 8);
+  const renderer::CompiledScene compiled = renderer::compile_scene(scene);
+  const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, rpp);
+  renderer::GpuTracer tracer;
+  tracer.load(compiled);
+  const renderer::RenderResult gpu = tracer.render_adaptive(frame);
+  const renderer::RenderResult cpu = renderer::render_cpu_adaptive(compiled, frame);
+  renderer::gpu::FrameParams other = frame;
+  other.sampling.w += 1;
+  const renderer::RenderResult cpu_other = renderer::render_cpu_adaptive(compiled, other);
+  ASSERT_TRUE(test::all_finite(gpu.composite));
+  EXPECT_EQ(sum(gpu.sample_counts), sum(cpu.sample_counts));
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < gpu.sample_counts.size(); ++i)
+    same += gpu.sample_counts[i] == cpu.sample_counts[i] ? 1u : 0u;
+  const double noise = test::rmse(cpu.composite, cpu_other.composite) / std::sqrt(2.0);
+  const double difference = test::rmse(cpu.composite, gpu.composite);
+  std::printf("%s adaptive at %d rpp: GPU vs CPU RMSE %.2e, sampling noise %.2e, equal shares "
+              "%zu of %zu pixels\n",
+              GetParam().c_str(), rpp, difference, noise, same, gpu.sample_counts.size());
+  // The shares come from float sums that the two executors may round
+  // differently, so a few pixels may differ by a sample or so.
+  EXPECT_GT(double(same), 0.9 * double(gpu.sample_counts.size()));
+  EXPECT_LT(difference, noise);
+}
+
+// The quality claim at small scale: relative RMSE against a converged
+// reference at equal total rays, uniform and adaptive, and the adaptive
+// budget that matches uniform 49 rpp.
+TEST_P(Adaptive, LowerErrorThanUniformAtEqualRays) {
+  const renderer::Scene scene = reference_scene(GetParam(), 16);
+  const renderer::CompiledScene compiled = renderer::compile_scene(scene);
+  renderer::gpu::FrameParams ref_frame = renderer::make_frame_params(scene, 1024);
+  ref_frame.sampling.w += 1000; // independent of the renders measured
+  const renderer::Image reference = renderer::render_cpu(compiled, ref_frame).composite;
+  const auto error = [&](int rpp, bool adaptive) {
+    const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, rpp);
+    const renderer::RenderResult r = adaptive ? renderer::render_cpu_adaptive(compiled, frame)
+                                              : renderer::render_cpu(compiled, frame);
+    return test::relative_rmse(reference, r.composite);
+  };
+  const double uniform49 = error(49, false);
+  const double adaptive49 = error(49, true);
+  int matching = 0;
+  for (const int rpp : {4, 6, 8, 12, 16, 25, 36, 49}) {
+    const double e = error(rpp, true);
+    std::printf("%s %dx%d: adaptive %2d rpp rel. RMSE %.4f (uniform 49: %.4f)\n",
+                GetParam().c_str(), scene.render.width, scene.render.height, rpp, e, uniform49);
+    if (matching == 0 && e <= uniform49)
+      matching = rpp;
+  }
+  std::printf("%s: uniform 49 rpp %.4f, adaptive 49 rpp %.4f; adaptive matches uniform 49 at %d "
+              "rpp (%.1fx fewer rays)\n",
+              GetParam().c_str(), uniform49, adaptive49, matching,
+              matching > 0 ? 49.0 / matching : 0.0);
+  EXPECT_LT(adaptive49, uniform49);
+}
+
+INSTANTIATE_TEST_SUITE_P(ReferenceScenes, Adaptive, ::testing::Values("boxes", "ar_basic"));
+
+} // namespace
+} // namespace camhead
