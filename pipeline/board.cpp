@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -288,7 +289,9 @@ Board load_board(const std::filesystem::path &file) {
 }
 
 std::string_view source_type(const LensSourceConfig &source) {
+  // In LensSourceKind's order: a new kind must add its name here.
   static constexpr std::string_view names[] = {"trace", "usb", "gpio", "freed", "opentrackio"};
+  static_assert(std::size(names) == std::variant_size_v<LensSourceKind>);
   return names[source.kind.index()];
 }
 
