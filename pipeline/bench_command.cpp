@@ -6,7 +6,8 @@
 // repeated frames after warm-up, each frame the whole render() call (upload
 // of the frame parameters, tracing, compositing and read-back of the 8-bit
 // display image a live frame shows; --all-layers reads back the float layers
-// too), and where that time went.
+// too), and where that time went. --adaptive times the adaptive ray budget
+// (renderer adaptive.h) at the same mean rays per pixel.
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -33,6 +34,7 @@ struct BenchArgs {
   std::string device;
   bool cpu_peer = false;
   bool all_layers = false;
+  bool adaptive = false;
 };
 
 double paper_fps(int rpp) {
@@ -48,6 +50,12 @@ double paper_fps(int rpp) {
   }
 }
 
+std::string fmt_ms(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", seconds * 1e3);
+  return text;
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values[values.size() / 2];
@@ -61,17 +69,24 @@ struct FrameMedians {
 };
 
 template <typename RenderFn> FrameMedians median_frame(const BenchArgs &args, RenderFn render) {
-  std::vector<double> total, trace, resolve, unpack;
+  std::vector<double> total, device, allocation, submit, unpack, submissions;
   for (int i = 0; i < args.warmup + args.frames; ++i) {
     const renderer::RenderResult result = render();
     if (i >= args.warmup) {
       total.push_back(result.seconds);
-      trace.push_back(result.timings.trace_s);
-      resolve.push_back(result.timings.resolve_s);
+      device.push_back(result.timings.device_s);
+      allocation.push_back(result.timings.allocation_s);
+      submit.push_back(result.timings.submit_s);
       unpack.push_back(result.timings.unpack_s);
+      submissions.push_back(result.timings.submissions);
     }
   }
-  return {median(total), {median(trace), median(resolve), median(unpack)}};
+  return {median(total),
+          {.device_s = median(device),
+           .allocation_s = median(allocation),
+           .submit_s = median(submit),
+           .unpack_s = median(unpack),
+           .submissions = int(median(submissions))}};
 }
 
 int run_bench(const BenchArgs &args) {
@@ -88,8 +103,9 @@ int run_bench(const BenchArgs &args) {
     tracer.load(compiled);
     std::printf("scene %s, %dx%d, device %s\n", args.scene.c_str(), args.width, args.height,
                 tracer.device_name().c_str());
-    std::printf("median of %d frames after %d warm-up frames; read back: %s\n\n", args.frames,
-                args.warmup, args.all_layers ? "all layers" : "8-bit display image");
+    std::printf("median of %d frames after %d warm-up frames; read back: %s; sampling: %s\n\n",
+                args.frames, args.warmup, args.all_layers ? "all layers" : "8-bit display image",
+                args.adaptive ? "adaptive (rpp = mean rays per pixel)" : "uniform");
     std::printf("| rpp | camera rays/frame | frame ms (median) | fps   | M camera rays/s | "
                 "paper fps (GTX 590) |%s\n",
                 args.cpu_peer ? " CPU reference ms | GPU speed / CPU |" : "");
@@ -101,7 +117,10 @@ int run_bench(const BenchArgs &args) {
     std::vector<FrameTimings> breakdown;
     for (int rpp : args.rpp) {
       const gpu::FrameParams frame = make_frame_params(scene, rpp);
-      const FrameMedians gpu = median_frame(args, [&] { return tracer.render(frame, {}, layers); });
+      const FrameMedians gpu = median_frame(args, [&] {
+        return args.adaptive ? tracer.render_adaptive(frame, {}, {}, layers)
+                             : tracer.render(frame, {}, layers);
+      });
       breakdown.push_back(gpu.phases);
       const double frame_s = gpu.total_s;
       const double rays = double(args.width) * args.height * rpp;
@@ -112,18 +131,27 @@ int run_bench(const BenchArgs &args) {
       if (args.cpu_peer) {
         // The same kernel on the same frame, compiled as C++: a peer in the
         // same process, so the ratio holds even on a noisy machine.
-        const double cpu = median_frame(args, [&] { return render_cpu(compiled, frame); }).total_s;
+        const double cpu = median_frame(args, [&] {
+                             return args.adaptive ? render_cpu_adaptive(compiled, frame)
+                                                  : render_cpu(compiled, frame);
+                           }).total_s;
         std::printf(" %16.2f | %15.2f |", cpu * 1e3, cpu / frame_s);
       }
       std::printf("\n");
       std::fflush(stdout);
     }
-    std::printf("\nWhere the GPU frame goes (medians, ms):\n\n"
-                "| rpp | trace | resolve + copy to host | unpack on host |\n"
-                "|-----|-------|------------------------|----------------|\n");
+    std::printf("\nWhere the GPU frame goes (medians, ms; device: timestamps from the first "
+                "kernel to the last copy to host memory, 0 without timestamps):\n\n"
+                "| rpp | on the device | adaptive allocation (part of it) | submit to last "
+                "fence | unpack on host | submissions |\n"
+                "|-----|---------------|----------------------------------|--------------------"
+                "--|----------------|-------------|\n");
     for (std::size_t i = 0; i < breakdown.size(); ++i)
-      std::printf("| %3d | %5.2f | %22.2f | %14.2f |\n", args.rpp[i], breakdown[i].trace_s * 1e3,
-                  breakdown[i].resolve_s * 1e3, breakdown[i].unpack_s * 1e3);
+      std::printf("| %3d | %13.3f | %32s | %20.3f | %14.3f | %11d |\n", args.rpp[i],
+                  breakdown[i].device_s * 1e3,
+                  args.adaptive ? fmt_ms(breakdown[i].allocation_s).c_str() : "-",
+                  breakdown[i].submit_s * 1e3, breakdown[i].unpack_s * 1e3,
+                  breakdown[i].submissions);
     return 0;
   } catch (const std::exception &e) {
     std::fprintf(stderr, "bench: %s\n", e.what());
@@ -159,6 +187,9 @@ void add_bench_command(CLI::App &app) {
   cmd->add_flag("--all-layers", args->all_layers,
                 "Read back every float layer too, not only the 8-bit image a live frame\n"
                 "shows");
+  cmd->add_flag("--adaptive", args->adaptive,
+                "Adaptive ray budget per pixel (a pilot, then shares by variance and blur) at\n"
+                "the same mean rays per pixel");
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
   cmd->add_flag("--cpu-peer", args->cpu_peer,
                 "Also time the CPU reference on the same frames and print the ratio");

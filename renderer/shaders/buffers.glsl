@@ -8,8 +8,6 @@
 #define PRECISE precise
 #define CAMHEAD_PI 3.14159265358979f
 
-layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
-
 layout(std430, binding = BINDING_PRIMITIVES) readonly buffer Primitives { Primitive primitives[]; };
 layout(std430, binding = BINDING_NODES) readonly buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = BINDING_MATERIALS) readonly buffer Materials { Material materials[]; };
@@ -24,7 +22,12 @@ layout(std430, binding = BINDING_OUT_MIXED) writeonly buffer OutMixed { vec4 out
 layout(std430, binding = BINDING_OUT_REAL) writeonly buffer OutReal { vec4 out_real[]; };
 layout(std430, binding = BINDING_OUT_AUX) writeonly buffer OutAux { vec4 out_aux[]; };
 layout(std430, binding = BINDING_OUT_DISPLAY) writeonly buffer OutDisplay { uint out_display[]; };
-layout(std430, binding = BINDING_SAMPLE_COUNTS) readonly buffer SampleCounts { uint sample_counts[]; };
+layout(std430, binding = BINDING_SAMPLE_COUNTS) buffer SampleCounts { uint sample_counts[]; };
+layout(std430, binding = BINDING_ADAPTIVE_WEIGHTS) buffer AdaptiveWeights { float adaptive_weights[]; };
+// Pairs per bin (count, offset sum), flat for atomicAdd.
+layout(std430, binding = BINDING_ADAPTIVE_HISTOGRAM) buffer AdaptiveHistogram { uint adaptive_histogram[]; };
+layout(std430, binding = BINDING_ADAPTIVE_GROUPS) buffer AdaptiveGroups { float adaptive_groups[]; };
+layout(std430, binding = BINDING_ADAPTIVE_SOLUTION) buffer AdaptiveSolutionBuffer { AdaptiveSolution adaptive_solution; };
 
 // Index of this invocation's pixel, or -1 outside the image.
 int pixel_index() {

@@ -80,6 +80,7 @@ struct FrameParams {
   uvec4 image;      // x: width, y: height, z: has_plate, w: light count
   uvec4 sampling; // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
   uvec4 tracing;  // x: max_bounces; y: adaptive pilot samples (0 = uniform); z, w: reserved (0)
+  vec4 adaptive;  // adaptive allocation: x coc_weight, y cap (samples per pixel); z, w: reserved
 };
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.
@@ -100,11 +101,30 @@ struct FrameParams {
 #define BINDING_OUT_AUX 12       // vec4 per pixel: x mask M, y mean hit depth (0 if none)
 #define BINDING_OUT_DISPLAY 13   // uint per pixel: RGBA8, sRGB-encoded I_f, alpha = M
 #define BINDING_SAMPLE_COUNTS 14 // uint per pixel: samples of the pixel (adaptive only)
-#define BINDING_COUNT 15
+// The adaptive allocation's working buffers (adaptive.glsl).
+#define BINDING_ADAPTIVE_WEIGHTS 15   // float per pixel: weight w_i
+#define BINDING_ADAPTIVE_HISTOGRAM 16 // uint pairs per bin: count, sum of in-bin offsets
+#define BINDING_ADAPTIVE_GROUPS 17    // float per 8x8 tile: sum of |pilot mean luminance|
+#define BINDING_ADAPTIVE_SOLUTION 18  // AdaptiveSolution
+#define BINDING_COUNT 19
+
+// Histogram bins of the adaptive weights: 16 per octave over every
+// non-negative float (adaptive.glsl).
+#define ADAPTIVE_BINS 4096u
+
+// The water level of the adaptive allocation and the rays it gave out.
+//   solution: x lambda, y floor weight, z expected total samples
+//   rays:     x, y the low and high words of the total samples given out
+struct AdaptiveSolution {
+  vec4 solution;
+  uvec4 rays;
+};
 
 // The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to
 // the accumulators (the host clears them before the first batch); the resolve
-// kernel divides by sampling.z and composites.
+// kernel divides by sampling.z and composites. The resolve reads neither
+// sampling.x nor sampling.y, so it runs in the last batch's submission, on
+// the same frame parameters.
 //
 // Adaptive sampling (tracing.y = k > 0, renderer/include/camhead/renderer/
 // adaptive.h): a pilot of k samples per pixel runs as above (tracing.y = 0,
@@ -112,7 +132,8 @@ struct FrameParams {
 // sample_counts. With tracing.y = k the trace kernel adds samples
 // [sampling.x, sampling.y) of the pixel's own second pattern of n_i - k
 // samples (another seed), stopping at n_i - k, and the resolve kernel divides
-// by n_i.
+// by n_i. The shares are computed on the GPU between the passes by
+// adaptive_weights.comp, adaptive_solve.comp and adaptive_shares.comp.
 
 // Workgroup shape of both kernels (pixels).
 #define CAMHEAD_TILE_X 8

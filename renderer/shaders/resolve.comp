@@ -4,6 +4,8 @@
 #include "buffers.glsl"
 #include "kernel.glsl"
 
+layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
+
 // The sRGB transfer function (IEC 61966-2-1) as image_io's PNG writer applies
 // it, in float where the writer uses double: the bytes may differ by one.
 vec3 linear_to_srgb(vec3 v) {

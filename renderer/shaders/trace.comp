@@ -4,9 +4,16 @@
 #include "buffers.glsl"
 #include "kernel.glsl"
 
+layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
+
 void main() {
   int i = pixel_index();
   if (i < 0) {
+    return;
+  }
+  // An adaptive second pass dispatches every pixel for samples up to the
+  // cap; a pixel whose share is done skips the accumulators' round trip.
+  if (frame.tracing.y != 0u && sample_counts[i] - frame.tracing.y <= frame.sampling.x) {
     return;
   }
   vec4 acc_mixed = accum_mixed[i];

@@ -1,111 +1,138 @@
+// The C++ executor of the adaptive allocation: the three GPU steps
+// (adaptive_weights.comp, adaptive_solve.comp, adaptive_shares.comp) in the
+// same order, with the same arithmetic (adaptive.glsl) and the same
+// reduction trees, so that both executors give out the same shares.
 #include "camhead/renderer/adaptive.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <limits>
-#include <numeric>
+#include <cstdint>
+
+#include <glm/common.hpp>
+#include <glm/exponential.hpp>
+#include <glm/vec2.hpp>
 
 namespace camhead::renderer {
+
+namespace cpu {
+namespace {
+
+using namespace glm; // the GLSL built-ins adaptive.glsl calls unqualified
+using gpu::FrameParams;
+using uint = std::uint32_t;
+
+#ifndef CAMHEAD_PI
+#define CAMHEAD_PI 3.14159265358979f
+#endif
+
+struct AdaptiveKernel {
+  const vec4 *accum_aux = nullptr;
+  FrameParams frame{};
+
+#include "adaptive.glsl"
+};
+
+constexpr uint kSolveThreads = 256; // adaptive_solve.comp's ADAPTIVE_SOLVE_THREADS
+constexpr uint kTileX = CAMHEAD_TILE_X;
+constexpr uint kTileY = CAMHEAD_TILE_Y;
+
+// A workgroup's shared-memory tree sum, in the kernels' order.
+template <std::size_t N> float tree_sum(std::array<float, N> values) {
+  for (std::size_t stride = N / 2; stride > 0; stride /= 2)
+    for (std::size_t t = 0; t < stride; ++t)
+      values[t] += values[t + stride];
+  return values[0];
+}
+
+} // namespace
+} // namespace cpu
 
 std::uint32_t adaptive_pilot(const AdaptiveSampling &settings, std::uint32_t mean_samples) {
   const std::uint32_t quarter = std::max(1u, mean_samples / 4u);
   return std::max(1u, std::min({settings.pilot, mean_samples, quarter}));
 }
 
+gpu::vec4 adaptive_parameters(const AdaptiveSampling &settings, std::uint32_t pilot,
+                              std::uint32_t mean_samples) {
+  const float cap = std::max(float(pilot), std::floor(settings.max_factor * float(mean_samples)));
+  return {settings.coc_weight, cap, 0.0f, 0.0f};
+}
+
 std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux,
                                             const gpu::FrameParams &frame, std::uint32_t pilot,
                                             const AdaptiveSampling &settings) {
-  const int width = int(frame.image.x);
-  const int height = int(frame.image.y);
-  const std::size_t pixels = std::size_t(width) * std::size_t(height);
-  const std::uint32_t mean_samples = std::max(frame.sampling.z, pilot);
-  const double n = double(std::max(pilot, 1u));
+  using cpu::kSolveThreads;
+  using cpu::kTileX;
+  using cpu::kTileY;
+  cpu::AdaptiveKernel k;
+  k.accum_aux = pilot_aux.data();
+  k.frame = frame;
+  k.frame.tracing.y = pilot;
+  k.frame.sampling.z = std::max(frame.sampling.z, pilot);
+  k.frame.adaptive = adaptive_parameters(settings, pilot, k.frame.sampling.z);
+  const std::uint32_t width = frame.image.x;
+  const std::uint32_t height = frame.image.y;
+  const std::size_t pixels = std::size_t(width) * height;
 
-  // Per pixel: the pilot's mean luminance and sample variance.
-  std::vector<double> mean(pixels), variance(pixels);
-  double image_mean = 0.0;
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const glm::vec4 a = pilot_aux[i];
-    mean[i] = double(a.z) / n;
-    const double second = double(a.w) / n;
-    variance[i] = n > 1.0 ? std::max(0.0, second - mean[i] * mean[i]) * n / (n - 1.0) : 0.0;
-    image_mean += std::abs(mean[i]);
-  }
-  image_mean /= double(std::max<std::size_t>(pixels, 1));
-
-  // Each pixel's weight, an estimate of the standard deviation of one of its
-  // samples: the largest pilot variance in its 3x3 neighbourhood (a pilot of
-  // a few samples misses edges that its neighbours catch), a quarter of the
-  // variance of the neighbourhood's samples pooled (which alone sees
-  // anything when the pilot is one sample), and a floor from the circle of
-  // confusion.
-  const double aperture = frame.lens.x;
-  const double focus = frame.lens.y;
-  const double focal_px = frame.lens.z;
-  std::vector<double> weight(pixels);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      double largest = 0.0, sum = 0.0, squares = 0.0, count = 0.0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= width || ny >= height)
-            continue;
-          const std::size_t j = std::size_t(ny) * width + nx;
-          largest = std::max(largest, variance[j]);
-          sum += pilot_aux[j].z;
-          squares += pilot_aux[j].w;
-          count += n;
-        }
-      const double pooled_mean = sum / count;
-      const double pooled = std::max(0.0, squares / count - pooled_mean * pooled_mean);
-      const std::size_t i = std::size_t(y) * width + x;
-      const glm::vec4 a = pilot_aux[i];
-      const double inverse_depth = a.y > 0.0f ? double(a.y) / double(a.x) : 0.0; // miss: infinity
-      const double coc_px =
-          aperture > 0.0 ? aperture * focal_px * std::abs(inverse_depth - 1.0 / focus) : 0.0;
-      const double coc = settings.coc_weight * std::abs(mean[i]) * std::min(coc_px, 8.0) / 8.0;
-      weight[i] = std::sqrt(largest + 0.25 * pooled + coc * coc) + 1e-3 * image_mean + 1e-12;
+  // 1. adaptive_weights.comp: weights, histogram, tile luminance, a tile
+  //    (workgroup) at a time.
+  std::vector<float> weights(pixels);
+  std::vector<std::uint32_t> histogram(2 * ADAPTIVE_BINS, 0u);
+  const std::uint32_t tiles_x = (width + kTileX - 1) / kTileX;
+  const std::uint32_t tiles_y = (height + kTileY - 1) / kTileY;
+  std::vector<float> tiles(std::size_t(tiles_x) * tiles_y);
+  for (std::uint32_t ty = 0; ty < tiles_y; ++ty)
+    for (std::uint32_t tx = 0; tx < tiles_x; ++tx) {
+      // By local invocation index, as the kernel's shared array.
+      std::array<float, kTileX * kTileY> luminance{};
+      for (std::uint32_t t = 0; t < kTileX * kTileY; ++t) {
+        const std::uint32_t x = tx * kTileX + t % kTileX, y = ty * kTileY + t / kTileX;
+        if (x >= width || y >= height)
+          continue;
+        const std::size_t i = std::size_t(y) * width + x;
+        const float w = k.adaptive_weight(int(x), int(y));
+        weights[i] = w;
+        const std::uint32_t bin = k.adaptive_bin(w);
+        histogram[2 * bin] += 1u;
+        histogram[2 * bin + 1] += k.adaptive_bin_offset(w);
+        luminance[t] = std::abs(k.adaptive_moments(pilot_aux[i], float(pilot)).x);
+      }
+      tiles[std::size_t(ty) * tiles_x + tx] = cpu::tree_sum(luminance);
     }
 
-  // Water-filling: n_i = clamp(lambda w_i, pilot, cap) with lambda such that
-  // the n_i add up to the budget, which minimises sum sigma_i^2 / n_i.
-  const double cap =
-      std::max(double(pilot), std::floor(double(settings.max_factor) * mean_samples));
-  const double budget = double(pixels) * mean_samples;
-  const auto total_at = [&](double lambda) {
-    double total = 0.0;
-    for (std::size_t i = 0; i < pixels; ++i)
-      total += std::clamp(lambda * weight[i], double(pilot), cap);
-    return total;
+  // 2. adaptive_solve.comp: floor weight and water level.
+  std::array<float, kSolveThreads> partial{};
+  for (std::size_t g = 0; g < tiles.size(); ++g)
+    partial[g % kSolveThreads] += tiles[g];
+  const float floor_weight =
+      ADAPTIVE_FLOOR_FRACTION * cpu::tree_sum(partial) / (float(width) * float(height)) +
+      ADAPTIVE_FLOOR_ABSOLUTE;
+  std::vector<float> mean_weight(ADAPTIVE_BINS, 0.0f);
+  for (std::uint32_t bin = 0; bin < ADAPTIVE_BINS; ++bin)
+    if (histogram[2 * bin] > 0)
+      mean_weight[bin] = k.adaptive_bin_mean(bin, histogram[2 * bin], histogram[2 * bin + 1]);
+  const float pilot_f = float(pilot);
+  const float cap = k.frame.adaptive.y;
+  const auto total_at = [&](float lambda) {
+    std::array<float, kSolveThreads> sums{};
+    for (std::uint32_t bin = 0; bin < ADAPTIVE_BINS; ++bin)
+      sums[bin % kSolveThreads] += k.adaptive_bin_total(mean_weight[bin], histogram[2 * bin],
+                                                        lambda, floor_weight, pilot_f, cap);
+    return cpu::tree_sum(sums);
   };
-  double lo = 0.0, hi = 1.0;
-  while (total_at(hi) < budget && hi < 1e30)
-    hi *= 2.0;
-  for (int it = 0; it < 200; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (total_at(mid) < budget ? lo : hi) = mid;
+  const float budget = float(width) * float(height) * float(k.frame.sampling.z);
+  float low = -ADAPTIVE_LOG2_LAMBDA_RANGE, high = ADAPTIVE_LOG2_LAMBDA_RANGE;
+  for (int step = 0; step < ADAPTIVE_BISECTION_STEPS; ++step) {
+    const float middle = 0.5f * (low + high);
+    (total_at(glm::exp2(middle)) < budget ? low : high) = middle;
   }
-  std::vector<double> target(pixels);
+  const float lambda = glm::exp2(high);
+
+  // 3. adaptive_shares.comp.
   std::vector<std::uint32_t> counts(pixels);
-  double assigned = 0.0;
-  for (std::size_t i = 0; i < pixels; ++i) {
-    target[i] = std::clamp(hi * weight[i], double(pilot), cap);
-    counts[i] = std::uint32_t(std::floor(target[i]));
-    assigned += counts[i];
-  }
-  // The rounding remainder, one sample each to the largest fractions.
-  std::vector<std::size_t> order(pixels);
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const double fa = target[a] - std::floor(target[a]), fb = target[b] - std::floor(target[b]);
-    return fa != fb ? fa > fb : a < b;
-  });
-  for (std::size_t k = 0; k < pixels && assigned < budget; ++k)
-    if (counts[order[k]] < cap) {
-      ++counts[order[k]];
-      assigned += 1.0;
-    }
+  for (std::size_t i = 0; i < pixels; ++i)
+    counts[i] = k.adaptive_share(weights[i], std::uint32_t(i), lambda, floor_weight, pilot_f, cap);
   return counts;
 }
 

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -44,49 +43,12 @@ std::array<VkDescriptorType, kBindingCount> binding_types() {
   return types;
 }
 
-bool contains_ignoring_case(const std::string &text, const std::string &part) {
-  const auto lower = [](char c) { return std::tolower(static_cast<unsigned char>(c)); };
-  return std::search(text.begin(), text.end(), part.begin(), part.end(),
-                     [&](char a, char b) { return lower(a) == lower(b); }) != text.end();
-}
-
-// GpuTracer's device rule (gpu_tracer.h), so that both find the same GPU.
-vk::PhysicalDevice choose_device(const std::vector<vk::PhysicalDevice> &devices,
-                                 const std::string &wanted) {
-  if (devices.empty())
-    throw GpuError("no Vulkan device with compute support");
-  if (wanted.empty()) {
-    for (const vk::PhysicalDevice &device : devices)
-      if (!device.quirks.software_device &&
-          (device.info.type == "discrete" || device.info.type == "integrated"))
-        return device;
-    return devices.front();
-  }
-  if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-    const std::size_t index = wanted.size() < 9 ? std::stoul(wanted) : devices.size();
-    if (index < devices.size())
-      return devices[index];
-  }
-  for (const vk::PhysicalDevice &device : devices)
-    if (contains_ignoring_case(device.info.name, wanted))
-      return device;
-  throw GpuError("no Vulkan device matches '" + wanted + "'");
-}
-
 void require_layer(const Image &image, int width, int height, int channels, const char *name) {
   if (image.width != width || image.height != height || image.channels != channels)
     throw GpuError(std::string("DofGather::apply: the pinhole render's ") + name + " layer is " +
                    std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
                    std::to_string(image.channels) + ", expected " + std::to_string(width) + "x" +
                    std::to_string(height) + "x" + std::to_string(channels));
-}
-
-Image unpack(const float *vec4s, int width, int height, int channels, int first) {
-  Image image(width, height, channels);
-  for (std::size_t i = 0; i < image.pixel_count(); ++i)
-    for (int c = 0; c < channels; ++c)
-      image.data[i * channels + c] = vec4s[i * 4 + first + c];
-  return image;
 }
 
 } // namespace
@@ -99,7 +61,7 @@ float coc_radius_px(const gpu::FrameParams &lens, float depth) {
 
 struct DofGather::Impl {
   explicit Impl(const std::string &wanted)
-      : device(choose_device(instance.compute_devices(), wanted)),
+      : device(vk::choose_device(instance.compute_devices(), wanted)),
         descriptors(device, binding_types()),
         pipeline_layout(vk::make_pipeline_layout(device, descriptors.layout())),
         gather(vk::make_compute_pipeline(
@@ -108,7 +70,8 @@ struct DofGather::Impl {
         commands(device), params(device, {.size = sizeof(GatherParams),
                                           .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                           .memory = vk::MemoryUse::upload,
-                                          .name = "gather parameters"}) {
+                                          .name = "gather parameters"}),
+        timestamps(device, 2) {
     descriptors.write(kParams, params);
   }
   ~Impl() { device.wait_idle(); }
@@ -124,6 +87,7 @@ struct DofGather::Impl {
   vk::UniquePipeline gather;
   vk::CommandRunner commands;
   vk::Buffer params;
+  vk::TimestampQueries timestamps;
   std::array<vk::Buffer, kBindingCount> buffers; // by binding; kParams unused
   vk::Buffer readback;                           // composite, mixed, real
   std::size_t allocated_pixels = 0;
@@ -203,16 +167,20 @@ DofGatherResult DofGather::Impl::apply(const RenderResult &pinhole, const gpu::F
 
   // The kernel alone, timed as the tracer times its batches.
   VkCommandBuffer command_buffer = commands.begin();
+  timestamps.reset(command_buffer);
+  timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
   vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, gather.get());
   const VkDescriptorSet set = descriptors.get();
   vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
                           1, &set, 0, nullptr);
   vkCmdDispatch(command_buffer, std::uint32_t(width + kTile - 1) / kTile,
                 std::uint32_t(height + kTile - 1) / kTile, 1);
+  timestamps.write(command_buffer, 1, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
   const Clock::time_point submitted = Clock::now();
   commands.submit_and_wait();
   DofGatherResult result;
   result.gather_s = std::chrono::duration<double>(Clock::now() - submitted).count();
+  result.device_s = timestamps.seconds(0, 1).value_or(0.0);
   result.max_radius_px = max_radius;
 
   command_buffer = commands.begin();
@@ -230,10 +198,10 @@ DofGatherResult DofGather::Impl::apply(const RenderResult &pinhole, const gpu::F
   commands.submit_and_wait();
 
   const auto *mapped = static_cast<const float *>(readback.mapped());
-  result.image.composite = unpack(mapped, width, height, 3, 0);
-  result.image.mixed = unpack(mapped + 4 * pixels, width, height, 3, 0);
-  result.image.mask = unpack(mapped + 4 * pixels, width, height, 1, 3);
-  result.image.real = unpack(mapped + 8 * pixels, width, height, 3, 0);
+  result.image.composite = vk::unpack_layer(mapped, width, height, 3, 0);
+  result.image.mixed = vk::unpack_layer(mapped + 4 * pixels, width, height, 3, 0);
+  result.image.mask = vk::unpack_layer(mapped + 4 * pixels, width, height, 1, 3);
+  result.image.real = vk::unpack_layer(mapped + 8 * pixels, width, height, 3, 0);
   result.image.depth = pinhole.depth;
   result.image.camera_rays = pinhole.camera_rays;
   result.image.seconds = std::chrono::duration<double>(Clock::now() - start).count();

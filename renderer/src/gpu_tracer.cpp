@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <chrono>
 #include <cstdint>
 #include <cstring>
@@ -14,6 +13,9 @@
 #include <optional>
 #include <span>
 
+#include "adaptive_shares_spv.h"
+#include "adaptive_solve_spv.h"
+#include "adaptive_weights_spv.h"
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/bvh.h"
 #include "resolve_spv.h"
@@ -33,7 +35,9 @@ double seconds_since(Clock::time_point start) {
 // Samples per pixel of the next trace submission, from the measured cost of
 // the previous one. Submissions of about kTargetSeconds stay well clear of
 // display-driver watchdogs (about 2 s) and report progress often, while the
-// per-submission overhead stays negligible.
+// per-submission overhead stays negligible. A sizer lives as long as the
+// loaded scene, so that a live frame of a few samples, once one frame has
+// been measured, is one submission.
 class BatchSizer {
 public:
   static constexpr double kTargetSeconds = 0.25;
@@ -60,58 +64,8 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   return types;
 }
 
-bool contains_ignoring_case(std::string_view text, std::string_view part) {
-  const auto lower = [](char c) { return std::tolower(static_cast<unsigned char>(c)); };
-  return std::search(text.begin(), text.end(), part.begin(), part.end(),
-                     [&](char a, char b) { return lower(a) == lower(b); }) != text.end();
-}
-
-std::vector<GpuDeviceInfo> infos(const std::vector<vk::PhysicalDevice> &devices) {
-  std::vector<GpuDeviceInfo> out;
-  for (const vk::PhysicalDevice &device : devices)
-    out.push_back(device.info);
-  return out;
-}
-
-// The device rule of GpuTracer's constructor (gpu_tracer.h).
-vk::PhysicalDevice choose_device(const std::vector<vk::PhysicalDevice> &devices,
-                                 const std::string &wanted) {
-  if (devices.empty())
-    throw GpuError("no Vulkan device with compute support (install a GPU driver, or Mesa's "
-                   "lavapipe from mesa-vulkan-drivers)");
-  if (wanted.empty()) {
-    for (const vk::PhysicalDevice &device : devices)
-      if (!device.quirks.software_device &&
-          (device.info.type == "discrete" || device.info.type == "integrated"))
-        return device;
-    return devices.front();
-  }
-  const std::string listing = "; available devices:\n" + format_gpu_devices(infos(devices));
-  if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-    const std::size_t index = wanted.size() < 9 ? std::stoul(wanted) : devices.size();
-    if (index >= devices.size())
-      throw GpuError("no Vulkan device with index " + wanted + listing);
-    return devices[index];
-  }
-  for (const vk::PhysicalDevice &device : devices)
-    if (contains_ignoring_case(device.info.name, wanted))
-      return device;
-  throw GpuError("no Vulkan device matches '" + wanted + "'" + listing);
-}
-
 template <typename T> std::span<const std::byte> bytes_of(const std::vector<T> &values) {
   return std::as_bytes(std::span(values));
-}
-
-// One layer of the read-back buffer (a vec4 per pixel) as an Image of
-// `channels` channels starting at component `first`; alpha is dropped.
-Image unpack(const float *vec4s, int width, int height, int channels, int first) {
-  Image image(width, height, channels);
-  const std::size_t pixels = image.pixel_count();
-  for (std::size_t i = 0; i < pixels; ++i)
-    for (int c = 0; c < channels; ++c)
-      image.data[i * channels + c] = vec4s[i * 4 + first + c];
-  return image;
 }
 
 // The per-pixel buffers, in the order the read-back buffer holds the outputs.
@@ -139,7 +93,7 @@ std::vector<GpuDeviceInfo> list_gpu_devices() {
       return {};
     throw;
   }
-  return infos(instance->compute_devices());
+  return vk::device_infos(instance->compute_devices());
 }
 
 struct GpuTracer::Impl {
@@ -149,13 +103,24 @@ struct GpuTracer::Impl {
   void load(const CompiledScene &scene);
   RenderResult render(const gpu::FrameParams &requested, const ProgressFn &progress,
                       LayerSelection layers, const AdaptiveSampling *adaptive);
-  // Adds samples [0, end) to the accumulators in batches (clearing them
-  // first if `clear`); `report` gets the samples done.
-  void trace_batches(gpu::FrameParams &frame, std::uint32_t end, bool clear,
-                     const std::function<void(std::uint32_t)> &report);
-  // The accumulated aux layer (layout.h), through the read-back buffer.
-  std::vector<glm::vec4> read_accum_aux();
-  void dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
+  // Records commands into a command buffer.
+  using Recorder = std::function<void(VkCommandBuffer)>;
+  // Adds samples [0, end) of `frame` to the accumulators in batches sized by
+  // `sizer`, one submission each; `prologue` records commands into the first
+  // submission, before its batch, and `epilogue` into the last, after it
+  // (both submitted also when `end` is 0). `report` gets the samples done.
+  // Returns the number of submissions.
+  int trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
+                    const Recorder &prologue, const Recorder &epilogue,
+                    const std::function<void(std::uint32_t)> &report);
+  // Records the accumulators' clear, ordered before the kernels.
+  void record_clear(VkCommandBuffer command_buffer) const;
+  // Records adaptive_weights, _solve and _shares (adaptive.glsl) after the
+  // pilot: sample_counts and the adaptive solution, ordered before the kernels.
+  void record_allocation(VkCommandBuffer command_buffer) const;
+  // Dispatches `pipeline` over the image's tiles, or over `groups`.
+  void dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
+                std::optional<glm::uvec2> groups = std::nullopt) const;
 
   // Declaration order is destruction order in reverse: everything made from
   // the device goes before it, and the device before the instance.
@@ -165,10 +130,18 @@ struct GpuTracer::Impl {
   vk::UniquePipelineLayout pipeline_layout;
   vk::UniquePipeline trace;
   vk::UniquePipeline resolve;
+  vk::UniquePipeline adaptive_weights;
+  vk::UniquePipeline adaptive_solve;
+  vk::UniquePipeline adaptive_shares;
   vk::CommandRunner commands;
   vk::Buffer frame_uniform;
+  // 0: the frame's first command, 1: its last; 2, 3: around the adaptive
+  // allocation (adaptive frames only).
+  vk::TimestampQueries timestamps;
   std::array<vk::Buffer, BINDING_COUNT> buffers; // by binding; BINDING_FRAME unused
-  vk::Buffer readback; // the kOutputs, one after another, then the display image
+  // The kOutputs one after another, then the display image, the sample
+  // counts and the adaptive solution.
+  vk::Buffer readback;
 
   bool loaded = false;
   std::uint32_t width = 0;
@@ -176,20 +149,33 @@ struct GpuTracer::Impl {
   bool has_plate = false;
   gpu::uvec4 counts{};    // primitives, nodes, lights
   glm::vec3 origin{0.0f}; // CompiledScene::origin of the loaded scene
+  // Batch sizes, one per kind of pass, for the loaded scene.
+  BatchSizer uniform_sizer;
+  BatchSizer second_pass_sizer;
 };
 
 GpuTracer::Impl::Impl(const std::string &wanted)
-    : device(choose_device(instance.compute_devices(), wanted)),
+    : device(vk::choose_device(instance.compute_devices(), wanted)),
       descriptors(device, binding_types()),
       pipeline_layout(vk::make_pipeline_layout(device, descriptors.layout())),
       trace(vk::make_compute_pipeline(
           device, {.layout = pipeline_layout.get(), .spirv = trace_spv, .name = "trace.comp"})),
       resolve(vk::make_compute_pipeline(
           device, {.layout = pipeline_layout.get(), .spirv = resolve_spv, .name = "resolve.comp"})),
+      adaptive_weights(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                          .spirv = adaptive_weights_spv,
+                                                          .name = "adaptive_weights.comp"})),
+      adaptive_solve(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                        .spirv = adaptive_solve_spv,
+                                                        .name = "adaptive_solve.comp"})),
+      adaptive_shares(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                         .spirv = adaptive_shares_spv,
+                                                         .name = "adaptive_shares.comp"})),
       commands(device), frame_uniform(device, {.size = sizeof(gpu::FrameParams),
                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                                .memory = vk::MemoryUse::upload,
-                                               .name = "frame parameters"}) {
+                                               .name = "frame parameters"}),
+      timestamps(device, 4) {
   descriptors.write(BINDING_FRAME, frame_uniform);
 }
 
@@ -243,10 +229,21 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
                                                     VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                                                     VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                            .name = "accumulator"});
-  buffers[BINDING_SAMPLE_COUNTS] = vk::Buffer(
-      device, {.size = pixels * sizeof(std::uint32_t),
-               .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-               .name = "sample counts"});
+  const auto scratch = [&](int binding, VkDeviceSize size, const char *name) {
+    buffers[binding] = vk::Buffer(device, {.size = size,
+                                           .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                           .name = name});
+  };
+  const std::size_t tiles = std::size_t((scene.width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X) *
+                            std::size_t((scene.height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y);
+  scratch(BINDING_SAMPLE_COUNTS, pixels * sizeof(std::uint32_t), "sample counts");
+  scratch(BINDING_ADAPTIVE_WEIGHTS, pixels * sizeof(float), "adaptive weights");
+  scratch(BINDING_ADAPTIVE_HISTOGRAM, 2 * ADAPTIVE_BINS * sizeof(std::uint32_t),
+          "adaptive histogram");
+  scratch(BINDING_ADAPTIVE_GROUPS, tiles * sizeof(float), "adaptive tile sums");
+  scratch(BINDING_ADAPTIVE_SOLUTION, sizeof(gpu::AdaptiveSolution), "adaptive solution");
   for (const int binding : kOutputs)
     buffers[binding] = vk::Buffer(
         device, {.size = layer_bytes,
@@ -256,7 +253,8 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
       device, {.size = pixels * sizeof(std::uint32_t),
                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                .name = "display output"});
-  readback = vk::Buffer(device, {.size = layer_bytes * kOutputs.size() + pixels * 4,
+  readback = vk::Buffer(device, {.size = layer_bytes * kOutputs.size() + 2 * pixels * 4 +
+                                         sizeof(gpu::AdaptiveSolution),
                                  .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                  .memory = vk::MemoryUse::readback,
                                  .name = "read-back"});
@@ -269,16 +267,21 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   has_plate = !scene.plate.empty();
   counts = gpu::uvec4(scene.primitives.size(), scene.nodes.size(), scene.lights.size(), 0);
   origin = scene.origin;
+  uniform_sizer = {};
+  second_pass_sizer = {};
   loaded = true;
 }
 
-void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
+void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
+                               std::optional<glm::uvec2> groups) const {
   vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   const VkDescriptorSet set = descriptors.get();
   vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
                           1, &set, 0, nullptr);
-  vkCmdDispatch(command_buffer, (width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
-                (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y, 1);
+  const glm::uvec2 count =
+      groups.value_or(glm::uvec2((width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
+                                 (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y));
+  vkCmdDispatch(command_buffer, count.x, count.y, 1);
 }
 
 RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const ProgressFn &progress,
@@ -301,72 +304,83 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   frame.image.z = requested.image.z != 0 && has_plate ? 1u : 0u;
   frame.image.w = counts.z;
 
-  FrameTimings timings;
-  Clock::time_point phase = Clock::now();
-  std::vector<std::uint32_t> shares;
-  std::uint64_t rays = std::uint64_t(width) * height * total;
-  if (adaptive == nullptr) {
-    frame.tracing.y = 0u;
-    trace_batches(frame, total, true, [&](std::uint32_t done) {
-      if (progress)
-        progress(static_cast<int>(done), static_cast<int>(total));
-    });
-  } else {
-    // adaptive.h: a pilot, the budget from what it saw, each pixel's share.
-    const std::uint32_t pilot = adaptive_pilot(*adaptive, total);
-    const auto report = [&](double done) {
-      if (progress)
-        progress(static_cast<int>(done), static_cast<int>(total));
-    };
-    frame.tracing.y = 0u;
-    frame.sampling.z = pilot;
-    trace_batches(frame, pilot, true, report);
-    gpu::FrameParams budget_frame = requested;
-    budget_frame.image = frame.image;
-    shares = allocate_samples(read_accum_aux(), budget_frame, pilot, *adaptive);
-    vk::Uploader uploader(device);
-    uploader.upload(buffers[BINDING_SAMPLE_COUNTS], bytes_of(shares));
-    uploader.flush(commands);
-    const std::uint32_t most = *std::max_element(shares.begin(), shares.end());
-    frame.tracing.y = pilot;
-    frame.sampling.z = total;
-    trace_batches(frame, most - pilot, false, [&](std::uint32_t done) {
-      report(pilot + double(done) * (total - pilot) / std::max(most - pilot, 1u));
-    });
-    rays = 0;
-    for (const std::uint32_t n : shares)
-      rays += n;
-  }
-  timings.trace_s = seconds_since(phase);
-  phase = Clock::now();
-
-  frame.sampling = gpu::uvec4(0, total, total, requested.sampling.w);
-  std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);
-  VkCommandBuffer command_buffer = commands.begin();
-  dispatch(command_buffer, resolve.get());
-  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                     VK_ACCESS_TRANSFER_READ_BIT);
+  // Where the read-back buffer holds what comes back.
   const VkDeviceSize layer_bytes = buffers[BINDING_OUT_AUX].size();
-  const std::array<bool, kOutputs.size()> wanted = {selection.composite, selection.mixed,
-                                                    selection.real, selection.mask_and_depth};
-  for (std::size_t i = 0; i < kOutputs.size(); ++i) {
-    if (!wanted[i])
-      continue;
-    const VkBufferCopy region{0, i * layer_bytes, layer_bytes};
-    vkCmdCopyBuffer(command_buffer, buffers[kOutputs[i]].get(), readback.get(), 1, &region);
-  }
   const VkDeviceSize display_offset = kOutputs.size() * layer_bytes;
   const VkDeviceSize display_bytes = buffers[BINDING_OUT_DISPLAY].size();
-  if (selection.display) {
-    const VkBufferCopy region{0, display_offset, display_bytes};
-    vkCmdCopyBuffer(command_buffer, buffers[BINDING_OUT_DISPLAY].get(), readback.get(), 1, &region);
+  const VkDeviceSize counts_offset = display_offset + display_bytes;
+  const VkDeviceSize counts_bytes = buffers[BINDING_SAMPLE_COUNTS].size();
+  const VkDeviceSize solution_offset = counts_offset + counts_bytes;
+
+  // The frame's first commands: the clear, and the first timestamp.
+  const auto begin_frame = [&](VkCommandBuffer command_buffer) {
+    timestamps.reset(command_buffer);
+    timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
+    record_clear(command_buffer);
+  };
+  // Its last: the resolve kernel (which reads sampling.z and tracing.y alone,
+  // so it shares the last batch's uniform and submission), the copies to the
+  // read-back buffer and the second timestamp.
+  const auto end_frame = [&](VkCommandBuffer command_buffer) {
+    dispatch(command_buffer, resolve.get());
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                       VK_ACCESS_TRANSFER_READ_BIT);
+    const auto copy = [&](int binding, VkDeviceSize offset, VkDeviceSize bytes) {
+      const VkBufferCopy region{0, offset, bytes};
+      vkCmdCopyBuffer(command_buffer, buffers[binding].get(), readback.get(), 1, &region);
+    };
+    const std::array<bool, kOutputs.size()> wanted = {selection.composite, selection.mixed,
+                                                      selection.real, selection.mask_and_depth};
+    for (std::size_t i = 0; i < kOutputs.size(); ++i)
+      if (wanted[i])
+        copy(kOutputs[i], i * layer_bytes, layer_bytes);
+    if (selection.display)
+      copy(BINDING_OUT_DISPLAY, display_offset, display_bytes);
+    if (adaptive != nullptr) {
+      if (selection.sample_counts)
+        copy(BINDING_SAMPLE_COUNTS, counts_offset, counts_bytes);
+      copy(BINDING_ADAPTIVE_SOLUTION, solution_offset, sizeof(gpu::AdaptiveSolution));
+    }
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    timestamps.write(command_buffer, 1, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+  };
+  const auto report = [&](double done) {
+    if (progress)
+      progress(static_cast<int>(done), static_cast<int>(total));
+  };
+
+  FrameTimings timings;
+  if (adaptive == nullptr) {
+    frame.tracing.y = 0u;
+    timings.submissions = trace_batches(frame, total, uniform_sizer, begin_frame, end_frame,
+                                        [&](std::uint32_t done) { report(done); });
+  } else {
+    // adaptive.h: a pilot, each pixel's share from what it saw, the shares.
+    const std::uint32_t pilot = adaptive_pilot(*adaptive, total);
+    frame.tracing.y = 0u;
+    frame.sampling.z = pilot;
+    timings.submissions = trace_batches(frame, pilot, uniform_sizer, begin_frame, {},
+                                        [&](std::uint32_t done) { report(done); });
+    frame.tracing.y = pilot;
+    frame.sampling.z = total;
+    frame.adaptive = adaptive_parameters(*adaptive, pilot, total);
+    // Only the cap is known here, not the largest share (that would take a
+    // read-back): pixels whose share is done skip the later samples.
+    const std::uint32_t cap = std::uint32_t(frame.adaptive.y);
+    timings.submissions += trace_batches(
+        frame, cap - pilot, second_pass_sizer,
+        [&](VkCommandBuffer command_buffer) { record_allocation(command_buffer); }, end_frame,
+        [&](std::uint32_t done) {
+          report(pilot + double(done) * (total - pilot) / (cap - pilot));
+        });
   }
-  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                     VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-  commands.submit_and_wait();
-  timings.resolve_s = seconds_since(phase);
-  phase = Clock::now();
+  timings.submit_s = seconds_since(start);
+  timings.device_s = timestamps.seconds(0, 1).value_or(0.0);
+  if (adaptive != nullptr)
+    timings.allocation_s = timestamps.seconds(2, 3).value_or(0.0);
+  const Clock::time_point unpacking = Clock::now();
 
   const auto *mapped = static_cast<const std::uint8_t *>(readback.mapped());
   const auto layer = [&](std::size_t slot) {
@@ -376,79 +390,99 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   const int h = static_cast<int>(height);
   RenderResult result;
   if (selection.composite)
-    result.composite = unpack(layer(0), w, h, 3, 0);
+    result.composite = vk::unpack_layer(layer(0), w, h, 3, 0);
   if (selection.mixed)
-    result.mixed = unpack(layer(1), w, h, 3, 0);
+    result.mixed = vk::unpack_layer(layer(1), w, h, 3, 0);
   if (selection.real)
-    result.real = unpack(layer(2), w, h, 3, 0);
+    result.real = vk::unpack_layer(layer(2), w, h, 3, 0);
   if (selection.mask_and_depth) {
     const float *aux = layer(3);
-    result.mask = unpack(aux, w, h, 1, 0);  // out_aux.x
-    result.depth = unpack(aux, w, h, 1, 1); // out_aux.y
+    result.mask = vk::unpack_layer(aux, w, h, 1, 0);  // out_aux.x
+    result.depth = vk::unpack_layer(aux, w, h, 1, 1); // out_aux.y
   }
-  if (selection.display) {
+  if (selection.display)
     result.display.assign(mapped + display_offset, mapped + display_offset + display_bytes);
+  result.camera_rays = std::uint64_t(width) * height * total;
+  if (adaptive != nullptr) {
+    gpu::AdaptiveSolution solution;
+    std::memcpy(&solution, mapped + solution_offset, sizeof solution);
+    result.camera_rays = std::uint64_t(solution.rays.y) << 32 | solution.rays.x;
+    if (selection.sample_counts) {
+      const auto *shares = reinterpret_cast<const std::uint32_t *>(mapped + counts_offset);
+      result.sample_counts.assign(shares, shares + std::size_t(width) * height);
+    }
   }
-  result.camera_rays = rays;
-  result.sample_counts = std::move(shares);
-  timings.unpack_s = seconds_since(phase);
+  timings.unpack_s = seconds_since(unpacking);
   result.timings = timings;
   result.seconds = seconds_since(start);
   return result;
 }
 
-void GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, bool clear,
-                                    const std::function<void(std::uint32_t)> &report) {
+void GpuTracer::Impl::record_clear(VkCommandBuffer command_buffer) const {
+  for (const int binding : kAccumulators)
+    vkCmdFillBuffer(command_buffer, buffers[binding].get(), 0, VK_WHOLE_SIZE, 0);
+  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
+  const auto compute_to_compute = [&] {
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  };
+  timestamps.write(command_buffer, 2, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
+  vkCmdFillBuffer(command_buffer, buffers[BINDING_ADAPTIVE_HISTOGRAM].get(), 0, VK_WHOLE_SIZE, 0);
+  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  dispatch(command_buffer, adaptive_weights.get());
+  compute_to_compute();
+  dispatch(command_buffer, adaptive_solve.get(), glm::uvec2(1, 1));
+  compute_to_compute();
+  dispatch(command_buffer, adaptive_shares.get());
+  compute_to_compute();
+  timestamps.write(command_buffer, 3, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+}
+
+int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
+                                   const Recorder &prologue, const Recorder &epilogue,
+                                   const std::function<void(std::uint32_t)> &report) {
   // One uniform buffer suffices because each batch is waited for before the
   // next one rewrites it.
-  BatchSizer sizer;
-  if (clear && end == 0) {
-    VkCommandBuffer command_buffer = commands.begin();
-    for (const int binding : kAccumulators)
-      vkCmdFillBuffer(command_buffer, buffers[binding].get(), 0, VK_WHOLE_SIZE, 0);
-    commands.submit_and_wait();
-  }
-  for (std::uint32_t done = 0; done < end;) {
+  int submissions = 0;
+  std::uint32_t done = 0;
+  do {
     const std::uint32_t batch = std::min(sizer.next(), end - done);
     frame.sampling.x = done;
     frame.sampling.y = done + batch;
     std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);
 
     VkCommandBuffer command_buffer = commands.begin();
-    if (done == 0 && clear) {
-      for (const int binding : kAccumulators)
-        vkCmdFillBuffer(command_buffer, buffers[binding].get(), 0, VK_WHOLE_SIZE, 0);
-      vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+    if (done == 0 && prologue)
+      prologue(command_buffer);
+    if (batch > 0) {
+      dispatch(command_buffer, trace.get());
+      // Orders this batch's accumulation before the next batch or the resolve.
+      vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     }
-    dispatch(command_buffer, trace.get());
-    // Orders this batch's accumulation before the next batch or the resolve.
-    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    if (done + batch == end && epilogue)
+      epilogue(command_buffer);
     const Clock::time_point submitted = Clock::now();
     commands.submit_and_wait();
-    sizer.measured(batch, seconds_since(submitted));
+    ++submissions;
+    // A batch that carries the frame's set-up or resolve looks a little
+    // dearer per sample than it is: the next batch comes out a little smaller.
+    if (batch > 0)
+      sizer.measured(batch, seconds_since(submitted));
     done += batch;
-    if (report)
+    if (report && batch > 0)
       report(done);
-  }
-}
-
-std::vector<glm::vec4> GpuTracer::Impl::read_accum_aux() {
-  const VkDeviceSize layer_bytes = buffers[BINDING_ACCUM_AUX].size();
-  VkCommandBuffer command_buffer = commands.begin();
-  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                     VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                     VK_ACCESS_TRANSFER_READ_BIT);
-  const VkBufferCopy region{0, 0, layer_bytes};
-  vkCmdCopyBuffer(command_buffer, buffers[BINDING_ACCUM_AUX].get(), readback.get(), 1, &region);
-  vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                     VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-  commands.submit_and_wait();
-  const auto *values = static_cast<const glm::vec4 *>(readback.mapped());
-  return std::vector<glm::vec4>(values, values + std::size_t(width) * height);
+  } while (done < end);
+  return submissions;
 }
 
 GpuTracer::GpuTracer(const std::string &device) : impl_(std::make_unique<Impl>(device)) {}

@@ -1,10 +1,13 @@
 // Errors, driver quirks, the instance, device discovery and the logical device.
 #include "vulkan_context.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <string_view>
 
 #include <dlfcn.h>
 
@@ -176,6 +179,7 @@ std::vector<PhysicalDevice> Instance::compute_devices() const {
       device.info.name = properties.deviceName;
       device.info.type = device_type_name(properties.deviceType);
       device.compute_family = family;
+      device.timestamp_bits = families[family].timestampValidBits;
       device.quirks = detect_quirks(properties);
       devices.push_back(std::move(device));
       break;
@@ -257,6 +261,60 @@ void Device::wait_idle() const noexcept {
   // Used on teardown paths, where a lost device must not throw again.
   if (device_ != VK_NULL_HANDLE)
     static_cast<void>(vkDeviceWaitIdle(device_));
+}
+
+// ---------------------------------------------------------------------------
+// Device choice and read-back
+
+namespace {
+
+bool contains_ignoring_case(std::string_view text, std::string_view part) {
+  const auto lower = [](char c) { return std::tolower(static_cast<unsigned char>(c)); };
+  return std::search(text.begin(), text.end(), part.begin(), part.end(),
+                     [&](char a, char b) { return lower(a) == lower(b); }) != text.end();
+}
+
+} // namespace
+
+std::vector<GpuDeviceInfo> device_infos(const std::vector<PhysicalDevice> &devices) {
+  std::vector<GpuDeviceInfo> out;
+  for (const PhysicalDevice &device : devices)
+    out.push_back(device.info);
+  return out;
+}
+
+PhysicalDevice choose_device(const std::vector<PhysicalDevice> &devices,
+                             const std::string &wanted) {
+  if (devices.empty())
+    throw GpuError("no Vulkan device with compute support (install a GPU driver, or Mesa's "
+                   "lavapipe from mesa-vulkan-drivers)");
+  if (wanted.empty()) {
+    for (const PhysicalDevice &device : devices)
+      if (!device.quirks.software_device &&
+          (device.info.type == "discrete" || device.info.type == "integrated"))
+        return device;
+    return devices.front();
+  }
+  const std::string listing = "; available devices:\n" + format_gpu_devices(device_infos(devices));
+  if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    const std::size_t index = wanted.size() < 9 ? std::stoul(wanted) : devices.size();
+    if (index >= devices.size())
+      throw GpuError("no Vulkan device with index " + wanted + listing);
+    return devices[index];
+  }
+  for (const PhysicalDevice &device : devices)
+    if (contains_ignoring_case(device.info.name, wanted))
+      return device;
+  throw GpuError("no Vulkan device matches '" + wanted + "'" + listing);
+}
+
+Image unpack_layer(const float *vec4s, int width, int height, int channels, int first) {
+  Image image(width, height, channels);
+  const std::size_t pixels = image.pixel_count();
+  for (std::size_t i = 0; i < pixels; ++i)
+    for (int c = 0; c < channels; ++c)
+      image.data[i * channels + c] = vec4s[i * 4 + first + c];
+  return image;
 }
 
 } // namespace camhead::renderer::vk

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -73,6 +74,7 @@ using UniquePipeline = DeviceHandle<VkPipeline, vkDestroyPipeline>;
 using UniqueShaderModule = DeviceHandle<VkShaderModule, vkDestroyShaderModule>;
 using UniqueCommandPool = DeviceHandle<VkCommandPool, vkDestroyCommandPool>;
 using UniqueFence = DeviceHandle<VkFence, vkDestroyFence>;
+using UniqueQueryPool = DeviceHandle<VkQueryPool, vkDestroyQueryPool>;
 
 // Driver-specific decisions, made once per device in the "Driver quirks"
 // section of vulkan_context.cpp (with the process-wide ones), so that the rest
@@ -88,6 +90,7 @@ struct PhysicalDevice {
   VkPhysicalDevice handle = VK_NULL_HANDLE;
   GpuDeviceInfo info;
   std::uint32_t compute_family = 0;
+  std::uint32_t timestamp_bits = 0; // of the compute queue; 0: no timestamps
   DriverQuirks quirks;
 };
 
@@ -119,6 +122,20 @@ private:
   bool validation_ = false;
 };
 
+// The devices' GpuDeviceInfo, in order.
+[[nodiscard]] std::vector<GpuDeviceInfo> device_infos(const std::vector<PhysicalDevice> &devices);
+
+// The device rule of GpuTracer's constructor (gpu_tracer.h), shared by every
+// user of the GPU so that all find the same one. Throws GpuError naming the
+// devices there are.
+[[nodiscard]] PhysicalDevice choose_device(const std::vector<PhysicalDevice> &devices,
+                                           const std::string &wanted);
+
+// One layer of a read-back buffer (a vec4 per pixel) as an Image of
+// `channels` channels starting at component `first`.
+[[nodiscard]] Image unpack_layer(const float *vec4s, int width, int height, int channels,
+                                 int first);
+
 // Where a buffer lives, which decides the memory type.
 enum class MemoryUse {
   device_local, // kernels read and write it; filled by Uploader
@@ -140,6 +157,7 @@ public:
   [[nodiscard]] const std::string &name() const { return physical_.info.name; }
   [[nodiscard]] const DriverQuirks &quirks() const { return physical_.quirks; }
   [[nodiscard]] const VkPhysicalDeviceLimits &limits() const { return properties_.limits; }
+  [[nodiscard]] std::uint32_t timestamp_bits() const { return physical_.timestamp_bits; }
 
   // A memory type allowed by `type_bits` for `use`; throws GpuError if none.
   [[nodiscard]] std::uint32_t memory_type(std::uint32_t type_bits, MemoryUse use) const;
@@ -197,6 +215,31 @@ private:
   UniqueCommandPool pool_;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE; // freed with the pool
   UniqueFence fence_;
+};
+
+// Timestamps written by the device into a query pool: how long work took on
+// the device itself, without the submission latency that a host clock around
+// it includes (bench/RESULTS.md: most of a frame under 3 ms on an H100).
+class TimestampQueries {
+public:
+  TimestampQueries(const Device &device, std::uint32_t count);
+
+  // False where the compute queue has no timestamps; the other calls are
+  // then no-ops and seconds() is empty.
+  [[nodiscard]] bool supported() const { return pool_.get() != VK_NULL_HANDLE; }
+  // Records the reset of every query; must precede their writes.
+  void reset(VkCommandBuffer command_buffer) const;
+  // Records query `index`: the time when all earlier commands finished
+  // `stage` (top of pipe: when the next ones start).
+  void write(VkCommandBuffer command_buffer, std::uint32_t index,
+             VkPipelineStageFlagBits stage) const;
+  // Seconds from query `from` to query `to`, both executed.
+  [[nodiscard]] std::optional<double> seconds(std::uint32_t from, std::uint32_t to) const;
+
+private:
+  const Device *device_;
+  UniqueQueryPool pool_;
+  std::uint32_t count_ = 0;
 };
 
 // Fills device-local buffers: through the mapping where the memory is

@@ -1,4 +1,5 @@
 // Buffers, uploads, command submission, descriptors and compute pipelines.
+#include <array>
 #include <cstring>
 #include <string>
 
@@ -100,6 +101,48 @@ void CommandRunner::submit_and_wait() {
   // as VK_ERROR_DEVICE_LOST, and a slow software device is merely slow.
   device_->check(vkWaitForFences(device_->get(), 1, &fence, VK_TRUE, UINT64_MAX),
                  "vkWaitForFences");
+}
+
+// ---------------------------------------------------------------------------
+// TimestampQueries
+
+TimestampQueries::TimestampQueries(const Device &device, std::uint32_t count)
+    : device_(&device), count_(count) {
+  if (device.timestamp_bits() == 0 || count == 0)
+    return;
+  VkQueryPoolCreateInfo create{};
+  create.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+  create.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  create.queryCount = count;
+  VkQueryPool pool = VK_NULL_HANDLE;
+  device.check(vkCreateQueryPool(device.get(), &create, nullptr, &pool), "vkCreateQueryPool");
+  pool_ = UniqueQueryPool(device.get(), pool);
+}
+
+void TimestampQueries::reset(VkCommandBuffer command_buffer) const {
+  if (supported())
+    vkCmdResetQueryPool(command_buffer, pool_.get(), 0, count_);
+}
+
+void TimestampQueries::write(VkCommandBuffer command_buffer, std::uint32_t index,
+                             VkPipelineStageFlagBits stage) const {
+  if (supported())
+    vkCmdWriteTimestamp(command_buffer, stage, pool_.get(), index);
+}
+
+std::optional<double> TimestampQueries::seconds(std::uint32_t from, std::uint32_t to) const {
+  if (!supported())
+    return std::nullopt;
+  std::array<std::uint64_t, 2> ticks{};
+  for (int k = 0; k < 2; ++k)
+    device_->check(vkGetQueryPoolResults(device_->get(), pool_.get(), k == 0 ? from : to, 1,
+                                         sizeof(std::uint64_t), &ticks[k], sizeof(std::uint64_t),
+                                         VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                   "vkGetQueryPoolResults");
+  const std::uint32_t bits = device_->timestamp_bits();
+  const std::uint64_t mask = bits >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << bits) - 1;
+  const std::uint64_t elapsed = (ticks[1] - ticks[0]) & mask; // survives one wrap
+  return double(elapsed) * double(device_->limits().timestampPeriod) * 1e-9;
 }
 
 // ---------------------------------------------------------------------------

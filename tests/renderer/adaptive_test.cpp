@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numeric>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "camhead/renderer/adaptive.h"
@@ -24,12 +25,26 @@ std::uint64_t sum(const std::vector<std::uint32_t> &counts) {
   return std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
 }
 
+// How far the total of the shares may stray from the budget (adaptive.glsl):
+// each share is rounded at random, one Bernoulli draw of variance <= 1/4 per
+// pixel (four standard deviations allowed), and the water level is found on
+// a histogram whose bins place their weights to 1/256 of a bin of 4.4 %
+// (0.05 % of the budget allowed).
+double budget_tolerance(std::size_t pixels, double budget) {
+  return 4.0 * 0.5 * std::sqrt(double(pixels)) + 5e-4 * budget;
+}
+
+void expect_near_budget(std::uint64_t total, std::size_t pixels, std::uint64_t budget) {
+  EXPECT_NEAR(double(total), double(budget), budget_tolerance(pixels, double(budget)))
+      << "shares add up to " << total << " of a budget of " << budget;
+}
+
 renderer::Scene reference_scene(const std::string &name, int divisor) {
   return test::downscaled(renderer::load_scene(test::shared_dir() / "reference" / (name + ".json")),
                           divisor);
 }
 
-TEST(AdaptiveAllocation, NoisyPixelsGetMoreAndTheTotalIsTheBudget) {
+TEST(AdaptiveAllocation, NoisyPixelsGetMoreAndTheTotalIsTheBudgetInExpectation) {
   renderer::gpu::FrameParams frame{};
   frame.image = {16u, 8u, 0u, 0u};
   frame.sampling = {0u, 9u, 9u, 1u};
@@ -43,7 +58,7 @@ TEST(AdaptiveAllocation, NoisyPixelsGetMoreAndTheTotalIsTheBudget) {
       aux[y * 16 + x] = glm::vec4(2.0f, 2.0f, 1.0f, noisy ? 1.0f : 0.5f);
     }
   const auto counts = renderer::allocate_samples(aux, frame, pilot, AdaptiveSampling{});
-  EXPECT_EQ(sum(counts), 16u * 8u * 9u);
+  expect_near_budget(sum(counts), counts.size(), 16u * 8u * 9u);
   for (int y = 0; y < 8; ++y) {
     EXPECT_EQ(counts[y * 16 + 0], pilot) << "a quiet pixel away from the noise gets the pilot";
     EXPECT_GT(counts[y * 16 + 15], 9u);
@@ -61,8 +76,8 @@ TEST(AdaptiveAllocation, PilotLeavesRaysToShare) {
 
 class Adaptive : public ::testing::TestWithParam<std::string> {};
 
-// The shares on a reference scene: the budget exactly, at least the pilot
-// everywhere, and the mean share in and out of focus printed.
+// The shares on a reference scene: the budget, at least the pilot and at
+// most the cap everywhere, and the mean share in and out of focus printed.
 TEST_P(Adaptive, SharesAddUpToTheBudget) {
   constexpr int rpp = 16;
   const renderer::Scene scene = reference_scene(GetParam(), 8);
@@ -73,13 +88,18 @@ TEST_P(Adaptive, SharesAddUpToTheBudget) {
   ASSERT_TRUE(test::all_finite(r.mask));
   const std::size_t pixels = r.composite.pixel_count();
   ASSERT_EQ(r.sample_counts.size(), pixels);
-  EXPECT_EQ(sum(r.sample_counts), std::uint64_t(pixels) * rpp);
-  EXPECT_EQ(r.camera_rays, std::uint64_t(pixels) * rpp);
+  expect_near_budget(sum(r.sample_counts), pixels, std::uint64_t(pixels) * rpp);
+  std::printf("%s: %llu samples given out of a budget of %llu\n", GetParam().c_str(),
+              static_cast<unsigned long long>(sum(r.sample_counts)),
+              static_cast<unsigned long long>(pixels * rpp));
+  EXPECT_EQ(r.camera_rays, sum(r.sample_counts));
   const std::uint32_t pilot = renderer::adaptive_pilot(AdaptiveSampling{}, rpp);
+  const std::uint32_t cap = std::uint32_t(AdaptiveSampling{}.max_factor * rpp);
   double sharp = 0.0, blurred = 0.0;
   int sharp_n = 0, blurred_n = 0;
   for (std::size_t i = 0; i < pixels; ++i) {
     EXPECT_GE(r.sample_counts[i], pilot);
+    EXPECT_LE(r.sample_counts[i], cap);
     const float z = r.depth.data[i];
     const double coc_px =
         z > 0.0f ? frame.lens.x * frame.lens.z * std::abs(1.0 / z - 1.0 / frame.lens.y) : 1e9;
@@ -90,6 +110,23 @@ TEST_P(Adaptive, SharesAddUpToTheBudget) {
       blurred += r.sample_counts[i];
       ++blurred_n;
     }
+  }
+  // How much of a SIMD machine the shares keep busy: a group of lanes runs
+  // as long as its largest share (8 lanes: a row of a tile on lavapipe with
+  // AVX2; 32: 8x4 pixels, an NVIDIA warp of the 8x8 workgroup).
+  const int width = r.composite.width, height = r.composite.height;
+  for (const auto &[gx, gy] : {std::pair{8, 1}, std::pair{8, 4}}) {
+    double busy = 0.0;
+    for (int y0 = 0; y0 < height; y0 += gy)
+      for (int x0 = 0; x0 < width; x0 += gx) {
+        std::uint32_t most = 0;
+        for (int y = y0; y < std::min(y0 + gy, height); ++y)
+          for (int x = x0; x < std::min(x0 + gx, width); ++x)
+            most = std::max(most, r.sample_counts[std::size_t(y) * width + x]);
+        busy += double(most) * gx * gy;
+      }
+    std::printf("%s: %d-lane groups (%dx%d px) busy %.0f%% of the time\n", GetParam().c_str(),
+                gx * gy, gx, gy, 100.0 * double(sum(r.sample_counts)) / busy);
   }
   std::printf("%s: mean share in focus (CoC < 0.5 px) %.1f over %d px, defocused (> 2 px) %.1f "
               "over %d px, largest %u\n",
@@ -118,7 +155,14 @@ TEST_P(Adaptive, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
   other.sampling.w += 1;
   const renderer::RenderResult cpu_other = renderer::render_cpu_adaptive(compiled, other);
   ASSERT_TRUE(test::all_finite(gpu.composite));
-  EXPECT_EQ(sum(gpu.sample_counts), sum(cpu.sample_counts));
+  // The GPU counts the rays it gave out as it gives them (a 64-bit atomic
+  // sum), also when the shares are not read back.
+  EXPECT_EQ(gpu.camera_rays, sum(gpu.sample_counts));
+  EXPECT_EQ(
+      tracer.render_adaptive(frame, {}, {}, renderer::LayerSelection::display_only()).camera_rays,
+      gpu.camera_rays);
+  expect_near_budget(sum(gpu.sample_counts), gpu.sample_counts.size(),
+                     std::uint64_t(gpu.sample_counts.size()) * rpp);
   std::size_t same = 0;
   for (std::size_t i = 0; i < gpu.sample_counts.size(); ++i)
     same += gpu.sample_counts[i] == cpu.sample_counts[i] ? 1u : 0u;
@@ -127,9 +171,10 @@ TEST_P(Adaptive, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
   std::printf("%s adaptive at %d rpp: GPU vs CPU RMSE %.2e, sampling noise %.2e, equal shares "
               "%zu of %zu pixels\n",
               GetParam().c_str(), rpp, difference, noise, same, gpu.sample_counts.size());
-  // The shares come from float sums that the two executors may round
-  // differently, so a few pixels may differ by a sample or so.
-  EXPECT_GT(double(same), 0.9 * double(gpu.sample_counts.size()));
+  // The same arithmetic in the same order (adaptive.glsl), but on pilots
+  // that differ in the last bits and with transcendentals that may round
+  // differently: a share on the edge of a rounding step may differ by one.
+  EXPECT_GT(double(same), 0.99 * double(gpu.sample_counts.size()));
   EXPECT_LT(difference, noise);
 }
 

@@ -5,7 +5,8 @@
 // (width x height x sampling.z rays) shared out by allocate_samples() from
 // what the pilot saw, and a second pass that traces each pixel's share
 // (layout.h, "Adaptive sampling"). Both executors run the same three steps
-// (render_cpu_adaptive(), GpuTracer::render_adaptive()).
+// (render_cpu_adaptive(), GpuTracer::render_adaptive()); the GPU tracer
+// computes the shares on the GPU, between its two passes, with no read-back.
 #pragma once
 
 #include <cstdint>
@@ -33,11 +34,17 @@ struct AdaptiveSampling {
 [[nodiscard]] std::uint32_t adaptive_pilot(const AdaptiveSampling &settings,
                                            std::uint32_t mean_samples);
 
+// FrameParams::adaptive for these settings: the CoC weight and the cap.
+[[nodiscard]] gpu::vec4 adaptive_parameters(const AdaptiveSampling &settings, std::uint32_t pilot,
+                                            std::uint32_t mean_samples);
+
 // Samples per pixel (pilot included) from the pilot's accumulated aux layer
 // (layout.h BINDING_ACCUM_AUX: depth sum, hits, luminance sum, sum of
-// squares) of `pilot` samples. Every pixel gets at least `pilot`; the total
-// is width x height x frame.sampling.z exactly unless the cap forbids it.
-// A pure function of its inputs: both executors call it.
+// squares) of `pilot` samples (renderer/shaders/adaptive.glsl). Every pixel
+// gets at least `pilot` and at most the cap; the total is width x height x
+// frame.sampling.z in expectation (shares are rounded at random; unless the
+// cap forbids it). A pure function of its inputs, and the same steps as the
+// GPU tracer's kernels.
 [[nodiscard]] std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux,
                                                           const gpu::FrameParams &frame,
                                                           std::uint32_t pilot,

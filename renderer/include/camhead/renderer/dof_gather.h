@@ -36,6 +36,7 @@ struct DofGatherSettings {
 struct DofGatherResult {
   RenderResult image;       // composite, mixed, real, mask, depth (the input's)
   double gather_s = 0;      // the gather kernel alone: submit to fence, data on the device
+  double device_s = 0;      // the same by device timestamps; 0 without timestamps
   double max_radius_px = 0; // the radius gathered
 };
 

@@ -9,11 +9,20 @@
 
 namespace camhead::renderer {
 
-// Where a frame's wall time went, for `camhead bench` (not part of any test).
+// Where a frame's time went, for `camhead bench` and the chart (not part of
+// any test). GPU tracer only.
 struct FrameTimings {
-  double trace_s = 0.0;   // sample batches: submit to fence, all batches
-  double resolve_s = 0.0; // resolve kernel and the copy of the layers to host memory
-  double unpack_s = 0.0;  // host: layers into Images
+  // Device timestamps from the frame's first command to its last copy into
+  // host memory: the frame's cost on the device, without the latency of
+  // submitting and waiting (between submissions, that latency is included).
+  // 0 where the device has no timestamps.
+  double device_s = 0.0;
+  // Adaptive frames: the allocation kernels between the passes, by the same
+  // timestamps (part of device_s).
+  double allocation_s = 0.0;
+  double submit_s = 0.0; // host: from the call to the last fence, all submissions
+  double unpack_s = 0.0; // host: layers into Images
+  int submissions = 0;   // one per batch; a frame of one batch is one submission
 };
 
 struct RenderResult {
@@ -28,7 +37,8 @@ struct RenderResult {
   std::vector<std::uint8_t> display;
   double seconds = 0.0;          // wall time of the render, excluding scene upload
   std::uint64_t camera_rays = 0; // width x height x samples (adaptive: the sum of sample_counts)
-  // Adaptive sampling only: samples traced per pixel, row by row; else empty.
+  // Adaptive sampling only: samples traced per pixel, row by row; else (and
+  // from the GPU tracer when not selected) empty.
   std::vector<std::uint32_t> sample_counts;
   FrameTimings timings; // GPU tracer only
 };
@@ -43,9 +53,12 @@ struct LayerSelection {
   bool real = true;
   bool mask_and_depth = true;
   bool display = true;
+  bool sample_counts = true; // adaptive sampling only
 
   static constexpr LayerSelection all() { return {}; }
-  static constexpr LayerSelection display_only() { return {false, false, false, false, true}; }
+  static constexpr LayerSelection display_only() {
+    return {false, false, false, false, true, false};
+  }
 };
 
 // Called between sample batches with the samples per pixel done so far.

@@ -1,0 +1,39 @@
+#version 450
+// Adaptive allocation, step 1 of 3 (adaptive.glsl): each pixel's weight from
+// the pilot, counted into the histogram, and each tile's sum of absolute mean
+// luminance for the floor weight.
+#extension GL_GOOGLE_include_directive : require
+#include "buffers.glsl"
+#include "adaptive.glsl"
+
+layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
+
+const uint kTilePixels = CAMHEAD_TILE_X * CAMHEAD_TILE_Y;
+shared float tile_luminance[kTilePixels];
+
+void main() {
+  uvec2 p = gl_GlobalInvocationID.xy;
+  float luminance = 0.0f;
+  // No early return: every invocation reaches the barriers below.
+  if (p.x < frame.image.x && p.y < frame.image.y) {
+    uint i = p.y * frame.image.x + p.x;
+    float w = adaptive_weight(int(p.x), int(p.y));
+    adaptive_weights[i] = w;
+    uint bin = adaptive_bin(w);
+    atomicAdd(adaptive_histogram[2u * bin], 1u);
+    atomicAdd(adaptive_histogram[2u * bin + 1u], adaptive_bin_offset(w));
+    luminance = abs(adaptive_moments(accum_aux[i], float(frame.tracing.y)).x);
+  }
+  uint t = gl_LocalInvocationIndex;
+  tile_luminance[t] = luminance;
+  barrier();
+  for (uint stride = kTilePixels / 2u; stride > 0u; stride /= 2u) {
+    if (t < stride) {
+      tile_luminance[t] += tile_luminance[t + stride];
+    }
+    barrier();
+  }
+  if (t == 0u) {
+    adaptive_groups[gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x] = tile_luminance[0];
+  }
+}
