@@ -120,6 +120,19 @@ Measurement run_uniform(ChartContext &c, int rpp) {
   return m;
 }
 
+// 1b. The same budgets with the low-discrepancy sampler: pixel and aperture
+//     jointly from Owen-scrambled Sobol' (sampling.glsl).
+Measurement run_sobol(ChartContext &c, int rpp) {
+  gpu::FrameParams frame = make_frame_params(c.scene, rpp);
+  frame.tracing.z = SAMPLER_SOBOL;
+  Measurement m;
+  m.frame_s = median_seconds(c.args, [&] {
+    return frame_seconds(c.tracer.render(frame, {}, LayerSelection::display_only()));
+  });
+  m.composite = c.tracer.render(frame).composite;
+  return m;
+}
+
 // 2. Image-space depth of field: a pinhole render (aperture radius 0) at
 //    `rpp` for antialiasing, blurred by dof_gather.comp. Frame time = the
 //    pinhole frame (up to the display image in host memory) + the gather
@@ -169,6 +182,12 @@ const std::vector<Method> &methods() {
        {31, 119, 180},
        chart::Marker::circle,
        run_uniform},
+      {"sobol",
+       "thin-lens tracer, Owen-scrambled Sobol' pixel and lens samples (sampling.glsl)",
+       {1, 4, 9, 16, 25, 49, 100},
+       {255, 127, 14},
+       chart::Marker::triangle,
+       run_sobol},
       {"pinhole+gather",
        "pinhole render + depth-aware gather blur (dof_gather.comp)",
        {1, 4, 16},

@@ -22,7 +22,16 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   float filter_width = frame.lens.w;
   // 1. Jitter inside the pixel (box filter of width filter_width pixels),
   //    and form the pinhole direction; row 0 is the top of the image.
-  vec2 jitter = sample_dimension(s, n, pixel_pattern, DIM_PIXEL);
+  vec2 jitter;
+  vec2 aperture;
+  if (frame.tracing.z == SAMPLER_SOBOL) {
+    vec4 q = sobol_owen_4d(s, pixel_pattern);
+    jitter = vec2(q.x, q.y);
+    aperture = vec2(q.z, q.w);
+  } else {
+    jitter = sample_dimension(s, n, pixel_pattern, DIM_PIXEL);
+    aperture = sample_dimension(s, n, pixel_pattern, DIM_LENS);
+  }
   float px = float(x) + 0.5f + (jitter.x - 0.5f) * filter_width;
   float py = float(y) + 0.5f + (jitter.y - 0.5f) * filter_width;
   vec3 right = vec3(frame.cam_right);
@@ -40,8 +49,9 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   // 2. Where the pinhole ray meets the focal plane (a plane, not a sphere:
   //    divide by the cosine to the optical axis).
   vec3 focus_point = ray.origin + d * (frame.lens.y / dot(d, forward));
-  // 3. A point on the aperture disk, stratified separately from the pixel.
-  vec2 disk = aperture_radius * concentric_disk(sample_dimension(s, n, pixel_pattern, DIM_LENS));
+  // 3. A point on the aperture disk (CMJ: stratified separately from the
+  //    pixel; Sobol': jointly with it).
+  vec2 disk = aperture_radius * concentric_disk(aperture);
   // 4. The lens ray starts there and aims at the focus point.
   ray.origin = ray.origin + right * disk.x + up * disk.y;
   ray.dir = normalize(focus_point - ray.origin);

@@ -79,9 +79,14 @@ struct FrameParams {
   vec4 world_color; // rgb
   uvec4 image;      // x: width, y: height, z: has_plate, w: light count
   uvec4 sampling; // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
-  uvec4 tracing;  // x: max_bounces; y: adaptive pilot samples (0 = uniform); z, w: reserved (0)
+  uvec4 tracing;  // x: max_bounces; y: adaptive pilot samples (0 = uniform); z: camera
+                  // sampler (SAMPLER_*); w: reserved (0)
   vec4 adaptive;  // adaptive allocation: x coc_weight, y cap (samples per pixel); z, w: reserved
 };
+
+// Camera-ray samplers (FrameParams.tracing.z, sampling.glsl).
+#define SAMPLER_CMJ 0u   // correlated multi-jittered, pixel and lens stratified apart
+#define SAMPLER_SOBOL 1u // Owen-scrambled Sobol' in 4-D: pixel and lens jointly
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.
 #define BINDING_PRIMITIVES 0

@@ -101,6 +101,82 @@ vec2 sample_dimension(uint s, uint n, uint pixel_pattern, uint dimension) {
   return cmj_sample(s, n, pattern_for(pixel_pattern, dimension));
 }
 
+// ---------------------------------------------------------------- Sobol'
+
+// The low-discrepancy alternative for the camera ray (SAMPLER_SOBOL): the
+// first four dimensions of Sobol' (Joe and Kuo's direction numbers), Owen-
+// scrambled per pixel with a hash (Burley 2020, "Practical Hash-based Owen
+// Scrambling"), the pixel jitter in the first two and the aperture point in
+// the last two, so that pixel and lens are stratified jointly in 4-D rather
+// than each in 2-D. Progressive: a sample does not depend on n, and the
+// first 2^k samples of a pixel are a scrambled aligned block of the sequence.
+
+// Sobol' dimension d (0..3) of sample i, as 32-bit fixed point. The
+// direction numbers come from their recurrences (primitive polynomials 1,
+// x + 1, x^2 + x + 1, x^3 + x + 1; initial m = {1}, {1, 3}, {1, 3, 1}), one
+// per bit of i, so no table is needed in either language.
+uint sobol_u32(uint i, uint d) {
+  if (d == 0u) {
+    return bitfieldReverse(i);
+  }
+  uint result = 0u;
+  uint v1 = 0u; // V_{k-1}
+  uint v2 = 0u; // V_{k-2}
+  uint v3 = 0u; // V_{k-3}
+  for (uint k = 1u; i != 0u; ++k) {
+    uint v;
+    if (k == 1u) {
+      v = 0x80000000u;
+    } else if (d == 1u) {
+      v = v1 ^ (v1 >> 1u);
+    } else if (k == 2u) {
+      v = 0xc0000000u;
+    } else if (d == 2u) {
+      v = v2 ^ (v2 >> 2u) ^ v1;
+    } else if (k == 3u) {
+      v = 0x20000000u;
+    } else {
+      v = v3 ^ (v3 >> 3u) ^ v2;
+    }
+    if ((i & 1u) != 0u) {
+      result ^= v;
+    }
+    v3 = v2;
+    v2 = v1;
+    v1 = v;
+    i >>= 1u;
+  }
+  return result;
+}
+
+// Laine and Karras' hash, an Owen scramble of the bit-reversed value.
+uint laine_karras_permutation(uint x, uint seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return x;
+}
+
+uint nested_uniform_scramble(uint x, uint seed) {
+  return bitfieldReverse(laine_karras_permutation(bitfieldReverse(x), seed));
+}
+
+// Sample s of the pixel pattern p as a point of [0, 1)^4: x, y the pixel
+// jitter, z, w the aperture. The index is scrambled too (Burley's shuffle),
+// which keeps aligned blocks aligned and decorrelates neighbouring pixels.
+vec4 sobol_owen_4d(uint s, uint p) {
+  uint i = nested_uniform_scramble(s, hash_u32(p ^ 0x3c6ef372u));
+  float scale = 1.0f / 4294967296.0f;
+  float x = float(nested_uniform_scramble(sobol_u32(i, 0u), hash_u32(p + 0x9e3779b9u)) >> 8u);
+  float y = float(nested_uniform_scramble(sobol_u32(i, 1u), hash_u32(p + 0x7f4a7c15u)) >> 8u);
+  float z = float(nested_uniform_scramble(sobol_u32(i, 2u), hash_u32(p + 0xf39cc060u)) >> 8u);
+  float w = float(nested_uniform_scramble(sobol_u32(i, 3u), hash_u32(p + 0x5ced1fb7u)) >> 8u);
+  // 24 bits each, so that the float is exact and below 1.
+  return vec4(x, y, z, w) * (256.0f * scale);
+}
+
 // Shirley-Chiu concentric map: keeps the square's strata as disk strata.
 vec2 concentric_disk(vec2 u) {
   float ox = 2.0f * u.x - 1.0f;

@@ -11,6 +11,7 @@
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
+#include <glm/integer.hpp>
 #include <glm/vec2.hpp>
 
 namespace camhead::renderer {
