@@ -35,6 +35,7 @@ struct BenchArgs {
   bool cpu_peer = false;
   bool all_layers = false;
   bool adaptive = false;
+  bool skip_empty = false;
 };
 
 double paper_fps(int rpp) {
@@ -116,7 +117,9 @@ int run_bench(const BenchArgs &args) {
         args.all_layers ? LayerSelection::all() : LayerSelection::display_only();
     std::vector<FrameTimings> breakdown;
     for (int rpp : args.rpp) {
-      const gpu::FrameParams frame = make_frame_params(scene, rpp);
+      gpu::FrameParams frame = make_frame_params(scene, rpp);
+      if (args.skip_empty)
+        frame.tracing.w |= TRACING_SKIP_EMPTY_PIXELS;
       const FrameMedians gpu = median_frame(args, [&] {
         return args.adaptive ? tracer.render_adaptive(frame, {}, {}, layers)
                              : tracer.render(frame, {}, layers);
@@ -190,6 +193,9 @@ void add_bench_command(CLI::App &app) {
   cmd->add_flag("--adaptive", args->adaptive,
                 "Adaptive ray budget per pixel (a pilot, then shares by variance and blur) at\n"
                 "the same mean rays per pixel");
+  cmd->add_flag("--skip-empty-pixels", args->skip_empty,
+                "Trace one sample where no ray of a pixel can meet the scene (always on in\n"
+                "the CPU reference; on the GPU a measurement, see bench/RESULTS.md)");
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
   cmd->add_flag("--cpu-peer", args->cpu_peer,
                 "Also time the CPU reference on the same frames and print the ratio");

@@ -268,6 +268,92 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
   return result;
 }
 
+// Whether a ray of a pixel's bundle may meet box [bmin, bmax]. The rays of
+// a pixel start on the aperture disk (radius frame.lens.x) and pass through
+// the pixel's footprint on the focal plane at depth F (half-diagonal
+// `footprint`). At axial depth z each lies within A |1 - z/F| + h z/F of the
+// central ray (lens centre, pixel centre), a convex function of z; so a ray
+// of the bundle can meet the box only if the central ray meets the box grown
+// by that distance's larger end value over the box's depth range.
+bool bundle_meets_box(vec3 origin, vec3 inv_dir, float footprint, vec4 bmin4, vec4 bmax4) {
+  vec3 bmin = vec3(bmin4);
+  vec3 bmax = vec3(bmax4);
+  vec3 forward = vec3(frame.cam_forward);
+  float z_mid = dot(0.5f * (bmin + bmax) - origin, forward);
+  float z_extent = dot(0.5f * (bmax - bmin), abs(forward));
+  float z_far = z_mid + z_extent;
+  if (z_far <= 0.0f) {
+    return false; // behind the lens: camera rays only go forward
+  }
+  float z_near = max(z_mid - z_extent, 0.0f);
+  float focus = frame.lens.y;
+  float spread_near = frame.lens.x * abs(1.0f - z_near / focus) + footprint * z_near / focus;
+  float spread_far = frame.lens.x * abs(1.0f - z_far / focus) + footprint * z_far / focus;
+  // A margin for the rounding of the rays themselves.
+  float grow = max(spread_near, spread_far) * 1.001f + 1e-5f * max(z_far, 1.0f);
+  return box_entry(origin, inv_dir, vec4(bmin - vec3(grow), 0.0f), vec4(bmax + vec3(grow), 0.0f),
+                   CAMHEAD_NO_HIT) != CAMHEAD_NO_HIT;
+}
+
+// True when no camera ray of pixel (x, y) can meet any leaf of the BVH:
+// every sample of the pixel then sees the world alone, and one sample stands
+// for all of them (trace_pixel). This is what makes a frame cheap where the
+// proxy and the virtual objects cover little of it. A traversal with the
+// bundle test above that stops at the first leaf the bundle may reach;
+// conservative (a full stack counts as a leaf reached).
+bool pixel_misses_scene(uint x, uint y) {
+  if (!(abs(nodes[0].bmin.x) < 1e30f)) {
+    return true; // the empty BVH (bounds at +inf) admits no ray
+  }
+  vec3 origin = vec3(frame.cam_position);
+  float px = float(x) + 0.5f;
+  float py = float(y) + 0.5f;
+  vec3 d = normalize(vec3(frame.cam_right) * (px - 0.5f * float(frame.image.x)) +
+                     vec3(frame.cam_up) * (0.5f * float(frame.image.y) - py) +
+                     vec3(frame.cam_forward) * frame.lens.z);
+  vec3 inv_dir = safe_reciprocal(d);
+  float footprint = 0.70710678f * frame.lens.w * frame.lens.y / frame.lens.z;
+  uint stack[CAMHEAD_STACK_SIZE];
+  int top = 0;
+  if (bundle_meets_box(origin, inv_dir, footprint, nodes[0].bmin, nodes[0].bmax)) {
+    stack[0] = 0u;
+    top = 1;
+  }
+  while (top > 0) {
+    --top;
+    BvhNode node = nodes[stack[top]];
+    if (floatBitsToUint(node.bmax.w) > 0u) {
+      return false; // a leaf
+    }
+    uint left = floatBitsToUint(node.bmin.w);
+    for (uint child = left; child <= left + 1u; ++child) {
+      if (bundle_meets_box(origin, inv_dir, footprint, nodes[child].bmin, nodes[child].bmax)) {
+        if (top == CAMHEAD_STACK_SIZE) {
+          return false;
+        }
+        stack[top] = child;
+        ++top;
+      }
+    }
+  }
+  return true;
+}
+
+// Adds `weight` copies of sample r to the accumulators (trace_pixel).
+void accumulate_sample(SampleResult r, float weight, vec4 camera, bool has_plate,
+                       INOUT(vec4) acc_mixed, INOUT(vec4) acc_real, INOUT(vec4) acc_aux) {
+  float m = r.is_virtual ? 1.0f : 0.0f;
+  acc_mixed += weight * vec4(r.mixed, m);
+  acc_real += weight * vec4(r.real, 0.0f);
+  if (r.hit) {
+    acc_aux += weight * vec4(r.depth, 1.0f, 0.0f, 0.0f);
+  }
+  // This sample's composite (equation 4, linear in the sample).
+  vec3 f = has_plate ? r.mixed + (1.0f - m) * (vec3(camera) - r.real) : r.mixed;
+  float lum = dot(f, vec3(0.2126f, 0.7152f, 0.0722f));
+  acc_aux += weight * vec4(0.0f, 0.0f, lum, lum * lum);
+}
+
 // Adds samples [frame.sampling.x, frame.sampling.y) of pixel (x, y) to the
 // accumulators (layout.h: mixed.rgb + mask, real.rgb, aux = depth sum, hits,
 // and the sum and sum of squares of the luminance of each sample's composite,
@@ -285,18 +371,19 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
     seed = hash_u32(seed ^ 0xad5a3c1bu); // independent of the pilot's pattern
   }
   uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, seed);
-  for (uint s = frame.sampling.x; s < end; ++s) {
+  uint first = frame.sampling.x;
+  float weight = 1.0f;
+  // One sample for all where none can differ. A shorter loop rather than a
+  // second path: SIMD executors (lavapipe) run a branch's both sides but a
+  // loop only as long as its longest lane.
+  if (first < end && (frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u &&
+      pixel_misses_scene(x, y)) {
+    weight = float(end - first);
+    end = first + 1u;
+  }
+  for (uint s = first; s < end; ++s) {
     SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern), s, count, pixel_pattern);
-    float m = r.is_virtual ? 1.0f : 0.0f;
-    acc_mixed += vec4(r.mixed, m);
-    acc_real += vec4(r.real, 0.0f);
-    if (r.hit) {
-      acc_aux += vec4(r.depth, 1.0f, 0.0f, 0.0f);
-    }
-    // This sample's composite (equation 4, linear in the sample).
-    vec3 f = has_plate ? r.mixed + (1.0f - m) * (vec3(camera) - r.real) : r.mixed;
-    float lum = dot(f, vec3(0.2126f, 0.7152f, 0.0722f));
-    acc_aux += vec4(0.0f, 0.0f, lum, lum * lum);
+    accumulate_sample(r, weight, camera, has_plate, acc_mixed, acc_real, acc_aux);
   }
 }
 
