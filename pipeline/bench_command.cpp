@@ -16,6 +16,7 @@
 
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
+#include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "chart_command.h"
@@ -36,6 +37,7 @@ struct BenchArgs {
   bool all_layers = false;
   bool adaptive = false;
   bool skip_empty = false;
+  double frame_ms = 0.0; // > 0: follow this frame-time target instead of --rpp
 };
 
 double paper_fps(int rpp) {
@@ -90,6 +92,41 @@ template <typename RenderFn> FrameMedians median_frame(const BenchArgs &args, Re
            .submissions = int(median(submissions))}};
 }
 
+// --frame-ms: every frame's rays per pixel from FrameBudget, which learns
+// from the frames' device times; prints each frame and a summary.
+int run_frame_target(const BenchArgs &args, renderer::GpuTracer &tracer,
+                     const renderer::Scene &scene) {
+  using namespace camhead::renderer;
+  FrameBudget budget(FrameBudgetSettings{.target_s = args.frame_ms * 1e-3});
+  std::printf("frame-time target %.2f ms, %s sampling, %d frames\n\n", args.frame_ms,
+              args.adaptive ? "adaptive" : "uniform", args.warmup + args.frames);
+  std::printf("| frame | rpp | frame ms (device) |\n|-------|-----|-------------------|\n");
+  std::vector<double> times, rpps;
+  int late = 0;
+  for (int i = 0; i < args.warmup + args.frames; ++i) {
+    const std::uint32_t rpp = budget.rpp();
+    gpu::FrameParams frame = make_frame_params(scene, int(rpp));
+    if (args.skip_empty)
+      frame.tracing.w |= TRACING_SKIP_EMPTY_PIXELS;
+    const RenderResult r =
+        args.adaptive ? tracer.render_adaptive(frame, {}, {}, LayerSelection::display_only())
+                      : tracer.render(frame, {}, LayerSelection::display_only());
+    const double seconds = r.timings.device_s > 0.0 ? r.timings.device_s : r.seconds;
+    budget.measured(rpp, seconds);
+    std::printf("| %5d | %3u | %17.2f |%s\n", i, rpp, seconds * 1e3,
+                i < args.warmup ? " (warm-up)" : "");
+    if (i >= args.warmup) {
+      times.push_back(seconds);
+      rpps.push_back(rpp);
+      late += seconds > args.frame_ms * 1e-3 ? 1 : 0;
+    }
+  }
+  std::printf("\nafter warm-up: median %.0f rpp, median frame %.2f ms, %d of %d frames over the "
+              "target\n",
+              median(rpps), median(times) * 1e3, late, args.frames);
+  return 0;
+}
+
 int run_bench(const BenchArgs &args) {
   using namespace camhead::renderer;
   try {
@@ -104,6 +141,8 @@ int run_bench(const BenchArgs &args) {
     tracer.load(compiled);
     std::printf("scene %s, %dx%d, device %s\n", args.scene.c_str(), args.width, args.height,
                 tracer.device_name().c_str());
+    if (args.frame_ms > 0.0)
+      return run_frame_target(args, tracer, scene);
     std::printf("median of %d frames after %d warm-up frames; read back: %s; sampling: %s\n\n",
                 args.frames, args.warmup, args.all_layers ? "all layers" : "8-bit display image",
                 args.adaptive ? "adaptive (rpp = mean rays per pixel)" : "uniform");
@@ -193,6 +232,10 @@ void add_bench_command(CLI::App &app) {
   cmd->add_flag("--adaptive", args->adaptive,
                 "Adaptive ray budget per pixel (a pilot, then shares by variance and blur) at\n"
                 "the same mean rays per pixel");
+  cmd->add_option("--frame-ms", args->frame_ms,
+                  "Follow a frame-time target instead of --rpp: each frame's rays per pixel\n"
+                  "from the device time of the frames before (renderer frame_budget.h)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--skip-empty-pixels", args->skip_empty,
                 "Trace one sample where no ray of a pixel can meet the scene (always on in\n"
                 "the CPU reference; on the GPU a measurement, see bench/RESULTS.md)");

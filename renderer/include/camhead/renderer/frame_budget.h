@@ -1,0 +1,53 @@
+// Rays per pixel for a frame-time target: the budget a live frame spends,
+// uniform or adaptive (issue 4, "with a frame-time target").
+//
+// The cost of a frame grows with its rays per pixel, and the rate changes
+// with the scene, the lens (a wide aperture spreads rays over more of the
+// scene) and the device. FrameBudget learns the cost of one ray per pixel
+// from the frames it is told about (device time, FrameTimings::device_s, so
+// that host latency does not count) and chooses the next frame's rays per
+// pixel to fill the target:
+//   - the cost per rpp is an exponential average of the measured ones, so
+//     one noisy frame moves the budget a little, a lasting change fully;
+//   - a dearer frame shrinks the budget at once (a frame over target is a
+//     dropped frame), a cheaper one lets it grow by at most `max_growth`
+//     (or one rpp) over the rpp measured (a fast outlier must not make the
+//     next frame late).
+// Pure arithmetic on the timings it is given: testable with a made-up clock.
+#pragma once
+
+#include <cstdint>
+
+namespace camhead::renderer {
+
+struct FrameBudgetSettings {
+  double target_s = 1.0 / 30.0;
+  std::uint32_t min_rpp = 1;
+  std::uint32_t max_rpp = 1024;
+  // Weight of the newest frame in the average cost per rpp.
+  double smoothing = 0.3;
+  // Largest factor by which the budget grows from one frame to the next.
+  double max_growth = 1.5;
+  // Fraction of the target to aim at, headroom for frame-to-frame noise.
+  double headroom = 0.9;
+};
+
+class FrameBudget {
+public:
+  // Throws std::invalid_argument for a target <= 0 or min_rpp > max_rpp (or 0).
+  explicit FrameBudget(const FrameBudgetSettings &settings);
+
+  // Rays per pixel for the next frame.
+  [[nodiscard]] std::uint32_t rpp() const { return rpp_; }
+  // A frame of `rpp` rays per pixel took `seconds`; ignored unless both > 0.
+  void measured(std::uint32_t rpp, double seconds);
+  // The average seconds per ray per pixel so far (0 before any frame).
+  [[nodiscard]] double seconds_per_rpp() const { return seconds_per_rpp_; }
+
+private:
+  FrameBudgetSettings settings_;
+  std::uint32_t rpp_;
+  double seconds_per_rpp_ = 0.0;
+};
+
+} // namespace camhead::renderer

@@ -1,0 +1,36 @@
+#include "camhead/renderer/frame_budget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace camhead::renderer {
+
+FrameBudget::FrameBudget(const FrameBudgetSettings &settings)
+    : settings_(settings), rpp_(settings.min_rpp) {
+  if (!(settings.target_s > 0.0))
+    throw std::invalid_argument("frame-time target must be > 0 s, not " +
+                                std::to_string(settings.target_s));
+  if (settings.min_rpp == 0 || settings.min_rpp > settings.max_rpp)
+    throw std::invalid_argument("rays per pixel range " + std::to_string(settings.min_rpp) + ".." +
+                                std::to_string(settings.max_rpp) + " is empty or 0");
+}
+
+void FrameBudget::measured(std::uint32_t rpp, double seconds) {
+  if (rpp == 0 || !(seconds > 0.0) || !std::isfinite(seconds))
+    return;
+  const double per_rpp = seconds / rpp;
+  seconds_per_rpp_ = seconds_per_rpp_ == 0.0 ? per_rpp
+                                             : settings_.smoothing * per_rpp +
+                                                   (1.0 - settings_.smoothing) * seconds_per_rpp_;
+  // A frame that came out dear counts at once, not averaged away.
+  const double cost = std::max(seconds_per_rpp_, per_rpp);
+  const double fits = settings_.headroom * settings_.target_s / cost;
+  const double most = std::max(double(rpp) + 1.0, double(rpp) * settings_.max_growth);
+  const double next = std::clamp(std::floor(std::min(fits, most)), double(settings_.min_rpp),
+                                 double(settings_.max_rpp));
+  rpp_ = static_cast<std::uint32_t>(next);
+}
+
+} // namespace camhead::renderer

@@ -1,0 +1,104 @@
+// FrameBudget (frame_budget.h) against a made-up device whose frame costs
+// overhead + rpp x cost per rpp, with noise: it must fill the target without
+// running over it, and follow the scene when the cost changes.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <stdexcept>
+
+#include "camhead/renderer/frame_budget.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead {
+namespace {
+
+using renderer::FrameBudget;
+using renderer::FrameBudgetSettings;
+
+// Frame time of the made-up device, with +-4 % deterministic noise.
+struct Device {
+  double overhead_s = 0.0005;
+  double per_rpp_s = 0.0004;
+  std::uint32_t frame = 0;
+  double run(std::uint32_t rpp) {
+    const double noise = 0.04 * std::sin(double(frame++) * 2.3999632);
+    return (overhead_s + per_rpp_s * rpp) * (1.0 + noise);
+  }
+};
+
+// Runs `frames` frames; returns the largest frame time of the last `tail`.
+double run_frames(FrameBudget &budget, Device &device, int frames, int tail, double *smallest) {
+  double largest = 0.0;
+  *smallest = 1e30;
+  for (int i = 0; i < frames; ++i) {
+    const std::uint32_t rpp = budget.rpp();
+    const double t = device.run(rpp);
+    budget.measured(rpp, t);
+    if (i >= frames - tail) {
+      largest = std::max(largest, t);
+      *smallest = std::min(*smallest, t);
+    }
+  }
+  return largest;
+}
+
+TEST(FrameBudget, FillsTheTargetWithoutRunningOver) {
+  FrameBudget budget(FrameBudgetSettings{.target_s = 0.020});
+  Device device;
+  double smallest = 0.0;
+  const double largest = run_frames(budget, device, 40, 20, &smallest);
+  std::printf("settled at %u rpp: frames %.2f-%.2f ms for a 20 ms target\n", budget.rpp(),
+              smallest * 1e3, largest * 1e3);
+  EXPECT_LE(largest, 0.020);
+  EXPECT_GE(smallest, 0.75 * 0.020);
+}
+
+TEST(FrameBudget, FollowsTheSceneWhenItGetsDearerOrCheaper) {
+  FrameBudget budget(FrameBudgetSettings{.target_s = 0.020});
+  Device device;
+  double smallest = 0.0;
+  run_frames(budget, device, 40, 1, &smallest);
+  const std::uint32_t settled = budget.rpp();
+
+  device.per_rpp_s *= 3.0; // a wider aperture, say
+  const double late = device.run(budget.rpp());
+  budget.measured(budget.rpp(), late);
+  const double next = device.run(budget.rpp());
+  budget.measured(budget.rpp(), next);
+  std::printf("3x dearer: one frame at %.1f ms, the next at %.1f ms (%u -> %u rpp)\n", late * 1e3,
+              next * 1e3, settled, budget.rpp());
+  EXPECT_GT(late, 0.020) << "the first frame after the change cannot know it";
+  EXPECT_LE(next, 0.020) << "the one after it must";
+
+  device.per_rpp_s /= 9.0; // 3x cheaper than at first
+  const double largest = run_frames(budget, device, 40, 40, &smallest);
+  std::printf("then 3x cheaper than at first: %u rpp, no frame over %.1f ms\n", budget.rpp(),
+              largest * 1e3);
+  EXPECT_LE(largest, 0.020) << "growing back must not overshoot";
+  EXPECT_GT(budget.rpp(), 2 * settled);
+}
+
+TEST(FrameBudget, StaysWithinItsRange) {
+  FrameBudget fast(FrameBudgetSettings{.target_s = 1.0, .max_rpp = 64});
+  Device device;
+  double smallest = 0.0;
+  run_frames(fast, device, 30, 1, &smallest);
+  EXPECT_EQ(fast.rpp(), 64u);
+
+  FrameBudget slow(FrameBudgetSettings{.target_s = 0.0001, .min_rpp = 4});
+  run_frames(slow, device, 10, 1, &smallest);
+  EXPECT_EQ(slow.rpp(), 4u) << "a device too slow for the target still gets the minimum";
+  slow.measured(4, -1.0);
+  slow.measured(0, 0.01);
+  EXPECT_EQ(slow.rpp(), 4u);
+}
+
+TEST(FrameBudget, RejectsAnEmptyRangeOrNoTarget) {
+  EXPECT_THROW(FrameBudget(FrameBudgetSettings{.target_s = 0.0}), std::invalid_argument);
+  EXPECT_THROW(FrameBudget(FrameBudgetSettings{.min_rpp = 8, .max_rpp = 4}), std::invalid_argument);
+  EXPECT_THROW(FrameBudget(FrameBudgetSettings{.min_rpp = 0}), std::invalid_argument);
+}
+
+} // namespace
+} // namespace camhead
