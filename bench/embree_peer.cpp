@@ -10,6 +10,7 @@
 // frame in the same process, interleaved round by round, so that ratios
 // hold on a noisy machine. Prints Markdown rows (bench/run_peers.sh).
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -44,6 +45,7 @@ struct Args {
   bool camhead = false;
   std::string device;
   bool header = true;
+  std::uint32_t sampler = SAMPLER_CMJ; // camhead's camera-ray sampler (layout.h)
 };
 
 double median(std::vector<double> v) {
@@ -64,7 +66,8 @@ int run(const Args &args) {
   const BenchScene bench_scene = find_bench_scene(args.scene);
   const renderer::Scene scene = load_bench_scene(bench_scene, args.width, args.height);
   const renderer::CompiledScene compiled = renderer::compile_scene(scene);
-  const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, args.rpp);
+  renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, args.rpp);
+  frame.tracing.z = args.sampler;
   const int threads =
       args.threads > 0 ? args.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   const double rays = double(args.width) * args.height * args.rpp;
@@ -183,6 +186,11 @@ bool parse(int argc, char **argv, Args &args) {
       args.camhead = true;
     } else if (arg == "--no-header") {
       args.header = false;
+    } else if (arg == "--sampler") {
+      const std::string_view name = value();
+      if (name != "cmj" && name != "sobol")
+        return false;
+      args.sampler = name == "sobol" ? SAMPLER_SOBOL : SAMPLER_CMJ;
     } else {
       return false;
     }
@@ -200,7 +208,8 @@ int main(int argc, char **argv) {
                  "usage: embree_peer [--scene ar_basic|ar_demo|ar_basic_primary|ar_demo_primary|"
                  "FILE]\n"
                  "                   [--width 720] [--height 576] [--rpp 1] [--rounds 5]\n"
-                 "                   [--threads all] [--camhead [--device NAME]] [--no-header]\n");
+                 "                   [--threads all] [--camhead [--device NAME]] [--no-header]\n"
+                 "                   [--sampler cmj|sobol]\n");
     return 2;
   }
   try {

@@ -108,10 +108,10 @@ struct Method {
   Measurement (*run)(ChartContext &, int rpp);
 };
 
-// 1. The tracer as it is: stratified jittered pixel and lens samples
-//    (method.md section 2).
-Measurement run_uniform(ChartContext &c, int rpp) {
-  const gpu::FrameParams frame = make_frame_params(c.scene, rpp);
+// The tracer's frame at `rpp` with camera sampler `sampler` (layout.h).
+Measurement run_traced(ChartContext &c, int rpp, std::uint32_t sampler) {
+  gpu::FrameParams frame = make_frame_params(c.scene, rpp);
+  frame.tracing.z = sampler;
   Measurement m;
   m.frame_s = median_seconds(c.args, [&] {
     return frame_seconds(c.tracer.render(frame, {}, LayerSelection::display_only()));
@@ -120,17 +120,16 @@ Measurement run_uniform(ChartContext &c, int rpp) {
   return m;
 }
 
+// 1. The tracer as it is: stratified jittered pixel and lens samples
+//    (method.md section 2).
+Measurement run_uniform(ChartContext &c, int rpp) {
+  return run_traced(c, rpp, SAMPLER_CMJ);
+}
+
 // 1b. The same budgets with the low-discrepancy sampler: pixel and aperture
 //     jointly from Owen-scrambled Sobol' (sampling.glsl).
 Measurement run_sobol(ChartContext &c, int rpp) {
-  gpu::FrameParams frame = make_frame_params(c.scene, rpp);
-  frame.tracing.z = SAMPLER_SOBOL;
-  Measurement m;
-  m.frame_s = median_seconds(c.args, [&] {
-    return frame_seconds(c.tracer.render(frame, {}, LayerSelection::display_only()));
-  });
-  m.composite = c.tracer.render(frame).composite;
-  return m;
+  return run_traced(c, rpp, SAMPLER_SOBOL);
 }
 
 // 2. Image-space depth of field: a pinhole render (aperture radius 0) at

@@ -61,7 +61,7 @@ TEST(SobolSampler, DefocusedEdgeConvergesFasterThanInverseSquareRoot) {
   renderer::gpu::FrameParams reference_frame = frame_with(scene, 8192, SAMPLER_CMJ);
   reference_frame.sampling.w = 7;
   const renderer::Image reference = tracer.render(reference_frame).composite;
-  std::vector<double> log_n, log_err;
+  std::vector<double> rpps, errors_sobol;
   for (int n : {4, 16, 64, 256}) {
     double errors[2] = {0.0, 0.0};
     for (const std::uint32_t sampler : {SAMPLER_CMJ, SAMPLER_SOBOL}) {
@@ -74,20 +74,10 @@ TEST(SobolSampler, DefocusedEdgeConvergesFasterThanInverseSquareRoot) {
     }
     std::printf("%4d rpp: RMSE CMJ %.6f, Sobol' %.6f (ratio %.2f)\n", n, errors[SAMPLER_CMJ],
                 errors[SAMPLER_SOBOL], errors[SAMPLER_SOBOL] / errors[SAMPLER_CMJ]);
-    log_n.push_back(std::log(double(n)));
-    log_err.push_back(std::log(errors[SAMPLER_SOBOL]));
+    rpps.push_back(n);
+    errors_sobol.push_back(errors[SAMPLER_SOBOL]);
   }
-  double mx = 0, my = 0;
-  for (std::size_t i = 0; i < log_n.size(); ++i) {
-    mx += log_n[i] / double(log_n.size());
-    my += log_err[i] / double(log_n.size());
-  }
-  double sxy = 0, sxx = 0;
-  for (std::size_t i = 0; i < log_n.size(); ++i) {
-    sxy += (log_n[i] - mx) * (log_err[i] - my);
-    sxx += (log_n[i] - mx) * (log_n[i] - mx);
-  }
-  const double slope = sxy / sxx;
+  const double slope = test::log_log_slope(rpps, errors_sobol);
   std::printf("Sobol' error ~ N^%.3f between 4 and 256 rpp (independent sampling: N^-0.5)\n",
               slope);
   // A sampler that did not converge to the default's image would level off

@@ -66,25 +66,14 @@ TEST(Stratification, EdgeErrorFallsFasterThanInverseSquareRoot) {
   scene.render.seed = 7;
   const renderer::Image reference = test::render_gpu(scene, 8192).composite;
   scene.render.seed = 1;
-  std::vector<double> log_n, log_err;
+  std::vector<double> rpps, errors;
   for (int n : {4, 16, 64, 256}) {
     const double err = test::rmse(reference, test::render_gpu(scene, n).composite);
     std::printf("%4d rpp: RMSE %.6f\n", n, err);
-    log_n.push_back(std::log(double(n)));
-    log_err.push_back(std::log(err));
+    rpps.push_back(n);
+    errors.push_back(err);
   }
-  // Least-squares slope of log(error) against log(N).
-  double mx = 0, my = 0;
-  for (std::size_t i = 0; i < log_n.size(); ++i) {
-    mx += log_n[i] / double(log_n.size());
-    my += log_err[i] / double(log_n.size());
-  }
-  double sxy = 0, sxx = 0;
-  for (std::size_t i = 0; i < log_n.size(); ++i) {
-    sxy += (log_n[i] - mx) * (log_err[i] - my);
-    sxx += (log_n[i] - mx) * (log_n[i] - mx);
-  }
-  const double slope = sxy / sxx;
+  const double slope = test::log_log_slope(rpps, errors);
   std::printf("error ~ N^%.3f between 4 and 256 rpp (independent sampling: N^-0.5)\n", slope);
   EXPECT_LT(slope, -0.5);
 }

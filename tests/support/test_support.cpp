@@ -74,6 +74,21 @@ double rmse(const renderer::Image &a, const renderer::Image &b) {
   return std::sqrt(sum / double(a.data.size()));
 }
 
+double log_log_slope(const std::vector<double> &x, const std::vector<double> &y) {
+  const double n = double(x.size());
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    mx += std::log(x[i]) / n;
+    my += std::log(y[i]) / n;
+  }
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxy += (std::log(x[i]) - mx) * (std::log(y[i]) - my);
+    sxx += (std::log(x[i]) - mx) * (std::log(x[i]) - mx);
+  }
+  return sxy / sxx;
+}
+
 double relative_rmse(const renderer::Image &reference, const renderer::Image &test) {
   double sum = 0.0;
   for (float v : reference.data) {

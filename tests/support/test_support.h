@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/image.h"
@@ -36,6 +37,10 @@ namespace camhead::test {
 [[nodiscard]] double rmse(const renderer::Image &a, const renderer::Image &b);
 // rmse / RMS(reference), as compare.py's relRMSE.
 [[nodiscard]] double relative_rmse(const renderer::Image &reference, const renderer::Image &test);
+
+// Least-squares slope of log(y) against log(x): the exponent of a power law
+// (convergence rates: error ~ N^slope).
+[[nodiscard]] double log_log_slope(const std::vector<double> &x, const std::vector<double> &y);
 
 // Every sample finite: no NaN or Inf reaches an output.
 [[nodiscard]] bool all_finite(const renderer::Image &image);
