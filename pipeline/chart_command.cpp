@@ -648,8 +648,11 @@ void add_bench_chart_command(CLI::App &bench) {
                "The references are cached in DIR/chart_cache, so a rerun only re-times.\n"
                "Methods:" +
                    method_list +
-                   "\nExample (about 25 min on 2 CPU cores with lavapipe):\n"
-                   "  camhead bench chart ../shared/reference/ar_basic.json --scale 0.5 -o bench");
+                   "\nExamples (2 CPU cores, lavapipe: the first takes over half an hour, the\n"
+                   "second a few minutes):\n"
+                   "  camhead bench chart ../shared/reference/ar_basic.json --scale 0.5 -o bench\n"
+                   "  camhead bench chart ../shared/reference/ar_basic.json --scale 0.25 \\\n"
+                   "      --methods uniform,adaptive --frames 3 --warmup 1 -o /tmp/chart");
   cmd->add_option("scenes", args->scenes, "Scene files")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->out_dir, "Output folder (created if absent)")
       ->capture_default_str();
