@@ -12,6 +12,7 @@
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/scene_loader.h"
 #include "stability_support.h"
+#include "test_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -147,7 +148,7 @@ TEST(Degenerate, SpheresOfNoSizeRenderFinite) {
   // The worst case for a point-sized sphere: a camera ray straight through
   // its centre, where the surface normal is 0/0. One pixel, no jitter.
   for (float radius : {0.0f, 1e-30f}) {
-    Scene scene = stability::empty_scene("axis", 0.0f, 0.0f, 1, 1);
+    Scene scene = test::empty_scene("axis", 0.0f, 0.0f, 1, 1);
     scene.render.pixel_filter_width_px = 0.0f;
     scene.materials.push_back({"white", MaterialType::diffuse, glm::vec3(0.8f), 1.5f});
     scene.objects.push_back(sphere("point", {0.0f, 0.0f, -2.0f}, radius, 0, false));

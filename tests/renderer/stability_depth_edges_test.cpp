@@ -60,6 +60,18 @@ double max_abs_diff(const std::vector<double> &a, const std::vector<double> &b) 
   return worst;
 }
 
+// Largest column error of each measured layer against its expectation, and
+// of the expected composite (equation 4) against the physical camera.
+struct Errors {
+  double mask, mixed, real, depth, composite, method;
+};
+
+Errors errors(const Measured &m, const Expected &e) {
+  return {max_abs_diff(m.mask, e.mask),           max_abs_diff(m.mixed, e.mixed),
+          max_abs_diff(m.real, e.real),           max_abs_diff(m.depth, e.depth),
+          max_abs_diff(m.composite, e.composite), max_abs_diff(e.composite, e.physical)};
+}
+
 // The plate: the camera image, kCameraGain times the analytic real layer.
 Image plate_from(const std::vector<double> &real) {
   Image plate(kWidth, kHeight, 3);
@@ -108,7 +120,7 @@ struct VirtualForeground {
 
 VirtualForeground virtual_foreground_scene() {
   VirtualForeground v;
-  v.scene = stability::empty_scene("virtual_foreground", kFNumber, kFocusM, kWidth, kHeight);
+  v.scene = test::empty_scene("virtual_foreground", kFNumber, kFocusM, kWidth, kHeight);
   const int dark = stability::add_emitter(v.scene, "background_dark", kBackgroundDark);
   const int bright = stability::add_emitter(v.scene, "background_bright", kBackgroundBright);
   const int paint = stability::add_emitter(v.scene, "virtual", kVirtualRadiance);
@@ -147,29 +159,23 @@ Expected expected_virtual_foreground(const VirtualForeground &v) {
 
 void check_virtual_foreground(const RenderResult &r, const VirtualForeground &v, double tolerance,
                               bool verbose) {
-  ASSERT_TRUE(test::all_finite(r.composite) && test::all_finite(r.mixed) &&
-              test::all_finite(r.real) && test::all_finite(r.mask) && test::all_finite(r.depth));
+  ASSERT_TRUE(test::all_layers_finite(r));
   const Expected e = expected_virtual_foreground(v);
   const Measured m = measure(r);
   if (verbose) {
     print_profile("virtual f/1.4 foreground at 0.4 m over a sharp real edge at 2 m", e, m, v.u0);
   }
-  const double mask_err = max_abs_diff(m.mask, e.mask);
-  const double mixed_err = max_abs_diff(m.mixed, e.mixed);
-  const double real_err = max_abs_diff(m.real, e.real);
-  const double depth_err = max_abs_diff(m.depth, e.depth);
-  const double composite_err = max_abs_diff(m.composite, e.composite);
-  const double method_err = max_abs_diff(e.composite, e.physical);
+  const Errors err = errors(m, e);
   std::printf("blur radius %.3f px; max |measured - thin-lens expectation| over the columns:\n"
               "  mask %.5f, I_m %.5f, I_r %.5f, depth %.5f m, composite %.5f\n"
               "  equation (4) against a camera seeing a real occluder (gain %.1f): %.5f\n",
-              v.rho, mask_err, mixed_err, real_err, depth_err, composite_err, kCameraGain,
-              method_err);
-  EXPECT_LT(mask_err, tolerance);
-  EXPECT_LT(mixed_err, tolerance);
-  EXPECT_LT(real_err, tolerance);
-  EXPECT_LT(depth_err, 2.0 * tolerance); // depth spans 1.6 m, not 1
-  EXPECT_LT(composite_err, tolerance);
+              v.rho, err.mask, err.mixed, err.real, err.depth, err.composite, kCameraGain,
+              err.method);
+  EXPECT_LT(err.mask, tolerance);
+  EXPECT_LT(err.mixed, tolerance);
+  EXPECT_LT(err.real, tolerance);
+  EXPECT_LT(err.depth, 2.0 * tolerance); // depth spans 1.6 m, not 1
+  EXPECT_LT(err.composite, tolerance);
 
   // The real edge shows through the blurred rim: across it, I_m steps by the
   // uncovered fraction of the background step, as the lens would show it.
@@ -215,7 +221,7 @@ struct RealForeground {
 
 RealForeground real_foreground_scene() {
   RealForeground v;
-  v.scene = stability::empty_scene("real_foreground", kFNumber, kFocusM, kWidth, kHeight);
+  v.scene = test::empty_scene("real_foreground", kFNumber, kFocusM, kWidth, kHeight);
   const int near = stability::add_emitter(v.scene, "real_near", kRealForegroundRadiance);
   const int paint = stability::add_emitter(v.scene, "virtual", kVirtualBehindRadiance);
   const int wall = stability::add_emitter(v.scene, "real_wall", kFarBackgroundRadiance);
@@ -267,16 +273,10 @@ TEST(DepthEdges, BlurredRealForegroundOverSharpVirtualEdgeOnCpu) {
   const Expected e = expected_real_foreground(v);
   v.scene.plate = plate_from(e.real);
   const RenderResult r = test::render_cpu(v.scene, 256);
-  ASSERT_TRUE(test::all_finite(r.composite) && test::all_finite(r.mixed) &&
-              test::all_finite(r.real) && test::all_finite(r.mask) && test::all_finite(r.depth));
+  ASSERT_TRUE(test::all_layers_finite(r));
   const Measured m = measure(r);
   print_profile("real f/1.4 foreground at 0.4 m over a sharp virtual edge at 2 m", e, m, v.u0);
-  const double mask_err = max_abs_diff(m.mask, e.mask);
-  const double mixed_err = max_abs_diff(m.mixed, e.mixed);
-  const double real_err = max_abs_diff(m.real, e.real);
-  const double depth_err = max_abs_diff(m.depth, e.depth);
-  const double composite_err = max_abs_diff(m.composite, e.composite);
-  const double method_err = max_abs_diff(e.composite, e.physical);
+  const Errors err = errors(m, e);
   // Equation (4) at partial coverage: where the virtual panel is behind the
   // real rim, I_f - physical = A (1 - A)(gain - 1)(wall - foreground) per point.
   const double method_bound =
@@ -285,14 +285,14 @@ TEST(DepthEdges, BlurredRealForegroundOverSharpVirtualEdgeOnCpu) {
               "  mask %.5f, I_m %.5f, I_r %.5f, depth %.5f m, composite %.5f\n"
               "  equation (4) against a camera seeing a real panel (gain %.1f): %.5f "
               "(bound A(1-A)(gain-1)|wall-foreground| = %.5f)\n",
-              v.rho, mask_err, mixed_err, real_err, depth_err, composite_err, kCameraGain,
-              method_err, method_bound);
-  EXPECT_LT(mask_err, kCpuTolerance);
-  EXPECT_LT(mixed_err, kCpuTolerance);
-  EXPECT_LT(real_err, kCpuTolerance);
-  EXPECT_LT(depth_err, 0.04); // depth spans 3.6 m
-  EXPECT_LT(composite_err, kCpuTolerance);
-  EXPECT_LE(method_err, method_bound + 1e-9);
+              v.rho, err.mask, err.mixed, err.real, err.depth, err.composite, kCameraGain,
+              err.method, method_bound);
+  EXPECT_LT(err.mask, kCpuTolerance);
+  EXPECT_LT(err.mixed, kCpuTolerance);
+  EXPECT_LT(err.real, kCpuTolerance);
+  EXPECT_LT(err.depth, 0.04); // depth spans 3.6 m
+  EXPECT_LT(err.composite, kCpuTolerance);
+  EXPECT_LE(err.method, method_bound + 1e-9);
 
   // The virtual panel shows through the real rim in proportion to the
   // aperture that sees past the foreground: where the rim covers half the

@@ -27,11 +27,6 @@ using renderer::Scene;
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-bool all_layers_finite(const RenderResult &r) {
-  return test::all_finite(r.composite) && test::all_finite(r.mixed) && test::all_finite(r.real) &&
-         test::all_finite(r.mask) && test::all_finite(r.depth);
-}
-
 bool bit_identical(const RenderResult &a, const RenderResult &b) {
   return a.composite.data == b.composite.data && a.mixed.data == b.mixed.data &&
          a.real.data == b.real.data && a.mask.data == b.mask.data && a.depth.data == b.depth.data;
@@ -53,7 +48,7 @@ void check_blur(const std::vector<LensCase> &cases, bool gpu) {
   for (const LensCase &c : cases) {
     const Scene scene = test::edge_scene(c.f_number, c.focus_m, c.depth_m, 256, 4);
     const RenderResult r = gpu ? test::render_gpu(scene, 256) : test::render_cpu(scene, 256);
-    ASSERT_TRUE(all_layers_finite(r)) << c.what;
+    ASSERT_TRUE(test::all_layers_finite(r)) << c.what;
     const double expected = expected_coc(scene, c.depth_m);
     const double measured = test::measured_blur_diameter(test::row_average(r.composite));
     const double tolerance = std::max(0.25, 0.02 * expected);
@@ -132,7 +127,7 @@ TEST(LensExtremes, SceneFilesAcceptFocusNearerThanTheFocalLength) {
   const Scene scene = renderer::parse_scene(
       camera_json(R"(, "f_number": 22, "focus_distance_m": 0.02)"), "near.json");
   EXPECT_FLOAT_EQ(scene.camera.focus_distance_m, 0.02f);
-  EXPECT_TRUE(all_layers_finite(test::render_cpu(scene, 4)));
+  EXPECT_TRUE(test::all_layers_finite(test::render_cpu(scene, 4)));
 }
 
 TEST(LensExtremes, SceneFilesRejectFocusThatIsNoDistance) {
@@ -171,7 +166,7 @@ TEST(LensExtremes, ApertureZeroIsThePinholeBitForBit) {
   pinhole.camera.f_number = 0.0f;
   pinhole.camera.focus_distance_m = 0.0f; // as the loader leaves a pinhole
   const RenderResult reference = test::render_cpu(pinhole, 4);
-  ASSERT_TRUE(all_layers_finite(reference));
+  ASSERT_TRUE(test::all_layers_finite(reference));
   const float focus_values[] = {
       0.03f, 1.0f, 3.5f, 1e6f, kInfinity, -1.0f, std::numeric_limits<float>::quiet_NaN()};
   for (float focus : focus_values) {
@@ -212,7 +207,7 @@ TEST(LensExtremes, DegenerateLensStatesInFrameParamsAreDefined) {
   Scene base = stability::shaded_scene(64, 48);
   base.camera.focus_distance_m = 1e6f;
   const RenderResult far_focus = test::render_cpu(base, 4);
-  ASSERT_TRUE(all_layers_finite(far_focus));
+  ASSERT_TRUE(test::all_layers_finite(far_focus));
   // Beyond the loader's 1e6 m, and +inf (lens_control's "infinity"): the
   // focal plane is put at 1e6 m, where every aperture point's ray is
   // parallel to the pinhole ray to within a micro-radian.
@@ -228,7 +223,7 @@ TEST(LensExtremes, DegenerateLensStatesInFrameParamsAreDefined) {
   for (float focus : {0.0f, -2.0f, std::numeric_limits<float>::quiet_NaN()}) {
     Scene s = base;
     s.camera.focus_distance_m = focus;
-    EXPECT_TRUE(all_layers_finite(test::render_cpu(s, 4))) << "focus " << focus;
+    EXPECT_TRUE(test::all_layers_finite(test::render_cpu(s, 4))) << "focus " << focus;
   }
   // Extreme but legal: a focal plane a micrometre away, an aperture wider
   // than the scene (f/0.01: radius 1.75 m), the narrowest the loader takes.
@@ -240,7 +235,7 @@ TEST(LensExtremes, DegenerateLensStatesInFrameParamsAreDefined) {
     s.camera.f_number = l.f_number;
     s.camera.focus_distance_m = l.focus_m;
     const RenderResult r = test::render_cpu(s, 4);
-    EXPECT_TRUE(all_layers_finite(r)) << "f/" << l.f_number << " focus " << l.focus_m;
+    EXPECT_TRUE(test::all_layers_finite(r)) << "f/" << l.f_number << " focus " << l.focus_m;
   }
 }
 

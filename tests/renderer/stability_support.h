@@ -19,23 +19,6 @@ namespace camhead::stability {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// A camera at the origin looking down -Z (f = 50 mm, 36 mm sensor) at an
-// empty scene with a black world.
-inline renderer::Scene empty_scene(const std::string &name, float f_number, float focus_m,
-                                   int width, int height) {
-  renderer::Scene scene;
-  scene.source = name;
-  scene.render.width = width;
-  scene.render.height = height;
-  scene.camera.position = {0.0f, 0.0f, 0.0f};
-  scene.camera.look_at = {0.0f, 0.0f, -1.0f};
-  scene.camera.focal_length_mm = 50.0f;
-  scene.camera.sensor_width_mm = 36.0f;
-  scene.camera.f_number = f_number;
-  scene.camera.focus_distance_m = focus_m;
-  return scene;
-}
-
 // Adds an emission material of grey radiance `radiance`; returns its index.
 inline int add_emitter(renderer::Scene &scene, const std::string &name, float radiance) {
   scene.materials.push_back({name, renderer::MaterialType::emission, glm::vec3(radiance), 1.5f});

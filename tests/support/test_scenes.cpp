@@ -7,10 +7,10 @@
 
 namespace camhead::test {
 
-renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int width, int height) {
-  using namespace renderer;
-  Scene scene;
-  scene.source = "edge_scene";
+renderer::Scene empty_scene(const char *name, float f_number, float focus_m, int width,
+                            int height) {
+  renderer::Scene scene;
+  scene.source = name;
   scene.render.width = width;
   scene.render.height = height;
   scene.camera.position = {0.0f, 0.0f, 0.0f};
@@ -19,6 +19,12 @@ renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int wid
   scene.camera.sensor_width_mm = 36.0f;
   scene.camera.f_number = f_number;
   scene.camera.focus_distance_m = focus_m;
+  return scene;
+}
+
+renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int width, int height) {
+  using namespace renderer;
+  Scene scene = empty_scene("edge_scene", f_number, focus_m, width, height);
   scene.materials.push_back({"emitter", MaterialType::emission, glm::vec3(1.0f), 1.5f});
   Object plane;
   plane.name = "half_plane";

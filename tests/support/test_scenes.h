@@ -11,8 +11,12 @@
 
 namespace camhead::test {
 
-// A camera at the origin looking down -Z (f = 50 mm, 36 mm sensor) at a
-// radiance-1 emitter that fills the half-plane x > 0 at depth `depth_m`,
+// A camera at the origin looking down -Z (f = 50 mm, 36 mm sensor) at an
+// empty scene with a black world, named `name` in messages.
+[[nodiscard]] renderer::Scene empty_scene(const char *name, float f_number, float focus_m,
+                                          int width, int height);
+
+// empty_scene() with a radiance-1 emitter that fills the half-plane x > 0 at depth `depth_m`,
 // against a black world: a vertical edge on the image's centre column.
 [[nodiscard]] renderer::Scene edge_scene(float f_number, float focus_m, float depth_m,
                                          int width = 256, int height = 16);

@@ -107,6 +107,11 @@ bool all_finite(const renderer::Image &image) {
   return true;
 }
 
+bool all_layers_finite(const renderer::RenderResult &r) {
+  return all_finite(r.composite) && all_finite(r.mixed) && all_finite(r.real) &&
+         all_finite(r.mask) && all_finite(r.depth);
+}
+
 ScratchDir::ScratchDir() {
   const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = std::string("camhead_") + (info ? info->test_suite_name() : "test") + "_" +

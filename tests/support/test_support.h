@@ -44,6 +44,8 @@ namespace camhead::test {
 
 // Every sample finite: no NaN or Inf reaches an output.
 [[nodiscard]] bool all_finite(const renderer::Image &image);
+// ... in every float layer of a render (composite, mixed, real, mask, depth).
+[[nodiscard]] bool all_layers_finite(const renderer::RenderResult &r);
 
 // A fresh folder for one test's files, named after the test and the
 // process so that parallel ctest runs never share one; removed afterwards.
