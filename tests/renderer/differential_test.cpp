@@ -66,19 +66,8 @@ Scene shadow_scene() {
   scene.camera.look_at = {0.0f, 0.3f, 0.0f};
   scene.materials.push_back({"ground", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
   scene.materials.push_back({"paint", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
-  Object ground;
-  ground.name = "ground";
-  ground.type = ShapeType::plane;
-  ground.size = {20.0f, 1.0f, 20.0f};
-  ground.material = 0;
-  ground.real = true;
-  Object box;
-  box.name = "virtual_box";
-  box.type = ShapeType::box;
-  box.center = {0.0f, 0.5f, 0.0f};
-  box.size = glm::vec3(0.4f);
-  box.material = 1;
-  scene.objects = {ground, box};
+  scene.objects = {test::plane("ground", glm::vec3(0.0f), 20.0f, 0, true),
+                   test::box("virtual_box", {0.0f, 0.5f, 0.0f}, glm::vec3(0.4f), 1, false)};
   Light key;
   key.name = "key";
   key.type = LightType::point;

@@ -60,28 +60,6 @@ Scene base_scene() {
   return stability::shaded_scene(48, 36);
 }
 
-Object sphere(const std::string &name, glm::vec3 center, float radius, int material, bool real) {
-  Object o;
-  o.name = name;
-  o.type = ShapeType::sphere;
-  o.center = center;
-  o.radius = radius;
-  o.material = material;
-  o.real = real;
-  return o;
-}
-
-Object box(const std::string &name, glm::vec3 center, glm::vec3 size, int material, bool real) {
-  Object o;
-  o.name = name;
-  o.type = ShapeType::box;
-  o.center = center;
-  o.size = size;
-  o.material = material;
-  o.real = real;
-  return o;
-}
-
 Light point_light(glm::vec3 position, float power) {
   Light l;
   l.name = "point";
@@ -118,8 +96,9 @@ TEST(Degenerate, ZeroAreaAndNonFiniteTrianglesRenderFinite) {
   sliver.rotation_deg = {90.0f, 0.0f, 0.0f};
   sliver.material = 1;
   scene.objects.push_back(sliver);
-  scene.objects.push_back(box("flat_box", {0.5f, 0.01f, 1.2f}, {0.3f, 1e-9f, 0.3f}, 2, false));
-  scene.objects.push_back(box("needle", {-0.8f, 0.5f, 0.5f}, {1e-9f, 1.0f, 1e-9f}, 1, true));
+  scene.objects.push_back(
+      test::box("flat_box", {0.5f, 0.01f, 1.2f}, {0.3f, 1e-9f, 0.3f}, 2, false));
+  scene.objects.push_back(test::box("needle", {-0.8f, 0.5f, 0.5f}, {1e-9f, 1.0f, 1e-9f}, 1, true));
 
   const renderer::CompiledScene compiled = renderer::compile_scene(scene);
   std::size_t triangles = 0;
@@ -141,7 +120,7 @@ TEST(Degenerate, SpheresOfNoSizeRenderFinite) {
   // takes none but the tiny one, code can make all of them.
   for (float radius : {0.0f, -0.3f, 1e-30f, 1e-45f, kNaN, kInf}) {
     Scene scene = base_scene();
-    scene.objects.push_back(sphere("odd", {0.0f, 0.3f, 0.5f}, radius, 3, false));
+    scene.objects.push_back(test::sphere("odd", {0.0f, 0.3f, 0.5f}, radius, 3, false));
     const RenderResult r = test::render_cpu(scene, 4);
     expect_finite(r, "sphere radius " + std::to_string(radius));
   }
@@ -151,7 +130,7 @@ TEST(Degenerate, SpheresOfNoSizeRenderFinite) {
     Scene scene = test::empty_scene("axis", 0.0f, 0.0f, 1, 1);
     scene.render.pixel_filter_width_px = 0.0f;
     scene.materials.push_back({"white", MaterialType::diffuse, glm::vec3(0.8f), 1.5f});
-    scene.objects.push_back(sphere("point", {0.0f, 0.0f, -2.0f}, radius, 0, false));
+    scene.objects.push_back(test::sphere("point", {0.0f, 0.0f, -2.0f}, radius, 0, false));
     scene.lights.push_back(point_light({0.0f, 1.0f, 0.0f}, 100.0f));
     const RenderResult r = test::render_cpu(scene, 1);
     std::printf("ray through the centre of a sphere of radius %g: mask %g, mixed %g\n",
@@ -199,7 +178,7 @@ TEST(Degenerate, CameraInsideAClosedBoxSeesOnlyWhatIsInside) {
     scene.camera.focus_distance_m = 0.5f;
     scene.render.world_color = glm::vec3(0.0f);
     // A closed real box around the camera; every light is outside it.
-    scene.objects.push_back(box("room", scene.camera.position, glm::vec3(1.0f), 1, true));
+    scene.objects.push_back(test::box("room", scene.camera.position, glm::vec3(1.0f), 1, true));
     const RenderResult dark = test::render_cpu(scene, 4);
     expect_finite(dark, "camera in a box");
     std::printf("f/%.1f, camera inside a closed box, lights outside: max radiance %g\n",
@@ -221,11 +200,11 @@ TEST(Degenerate, CameraInsideGlassMirrorAndOnASurfaceRendersFinite) {
   const int glass = int(scene.materials.size()) - 1;
   // Inside a virtual glass ball.
   Scene in_glass = scene;
-  in_glass.objects.push_back(sphere("bubble", in_glass.camera.position, 0.5f, glass, false));
+  in_glass.objects.push_back(test::sphere("bubble", in_glass.camera.position, 0.5f, glass, false));
   expect_finite(test::render_cpu(in_glass, 4), "camera in glass");
   // Inside a real mirror box with a light: specular paths to the bounce limit.
   Scene in_mirror = scene;
-  in_mirror.objects.push_back(box("hall", scene.camera.position, glm::vec3(1.0f), 3, true));
+  in_mirror.objects.push_back(test::box("hall", scene.camera.position, glm::vec3(1.0f), 3, true));
   in_mirror.lights.push_back(
       point_light(scene.camera.position + glm::vec3(0.0f, 0.3f, 0.0f), 5.0f));
   const RenderResult mirror = test::render_cpu(in_mirror, 4);
@@ -254,7 +233,7 @@ TEST(Degenerate, LightInsideAClosedBoxLightsNothingOutside) {
   scene.lights.clear();
   scene.render.world_color = glm::vec3(0.0f);
   // A closed real box standing on the ground with the only light inside.
-  scene.objects.push_back(box("lantern", {0.0f, 0.5f, 0.0f}, glm::vec3(0.6f), 1, true));
+  scene.objects.push_back(test::box("lantern", {0.0f, 0.5f, 0.0f}, glm::vec3(0.6f), 1, true));
   scene.lights.push_back(point_light({0.0f, 0.5f, 0.0f}, 500.0f));
   Light panel;
   panel.name = "panel";
@@ -302,9 +281,10 @@ TEST(Degenerate, LightsOnSurfacesAndAtTheCameraRenderFinite) {
 TEST(Degenerate, DegenerateScenesRenderFiniteOnGpu) {
   CAMHEAD_REQUIRE_VULKAN();
   Scene scene = base_scene();
-  scene.objects.push_back(sphere("nothing", {0.0f, 0.3f, 0.5f}, 0.0f, 3, false));
-  scene.objects.push_back(box("flat_box", {0.5f, 0.01f, 1.2f}, {0.3f, 1e-9f, 0.3f}, 2, false));
-  scene.objects.push_back(box("room", scene.camera.position, glm::vec3(1.0f), 1, true));
+  scene.objects.push_back(test::sphere("nothing", {0.0f, 0.3f, 0.5f}, 0.0f, 3, false));
+  scene.objects.push_back(
+      test::box("flat_box", {0.5f, 0.01f, 1.2f}, {0.3f, 1e-9f, 0.3f}, 2, false));
+  scene.objects.push_back(test::box("room", scene.camera.position, glm::vec3(1.0f), 1, true));
   scene.lights.push_back(point_light(scene.camera.position, 20.0f));
   scene.lights.push_back(point_light({0.3f, 0.0f, 0.5f}, 100.0f));
   expect_finite(test::render_gpu(scene, 4), "degenerate scene on the GPU");

@@ -14,6 +14,7 @@
 
 #include "camhead/renderer/image.h"
 #include "camhead/renderer/scene.h"
+#include "test_scenes.h"
 
 namespace camhead::stability {
 
@@ -64,33 +65,11 @@ inline renderer::Scene shaded_scene(int width, int height) {
   scene.materials.push_back({"crate", MaterialType::diffuse, glm::vec3(0.6f, 0.5f, 0.4f), 1.5f});
   scene.materials.push_back({"paint", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
   scene.materials.push_back({"chrome", MaterialType::mirror, glm::vec3(0.9f), 1.5f});
-  Object ground;
-  ground.name = "ground";
-  ground.type = ShapeType::plane;
-  ground.size = {20.0f, 1.0f, 20.0f};
-  ground.material = 0;
-  ground.real = true;
-  Object crate;
-  crate.name = "crate";
-  crate.type = ShapeType::box;
-  crate.center = {0.8f, 0.25f, -0.5f};
-  crate.size = glm::vec3(0.5f);
-  crate.rotation_deg = {0.0f, 30.0f, 0.0f};
-  crate.material = 1;
-  crate.real = true;
-  Object box;
-  box.name = "virtual_box";
-  box.type = ShapeType::box;
-  box.center = {0.1f, 0.15f, 0.8f};
-  box.size = glm::vec3(0.3f);
-  box.material = 2;
-  Object ball;
-  ball.name = "virtual_ball";
-  ball.type = ShapeType::sphere;
-  ball.center = {-0.5f, 0.3f, 0.1f};
-  ball.radius = 0.3f;
-  ball.material = 3;
-  scene.objects = {ground, crate, box, ball};
+  scene.objects = {
+      test::plane("ground", glm::vec3(0.0f), 20.0f, 0, true),
+      test::box("crate", {0.8f, 0.25f, -0.5f}, glm::vec3(0.5f), 1, true, {0.0f, 30.0f, 0.0f}),
+      test::box("virtual_box", {0.1f, 0.15f, 0.8f}, glm::vec3(0.3f), 2, false),
+      test::sphere("virtual_ball", {-0.5f, 0.3f, 0.1f}, 0.3f, 3, false)};
   Light key;
   key.name = "key";
   key.type = LightType::point;

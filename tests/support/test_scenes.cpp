@@ -22,6 +22,41 @@ renderer::Scene empty_scene(const char *name, float f_number, float focus_m, int
   return scene;
 }
 
+renderer::Object sphere(const char *name, glm::vec3 center, float radius, int material, bool real) {
+  renderer::Object o;
+  o.name = name;
+  o.type = renderer::ShapeType::sphere;
+  o.center = center;
+  o.radius = radius;
+  o.material = material;
+  o.real = real;
+  return o;
+}
+
+renderer::Object box(const char *name, glm::vec3 center, glm::vec3 size, int material, bool real,
+                     glm::vec3 rotation_deg) {
+  renderer::Object o;
+  o.name = name;
+  o.type = renderer::ShapeType::box;
+  o.center = center;
+  o.size = size;
+  o.rotation_deg = rotation_deg;
+  o.material = material;
+  o.real = real;
+  return o;
+}
+
+renderer::Object plane(const char *name, glm::vec3 center, float size_m, int material, bool real) {
+  renderer::Object o;
+  o.name = name;
+  o.type = renderer::ShapeType::plane;
+  o.center = center;
+  o.size = {size_m, 1.0f, size_m};
+  o.material = material;
+  o.real = real;
+  return o;
+}
+
 renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int width, int height) {
   using namespace renderer;
   Scene scene = empty_scene("edge_scene", f_number, focus_m, width, height);

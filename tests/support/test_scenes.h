@@ -16,6 +16,15 @@ namespace camhead::test {
 [[nodiscard]] renderer::Scene empty_scene(const char *name, float f_number, float focus_m,
                                           int width, int height);
 
+// Scene objects, made in one line.
+[[nodiscard]] renderer::Object sphere(const char *name, glm::vec3 center, float radius,
+                                      int material, bool real);
+[[nodiscard]] renderer::Object box(const char *name, glm::vec3 center, glm::vec3 size, int material,
+                                   bool real, glm::vec3 rotation_deg = glm::vec3(0.0f));
+// A plane through `center`, normal +Y, of `size_m` x `size_m`.
+[[nodiscard]] renderer::Object plane(const char *name, glm::vec3 center, float size_m, int material,
+                                     bool real);
+
 // empty_scene() with a radiance-1 emitter that fills the half-plane x > 0 at depth `depth_m`,
 // against a black world: a vertical edge on the image's centre column.
 [[nodiscard]] renderer::Scene edge_scene(float f_number, float focus_m, float depth_m,
