@@ -13,6 +13,8 @@
 #include <dlfcn.h>
 #include <gpiod.h>
 
+#include "gpiod_library.h"
+
 namespace {
 
 struct LineState {
@@ -285,3 +287,24 @@ int gpiod_line_event_read_multiple(gpiod_line *line, gpiod_line_event *events,
 }
 
 } // extern "C"
+
+// --- The backend's table, filled from the link ---------------------------------
+// The backend calls libgpiod through detail::gpiod() (src/gpiod_library.h),
+// which camhead fills by dlopen. Defined here, the table holds the functions
+// above instead: this binary's definitions take the place of the library's
+// gpiod_library.cpp, which the linker then leaves out.
+namespace camhead::hal::lens::gpio::detail {
+
+const std::string &gpiod_load_error() {
+  static const std::string none;
+  return none;
+}
+
+const GpiodFunctions &gpiod() {
+#define CAMHEAD_GPIOD_LINKED(name) .name = &::gpiod_##name,
+  static const GpiodFunctions linked{CAMHEAD_GPIOD_FUNCTIONS(CAMHEAD_GPIOD_LINKED)};
+#undef CAMHEAD_GPIOD_LINKED
+  return linked;
+}
+
+} // namespace camhead::hal::lens::gpio::detail

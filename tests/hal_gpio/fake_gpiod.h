@@ -1,10 +1,11 @@
 // An in-process stand-in for the kernel behind libgpiod 1.6, so that the real
 // backend (src/gpiod_edge_source.cpp, unchanged) can be tested without GPIO
 // hardware: a link seam. fake_gpiod.cpp defines the libgpiod functions that
-// the backend calls; the test binary's definitions take precedence over
-// libgpiod.so's, and every call on a handle that is not a fake one is
-// forwarded to the real libgpiod (dlsym RTLD_NEXT), so tests that want the
-// real library (a missing chip) still get it.
+// the backend calls, and the backend's function table (src/gpiod_library.h)
+// points at them instead of at a dlopen'ed libgpiod; every call on a handle
+// that is not a fake one is forwarded to the real libgpiod (dlsym
+// RTLD_NEXT, else dlopen), so tests that want the real library (a missing
+// chip) still get it.
 //
 // What the fake models of the v1 uAPI: one event queue per line holding 16
 // (further events are dropped, as the kernel does), rising/falling from the

@@ -65,6 +65,7 @@ get_property(vm_scripts DIRECTORY PROPERTY vm_scripts)
 get_property(vm_results DIRECTORY PROPERTY vm_results)
 get_property(vm_programs DIRECTORY PROPERTY vm_programs)
 get_property(vm_modules DIRECTORY PROPERTY vm_modules)
+get_property(vm_libraries DIRECTORY PROPERTY vm_libraries)
 
 if(vm_missing)
   list(JOIN vm_missing ", " missing_text)
@@ -109,6 +110,10 @@ foreach(script IN LISTS vm_scripts)
 endforeach()
 foreach(program IN LISTS vm_programs)
   list(APPEND vm_args --program $<TARGET_FILE:${program}>)
+endforeach()
+list(REMOVE_DUPLICATES vm_libraries)
+foreach(library IN LISTS vm_libraries)
+  list(APPEND vm_args --library ${library})
 endforeach()
 add_custom_command(OUTPUT ${lab_dir}/initramfs.cpio.gz
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/make_initramfs.sh

@@ -6,13 +6,16 @@
 #
 #   make_initramfs.sh --out FILE --kernel K --busybox FILE --init FILE
 #       [--module NAME]... [--extra-module FILE.ko]... [--check FILE.sh]...
-#       [--program FILE]...
+#       [--program FILE]... [--library SONAME]...
+#
+# --library packs a library that a program opens at run time (dlopen), which
+# ldd cannot see: the hal backends' libusb-1.0.so.0 and libgpiod.so.2.
 #
 # The guest runs the checks in the order given.
 set -euo pipefail
 
 out='' kernel='' busybox='' init=''
-modules=() extra_modules=() checks=() programs=()
+modules=() extra_modules=() checks=() programs=() libraries=()
 while [ $# -gt 0 ]; do
   case $1 in
   --out) out=$2 ;;
@@ -23,6 +26,7 @@ while [ $# -gt 0 ]; do
   --extra-module) extra_modules+=("$2") ;;
   --check) checks+=("$2") ;;
   --program) programs+=("$2") ;;
+  --library) libraries+=("$2") ;;
   *)
     echo "make_initramfs.sh: unknown argument $1" >&2
     exit 2
@@ -98,6 +102,16 @@ printf '%s\n' "${checks[@]##*/}" >"$root/etc/lab-checks"
 for program in "${programs[@]}"; do
   install -m 755 "$program" "$root/usr/bin/"
   copy_libraries "$program"
+done
+for soname in "${libraries[@]}"; do
+  # Where the dynamic loader would find it here; the guest looks in the same place.
+  path=$(/sbin/ldconfig -p | awk -v name="$soname" '$1 == name && /x86-64/ { print $NF; exit }')
+  if [ -z "$path" ]; then
+    echo "make_initramfs.sh: --library $soname: not installed (ldconfig -p lists no such file)" >&2
+    exit 1
+  fi
+  [ -e "$root$path" ] || install -D -m 755 "$(readlink -f "$path")" "$root$path"
+  copy_libraries "$path"
 done
 
 # newc is the format the kernel unpacks; sorted names and fixed times keep

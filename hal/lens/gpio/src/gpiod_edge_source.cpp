@@ -81,15 +81,19 @@ std::string GpiodEdgeSource::line_name(const LineRole &role) const {
 
 bool GpiodEdgeSource::open(std::string &error) {
   close();
+  if (const std::string &why = gpiod_load_error(); !why.empty()) {
+    error = name() + ": " + why;
+    return false;
+  }
   errno = 0;
-  ChipHandle chip(gpiod_chip_open_lookup(chip_descr_.c_str()));
+  ChipHandle chip(gpiod().chip_open_lookup(chip_descr_.c_str()));
   if (!chip) {
     error = name() + ": cannot open chip: " +
             (errno != 0 ? errno_text(errno) : std::string("no chip by that name, path or label"));
     return false;
   }
-  chip_name_ = gpiod_chip_name(chip.get());
-  const unsigned num_lines = gpiod_chip_num_lines(chip.get());
+  chip_name_ = gpiod().chip_name(chip.get());
+  const unsigned num_lines = gpiod().chip_num_lines(chip.get());
 
   // One request per line rather than gpiod_line_request_bulk_*: libgpiod 1.6
   // makes one v1 event request per line either way, but this way a failure
@@ -101,17 +105,18 @@ bool GpiodEdgeSource::open(std::string &error) {
           line_name(role) + ": no such line; the chip has " + std::to_string(num_lines) + " lines";
       return false; // `chip` closes and releases the lines requested so far
     }
-    gpiod_line *line = gpiod_chip_get_line(chip.get(), role.offset);
+    gpiod_line *line = gpiod().chip_get_line(chip.get(), role.offset);
     if (line == nullptr) {
       error = line_name(role) + ": cannot get line: " + errno_text(errno);
       return false;
     }
     const int flags = request_flags_ | (role.active_low ? GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW : 0);
-    if (gpiod_line_request_both_edges_events_flags(line, consumer_.c_str(), flags) < 0) {
+    if (gpiod().line_request_both_edges_events_flags(line, consumer_.c_str(), flags) < 0) {
       const int err = errno;
       error = line_name(role) + ": cannot request both-edge events: " + errno_text(err);
-      if (err == EBUSY && gpiod_line_update(line) == 0 && gpiod_line_consumer(line) != nullptr) {
-        error += std::string("; used by \"") + gpiod_line_consumer(line) + '"';
+      if (err == EBUSY && gpiod().line_update(line) == 0 &&
+          gpiod().line_consumer(line) != nullptr) {
+        error += std::string("; used by \"") + gpiod().line_consumer(line) + '"';
       }
       return false;
     }
@@ -134,7 +139,7 @@ bool GpiodEdgeSource::read_levels(AllLevels &levels, std::int64_t &t_ns, std::st
     return false;
   }
   for (std::size_t i = 0; i < lines_.size(); ++i) {
-    const int value = gpiod_line_get_value(lines_[i]);
+    const int value = gpiod().line_get_value(lines_[i]);
     if (value < 0) {
       error = line_name(roles_[i]) + ": cannot read level: " + errno_text(errno);
       return false;
@@ -171,13 +176,13 @@ bool GpiodEdgeSource::wait_edges(std::chrono::milliseconds timeout, std::vector<
   const auto ms = std::max<std::int64_t>(timeout.count(), 0);
   timespec wait{static_cast<time_t>(ms / 1000), static_cast<long>((ms % 1000) * 1'000'000)};
   gpiod_line_bulk ready;
-  int rv = gpiod_line_event_wait_bulk(&all, &wait, &ready);
+  int rv = gpiod().line_event_wait_bulk(&all, &wait, &ready);
   bool ok = true;
   for (int round = 0; rv > 0 && ok && round < kMaxDrainRounds; ++round) {
     ok = read_ready(ready, out, error);
     if (ok) {
       const timespec zero{};
-      rv = gpiod_line_event_wait_bulk(&all, &zero, &ready);
+      rv = gpiod().line_event_wait_bulk(&all, &zero, &ready);
     }
   }
   if (ok && rv < 0) {
@@ -203,8 +208,8 @@ bool GpiodEdgeSource::read_ready(gpiod_line_bulk &ready, std::vector<EdgeEvent> 
     const LineRole &role = roles_[static_cast<std::size_t>(it - lines_.begin())];
     // Ready means at least one event (or a hang-up, which fails the read),
     // so this read does not block.
-    const int n =
-        gpiod_line_event_read_multiple(line, buffer_.data(), static_cast<unsigned>(buffer_.size()));
+    const int n = gpiod().line_event_read_multiple(line, buffer_.data(),
+                                                   static_cast<unsigned>(buffer_.size()));
     if (n < 0) {
       error = line_name(role) + ": cannot read events: " + errno_text(errno);
       return false;

@@ -1,5 +1,6 @@
-// The libgpiod 1.6 edge source: the only file of camhead that includes
-// <gpiod.h> (style.md: gpiod types never leave the module). See
+// The libgpiod 1.6 edge source: with gpiod_library.h, the only header of
+// camhead that includes <gpiod.h> (style.md: gpiod types never leave the
+// module). libgpiod is opened at run time (gpiod_library.h). See
 // gpio_quadrature.h for the behaviour of the v1 uAPI behind it.
 //
 // Handles: the chip is owned by a unique_ptr with gpiod_chip_close as its
@@ -15,15 +16,14 @@
 #include <string>
 #include <vector>
 
-#include <gpiod.h>
-
 #include "camhead/hal/lens/gpio/edge_source.h"
 #include "camhead/hal/lens/gpio/gpio_quadrature.h"
+#include "gpiod_library.h"
 
 namespace camhead::hal::lens::gpio::detail {
 
 struct ChipCloser {
-  void operator()(gpiod_chip *chip) const noexcept { gpiod_chip_close(chip); }
+  void operator()(gpiod_chip *chip) const noexcept { gpiod().chip_close(chip); }
 };
 using ChipHandle = std::unique_ptr<gpiod_chip, ChipCloser>;
 

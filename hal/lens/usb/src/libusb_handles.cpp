@@ -18,12 +18,12 @@ constexpr unsigned kControlTimeoutMs = 200;
 
 DeviceList::~DeviceList() {
   if (list_ != nullptr) {
-    libusb_free_device_list(list_, 1);
+    libusb().free_device_list(list_, 1);
   }
 }
 
 std::string error_name(int code) {
-  return libusb_error_name(code);
+  return libusb().error_name(code);
 }
 
 const char *transfer_status_name(libusb_transfer_status status) {
@@ -47,8 +47,8 @@ const char *transfer_status_name(libusb_transfer_status status) {
 }
 
 std::string where(libusb_device *dev) {
-  return "bus " + std::to_string(libusb_get_bus_number(dev)) + " device " +
-         std::to_string(libusb_get_device_address(dev));
+  return "bus " + std::to_string(libusb().get_bus_number(dev)) + " device " +
+         std::to_string(libusb().get_device_address(dev));
 }
 
 std::optional<LensInterface> find_lens_interface(const libusb_config_descriptor &config) {
@@ -82,8 +82,8 @@ std::string read_serial(libusb_device_handle *handle, const libusb_device_descri
     return {};
   }
   std::array<unsigned char, 64> text{};
-  const int n = libusb_get_string_descriptor_ascii(handle, desc.iSerialNumber, text.data(),
-                                                   static_cast<int>(text.size()));
+  const int n = libusb().get_string_descriptor_ascii(handle, desc.iSerialNumber, text.data(),
+                                                     static_cast<int>(text.size()));
   return n > 0
              ? std::string(reinterpret_cast<const char *>(text.data()), static_cast<std::size_t>(n))
              : std::string{};
@@ -92,9 +92,9 @@ std::string read_serial(libusb_device_handle *handle, const libusb_device_descri
 std::string read_board_info(libusb_device_handle *handle, int interface) {
   std::array<unsigned char, kUsbLensInfoSize> buffer{};
   const int rc =
-      libusb_control_transfer(handle, kUsbLensGetInfoRequestType, kUsbLensGetInfoRequest, 0,
-                              static_cast<std::uint16_t>(interface), buffer.data(),
-                              static_cast<std::uint16_t>(buffer.size()), kControlTimeoutMs);
+      libusb().control_transfer(handle, kUsbLensGetInfoRequestType, kUsbLensGetInfoRequest, 0,
+                                static_cast<std::uint16_t>(interface), buffer.data(),
+                                static_cast<std::uint16_t>(buffer.size()), kControlTimeoutMs);
   if (rc < 0) {
     return "no GET_INFO: " + error_name(rc);
   }

@@ -1,8 +1,8 @@
 // libusb for the lens backend: RAII for its C handles and the questions the
 // transport asks a device before it streams from it (which interface, which
 // endpoint, which serial, what GET_INFO says). Private to
-// camhead_hal_lens_usb: this is the only header that includes <libusb.h>, and
-// only libusb_transport.cpp and libusb_handles.cpp include it.
+// camhead_hal_lens_usb: with libusb_library.h, the only header that includes
+// <libusb.h>; only the libusb_*.cpp files include them.
 //
 // Thread safety: the functions are as thread-safe as libusb's; the transport
 // calls them all from its event thread.
@@ -13,26 +13,25 @@
 #include <optional>
 #include <string>
 
-#include <libusb.h>
-
 #include "camhead/hal/lens/monotonic_clock.h"
+#include "libusb_library.h"
 
 namespace camhead::hal::lens::detail {
 
 struct ContextDeleter {
-  void operator()(libusb_context *c) const { libusb_exit(c); }
+  void operator()(libusb_context *c) const { libusb().exit(c); }
 };
 struct HandleDeleter {
-  void operator()(libusb_device_handle *h) const { libusb_close(h); }
+  void operator()(libusb_device_handle *h) const { libusb().close(h); }
 };
 struct DeviceDeleter {
-  void operator()(libusb_device *d) const { libusb_unref_device(d); }
+  void operator()(libusb_device *d) const { libusb().unref_device(d); }
 };
 struct TransferDeleter {
-  void operator()(libusb_transfer *t) const { libusb_free_transfer(t); }
+  void operator()(libusb_transfer *t) const { libusb().free_transfer(t); }
 };
 struct ConfigDeleter {
-  void operator()(libusb_config_descriptor *c) const { libusb_free_config_descriptor(c); }
+  void operator()(libusb_config_descriptor *c) const { libusb().free_config_descriptor(c); }
 };
 using ContextPtr = std::unique_ptr<libusb_context, ContextDeleter>;
 using HandlePtr = std::unique_ptr<libusb_device_handle, HandleDeleter>;
@@ -46,7 +45,7 @@ using ConfigPtr = std::unique_ptr<libusb_config_descriptor, ConfigDeleter>;
 // libusb_get_device_list's array, unreferencing its devices on destruction.
 class DeviceList {
 public:
-  explicit DeviceList(libusb_context *ctx) : count_(libusb_get_device_list(ctx, &list_)) {}
+  explicit DeviceList(libusb_context *ctx) : count_(libusb().get_device_list(ctx, &list_)) {}
   ~DeviceList();
   DeviceList(const DeviceList &) = delete;
   DeviceList &operator=(const DeviceList &) = delete;

@@ -17,8 +17,6 @@
 #include <utility>
 #include <vector>
 
-#include <libusb.h>
-
 #include "camhead/hal/lens/usb/usb_lens.h"
 #include "camhead/hal/lens/usb/usb_lens_protocol.h"
 #include "libusb_handles.h"
@@ -81,8 +79,8 @@ private:
                                           libusb_hotplug_event event, void *user) {
     auto *self = static_cast<LibusbTransport *>(user);
     if (event == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED) {
-      self->arrivals_.emplace_back(libusb_ref_device(dev));
-    } else if (self->handle_ && libusb_get_device(self->handle_.get()) == dev) {
+      self->arrivals_.emplace_back(libusb().ref_device(dev));
+    } else if (self->handle_ && libusb().get_device(self->handle_.get()) == dev) {
       self->mark_gone("device went away (hotplug)");
     }
     return 0; // stay registered
@@ -112,7 +110,7 @@ void LibusbTransport::run() {
   link_.waiting("not connected");
   while (!stop_) {
     if (!ctx_ && !init_context()) {
-      // No libusb at all (no usbfs, a sandbox): try again later.
+      // No libusb at all (not installed, no usbfs, a sandbox): try again later.
       for (auto until = Clock::now() + config_.rescan_interval; !stop_ && Clock::now() < until;) {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
@@ -145,12 +143,12 @@ void LibusbTransport::run() {
       continue; // open what the scan found before waiting for events
     }
     timeval slice{0, kEventSliceUs};
-    libusb_handle_events_timeout_completed(ctx_.get(), &slice, nullptr);
+    libusb().handle_events_timeout_completed(ctx_.get(), &slice, nullptr);
 
     if (handle_ && halted_ && !gone_) {
       // A stalled endpoint: clear it here, outside the transfer callback
       // (a synchronous request inside one would re-enter the event loop).
-      const int rc = libusb_clear_halt(handle_.get(), lens_.endpoint);
+      const int rc = libusb().clear_halt(handle_.get(), lens_.endpoint);
       halted_ = false;
       if (rc < 0) {
         mark_gone("clear halt on endpoint failed: " + error_name(rc));
@@ -174,16 +172,20 @@ void LibusbTransport::run() {
 }
 
 bool LibusbTransport::init_context() {
+  if (const std::string &error = libusb_load_error(); !error.empty()) {
+    link_.waiting(error);
+    return false;
+  }
   libusb_context *raw = nullptr;
-  if (const int rc = libusb_init(&raw); rc < 0) {
+  if (const int rc = libusb().init(&raw); rc < 0) {
     link_.waiting("libusb_init failed: " + error_name(rc));
     return false;
   }
   ctx_.reset(raw);
-  hotplug_ = libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) != 0;
+  hotplug_ = libusb().has_capability(LIBUSB_CAP_HAS_HOTPLUG) != 0;
   if (hotplug_) {
     // ENUMERATE: the boards already present arrive through the same callback.
-    const int rc = libusb_hotplug_register_callback(
+    const int rc = libusb().hotplug_register_callback(
         ctx_.get(),
         static_cast<libusb_hotplug_event>(LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED |
                                           LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT),
@@ -201,7 +203,7 @@ bool LibusbTransport::init_context() {
 void LibusbTransport::drop_context() {
   arrivals_.clear(); // device references die before their context
   if (ctx_ && hotplug_) {
-    libusb_hotplug_deregister_callback(ctx_.get(), hotplug_handle_);
+    libusb().hotplug_deregister_callback(ctx_.get(), hotplug_handle_);
   }
   hotplug_ = false;
   ctx_.reset();
@@ -215,21 +217,21 @@ void LibusbTransport::scan_device_list() {
   }
   for (ssize_t i = 0; i < list.count(); ++i) {
     libusb_device_descriptor desc{};
-    if (libusb_get_device_descriptor(list[i], &desc) == LIBUSB_SUCCESS &&
+    if (libusb().get_device_descriptor(list[i], &desc) == LIBUSB_SUCCESS &&
         desc.idVendor == config_.vid && desc.idProduct == config_.pid) {
-      arrivals_.emplace_back(libusb_ref_device(list[i]));
+      arrivals_.emplace_back(libusb().ref_device(list[i]));
     }
   }
 }
 
 void LibusbTransport::try_open(libusb_device *dev) {
   libusb_device_descriptor desc{};
-  if (libusb_get_device_descriptor(dev, &desc) != LIBUSB_SUCCESS || desc.idVendor != config_.vid ||
-      desc.idProduct != config_.pid) {
+  if (libusb().get_device_descriptor(dev, &desc) != LIBUSB_SUCCESS ||
+      desc.idVendor != config_.vid || desc.idProduct != config_.pid) {
     return;
   }
   libusb_device_handle *raw = nullptr;
-  if (const int rc = libusb_open(dev, &raw); rc < 0) {
+  if (const int rc = libusb().open(dev, &raw); rc < 0) {
     std::string why = "cannot open " + where(dev) + ": " + error_name(rc);
     if (rc == LIBUSB_ERROR_ACCESS) {
       why += " (no permission on /dev/bus/usb: install systemd/70-camhead-lens.rules)";
@@ -246,7 +248,7 @@ void LibusbTransport::try_open(libusb_device *dev) {
   }
 
   libusb_config_descriptor *config_raw = nullptr;
-  if (const int rc = libusb_get_active_config_descriptor(dev, &config_raw); rc < 0) {
+  if (const int rc = libusb().get_active_config_descriptor(dev, &config_raw); rc < 0) {
     link_.waiting("cannot read the configuration of " + where(dev) + ": " + error_name(rc));
     return;
   }
@@ -261,8 +263,8 @@ void LibusbTransport::try_open(libusb_device *dev) {
   }
   // A vendor interface has no kernel driver; detaching one (usbfs from
   // another program aside) is harmless where the platform cannot.
-  libusb_set_auto_detach_kernel_driver(handle.get(), 1);
-  if (const int rc = libusb_claim_interface(handle.get(), lens->number); rc < 0) {
+  libusb().set_auto_detach_kernel_driver(handle.get(), 1);
+  if (const int rc = libusb().claim_interface(handle.get(), lens->number); rc < 0) {
     link_.waiting("cannot claim interface " + std::to_string(lens->number) + " of " + where(dev) +
                   ": " + error_name(rc) +
                   (rc == LIBUSB_ERROR_BUSY ? " (another program has it)" : ""));
@@ -286,7 +288,7 @@ void LibusbTransport::try_open(libusb_device *dev) {
   const std::size_t size = std::max<std::size_t>(lens_.max_packet, kUsbLensReportSize);
   for (Slot &slot : slots_) {
     if (!slot.transfer) {
-      slot.transfer.reset(libusb_alloc_transfer(0));
+      slot.transfer.reset(libusb().alloc_transfer(0));
     }
     slot.buffer.assign(size, 0);
     if (lens_.interrupt) {
@@ -305,7 +307,7 @@ void LibusbTransport::try_open(libusb_device *dev) {
 }
 
 void LibusbTransport::submit(Slot &slot) {
-  const int rc = libusb_submit_transfer(slot.transfer.get());
+  const int rc = libusb().submit_transfer(slot.transfer.get());
   if (rc == LIBUSB_SUCCESS) {
     slot.in_flight = true;
   } else if (rc == LIBUSB_ERROR_NO_DEVICE) {
@@ -369,7 +371,7 @@ void LibusbTransport::on_transfer(libusb_transfer *transfer) {
 void LibusbTransport::close_device(const std::string &reason) {
   for (Slot &slot : slots_) {
     if (slot.in_flight) {
-      libusb_cancel_transfer(slot.transfer.get());
+      libusb().cancel_transfer(slot.transfer.get());
     }
   }
   const auto deadline = Clock::now() + kCancelWait;
@@ -378,7 +380,7 @@ void LibusbTransport::close_device(const std::string &reason) {
   };
   while (any_in_flight() && Clock::now() < deadline) {
     timeval slice{0, 10'000};
-    libusb_handle_events_timeout_completed(ctx_.get(), &slice, nullptr);
+    libusb().handle_events_timeout_completed(ctx_.get(), &slice, nullptr);
   }
   std::string why = reason;
   for (Slot &slot : slots_) {
@@ -397,7 +399,7 @@ void LibusbTransport::close_device(const std::string &reason) {
       slot.transfer.reset();
     }
   }
-  libusb_release_interface(handle_.get(), lens_.number);
+  libusb().release_interface(handle_.get(), lens_.number);
   handle_.reset();
   gone_ = halted_ = false;
   link_.device_left(why);
