@@ -73,14 +73,8 @@ int run(const Args &args) {
   const double rays = double(args.width) * args.height * args.rpp;
 
   const EmbreeWorld world = make_embree_world(compiled);
-  CpuKernel kernel;
-  kernel.primitives = compiled.primitives.data();
-  kernel.nodes = compiled.nodes.data();
-  kernel.materials = compiled.materials.data();
-  kernel.lights = compiled.lights.data();
-  kernel.frame = frame;
-  // The compiled scene is stored relative to `origin` (compiled_scene.h).
-  kernel.frame.cam_position -= glm::vec4(compiled.origin, 0.0f);
+  std::vector<renderer::gpu::BvhNode> nodes;
+  CpuKernel kernel = renderer::cpu::make_cpu_kernel(compiled, frame, nodes);
 
   std::unique_ptr<renderer::GpuTracer> gpu;
   if (args.camhead) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -15,6 +16,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/gpu_layout.h"
 
 namespace camhead::renderer::cpu {
@@ -46,5 +48,12 @@ struct CpuKernel {
 #undef INOUT
 #undef OUT
 #undef PRECISE
+
+// The kernel as the CPU reference runs it: `scene` with `frame` moved into
+// the compiled scene's frame, uniform sampling (tracing.y = 0), pixels no
+// ray can take into the scene traced once (TRACING_SKIP_EMPTY_PIXELS).
+// `nodes` keeps the BVH alive (the empty one for a scene without nodes).
+[[nodiscard]] CpuKernel make_cpu_kernel(const CompiledScene &scene, const FrameParams &frame,
+                                        std::vector<BvhNode> &nodes);
 
 } // namespace camhead::renderer::cpu

@@ -33,20 +33,8 @@ private:
 
 } // namespace
 
-namespace {
-
-// The three accumulators of every pixel.
-struct Accumulators {
-  explicit Accumulators(std::size_t pixels)
-      : mixed(pixels, glm::vec4(0.0f)), real(pixels, glm::vec4(0.0f)),
-        aux(pixels, glm::vec4(0.0f)) {}
-  std::vector<glm::vec4> mixed, real, aux;
-};
-
-// A kernel for `scene` with `frame` in the compiled scene's frame. `nodes`
-// keeps the empty BVH alive for a scene without nodes.
-cpu::CpuKernel make_kernel(const CompiledScene &scene, const gpu::FrameParams &frame,
-                           std::vector<gpu::BvhNode> &nodes) {
+cpu::CpuKernel cpu::make_cpu_kernel(const CompiledScene &scene, const gpu::FrameParams &frame,
+                                    std::vector<gpu::BvhNode> &nodes) {
   cpu::CpuKernel kernel;
   kernel.primitives = scene.primitives.data();
   // As the GPU tracer: a scene without nodes traverses the empty BVH.
@@ -65,6 +53,16 @@ cpu::CpuKernel make_kernel(const CompiledScene &scene, const gpu::FrameParams &f
   kernel.frame.tracing.w |= TRACING_SKIP_EMPTY_PIXELS;
   return kernel;
 }
+
+namespace {
+
+// The three accumulators of every pixel.
+struct Accumulators {
+  explicit Accumulators(std::size_t pixels)
+      : mixed(pixels, glm::vec4(0.0f)), real(pixels, glm::vec4(0.0f)),
+        aux(pixels, glm::vec4(0.0f)) {}
+  std::vector<glm::vec4> mixed, real, aux;
+};
 
 // Runs kernel.trace_pixel over every pixel on `threads` threads; `report`
 // gets the fraction of rows done.
@@ -144,7 +142,7 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
   const std::size_t pixels = std::size_t(frame.image.x) * frame.image.y;
   const uint32_t total = frame.sampling.z;
   std::vector<gpu::BvhNode> nodes;
-  cpu::CpuKernel kernel = make_kernel(scene, frame, nodes);
+  cpu::CpuKernel kernel = cpu::make_cpu_kernel(scene, frame, nodes);
   kernel.frame.sampling.x = 0;
   kernel.frame.sampling.y = total;
   Accumulators acc(pixels);
@@ -167,7 +165,7 @@ RenderResult render_cpu_adaptive(const CompiledScene &scene, const gpu::FramePar
   const uint32_t total = frame.sampling.z;
   const uint32_t pilot = adaptive_pilot(settings, total);
   std::vector<gpu::BvhNode> nodes;
-  cpu::CpuKernel kernel = make_kernel(scene, frame, nodes);
+  cpu::CpuKernel kernel = cpu::make_cpu_kernel(scene, frame, nodes);
   Accumulators acc(pixels);
   const auto report = [&](double done) {
     if (progress)
