@@ -104,8 +104,10 @@ for program in "${programs[@]}"; do
   copy_libraries "$program"
 done
 for soname in "${libraries[@]}"; do
-  # Where the dynamic loader would find it here; the guest looks in the same place.
-  path=$(/sbin/ldconfig -p | awk -v name="$soname" '$1 == name && /x86-64/ { print $NF; exit }')
+  # Where the dynamic loader would find it here; the guest looks in the same
+  # place. awk reads to the end: an early exit would kill ldconfig with
+  # SIGPIPE, which pipefail turns into a silent failure of this script.
+  path=$(/sbin/ldconfig -p | awk -v name="$soname" '$1 == name && /x86-64/ && !found { print $NF; found = 1 }')
   if [ -z "$path" ]; then
     echo "make_initramfs.sh: --library $soname: not installed (ldconfig -p lists no such file)" >&2
     exit 1

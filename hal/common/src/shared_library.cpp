@@ -1,6 +1,8 @@
 // See shared_library.h.
 #include "camhead/hal/shared_library.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <utility>
 
 #include <dlfcn.h>
@@ -42,6 +44,12 @@ void *SharedLibrary::find(const char *symbol) {
              ": another version than camhead was built for? " + last_dl_error();
   }
   return address;
+}
+
+void abort_unloaded_library(const std::string &error) {
+  std::fprintf(stderr, "camhead: a device library was called although it did not load: %s\n",
+               error.c_str());
+  std::abort();
 }
 
 } // namespace camhead::hal

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 
 namespace camhead::hal {
 
@@ -46,6 +47,36 @@ private:
   std::string package_;
   void *handle_ = nullptr;
   std::string error_;
+};
+
+// Prints `error` and aborts: a backend called its library without checking
+// that it loaded, a bug rather than a user's problem.
+[[noreturn]] void abort_unloaded_library(const std::string &error);
+
+// A library and its table of functions (a struct of pointers), resolved
+// once by `resolve_all(library, functions)`. Kept for the life of the
+// process, like a linked library: hold it in a function-local static.
+template <class Functions> class FunctionTable {
+public:
+  template <class ResolveAll>
+  FunctionTable(std::string soname, std::string debian_package, ResolveAll resolve_all)
+      : library_(std::move(soname), std::move(debian_package)) {
+    resolve_all(library_, functions_);
+  }
+
+  // "" when every function was found; otherwise SharedLibrary::error().
+  [[nodiscard]] const std::string &error() const { return library_.error(); }
+  // The table; only after error() returned "" (aborts otherwise).
+  [[nodiscard]] const Functions &functions() const {
+    if (!library_.ok()) {
+      abort_unloaded_library(library_.error());
+    }
+    return functions_;
+  }
+
+private:
+  SharedLibrary library_;
+  Functions functions_{};
 };
 
 } // namespace camhead::hal
