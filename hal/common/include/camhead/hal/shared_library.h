@@ -54,8 +54,8 @@ private:
 [[noreturn]] void abort_unloaded_library(const std::string &error);
 
 // A library and its table of functions (a struct of pointers), resolved
-// once by `resolve_all(library, functions)`. Kept for the life of the
-// process, like a linked library: hold it in a function-local static.
+// once by `resolve_all(library, functions)`. Meant to live as long as the
+// process, like a linked library: a function-local static never destroyed.
 template <class Functions> class FunctionTable {
 public:
   template <class ResolveAll>
