@@ -60,7 +60,7 @@ TEST(DeviceLibraries, LibgpiodHasEveryFunctionTheBackendCalls) {
 #define CAMHEAD_EXPECT_FOUND(name) EXPECT_NE(gpiod.name, nullptr) << "gpiod_" #name;
   CAMHEAD_GPIOD_FUNCTIONS(CAMHEAD_EXPECT_FOUND)
 #undef CAMHEAD_EXPECT_FOUND
-  // No chip by this name on any machine: the real library answers (errno set).
+  // No chip by this name on any machine: the call reaches the real library.
   EXPECT_EQ(gpiod.chip_open_lookup("camhead-no-such-chip"), nullptr);
 }
 
