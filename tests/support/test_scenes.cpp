@@ -22,38 +22,39 @@ renderer::Scene empty_scene(const char *name, float f_number, float focus_m, int
   return scene;
 }
 
-renderer::Object sphere(const char *name, glm::vec3 center, float radius, int material, bool real) {
+namespace {
+
+// What every shape shares; the factories below add their own dimensions.
+renderer::Object object(const char *name, renderer::ShapeType type, glm::vec3 center, int material,
+                        bool real) {
   renderer::Object o;
   o.name = name;
-  o.type = renderer::ShapeType::sphere;
+  o.type = type;
   o.center = center;
-  o.radius = radius;
   o.material = material;
   o.real = real;
+  return o;
+}
+
+} // namespace
+
+renderer::Object sphere(const char *name, glm::vec3 center, float radius, int material, bool real) {
+  renderer::Object o = object(name, renderer::ShapeType::sphere, center, material, real);
+  o.radius = radius;
   return o;
 }
 
 renderer::Object box(const char *name, glm::vec3 center, glm::vec3 size, int material, bool real,
                      glm::vec3 rotation_deg) {
-  renderer::Object o;
-  o.name = name;
-  o.type = renderer::ShapeType::box;
-  o.center = center;
+  renderer::Object o = object(name, renderer::ShapeType::box, center, material, real);
   o.size = size;
   o.rotation_deg = rotation_deg;
-  o.material = material;
-  o.real = real;
   return o;
 }
 
 renderer::Object plane(const char *name, glm::vec3 center, float size_m, int material, bool real) {
-  renderer::Object o;
-  o.name = name;
-  o.type = renderer::ShapeType::plane;
-  o.center = center;
+  renderer::Object o = object(name, renderer::ShapeType::plane, center, material, real);
   o.size = {size_m, 1.0f, size_m};
-  o.material = material;
-  o.real = real;
   return o;
 }
 
@@ -61,17 +62,12 @@ renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int wid
   using namespace renderer;
   Scene scene = empty_scene("edge_scene", f_number, focus_m, width, height);
   scene.materials.push_back({"emitter", MaterialType::emission, glm::vec3(1.0f), 1.5f});
-  Object plane;
-  plane.name = "half_plane";
-  plane.type = ShapeType::plane;
   // An XZ plane turned to face the camera, reaching from x = 0 far to the
   // right and far up and down, so that only its left edge is in view.
   const float extent = 1000.0f * depth_m;
-  plane.center = {0.5f * extent, 0.0f, -depth_m};
-  plane.size = {extent, 1.0f, extent};
-  plane.rotation_deg = {90.0f, 0.0f, 0.0f};
-  plane.material = 0;
-  scene.objects.push_back(plane);
+  Object half_plane = plane("half_plane", {0.5f * extent, 0.0f, -depth_m}, extent, 0, false);
+  half_plane.rotation_deg = {90.0f, 0.0f, 0.0f};
+  scene.objects.push_back(half_plane);
   return scene;
 }
 
