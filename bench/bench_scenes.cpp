@@ -20,9 +20,8 @@ const std::string kPrimarySuffix = "_primary";
 } // namespace
 
 std::vector<BenchScene> bench_scenes() {
-  const fs::path shared = dir_from("CAMHEAD_SHARED_DIR", CAMHEAD_SHARED_DIR);
   const fs::path source = dir_from("CAMHEAD_SOURCE_DIR", CAMHEAD_SOURCE_DIR);
-  const fs::path basic = shared / "reference" / "ar_basic.json";
+  const fs::path basic = source / "tests" / "assets" / "reference" / "ar_basic.json";
   const fs::path demo = source / "scenes" / "ar_demo.json";
   return {{"ar_basic", basic, false},
           {"ar_demo", demo, false},

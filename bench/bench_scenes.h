@@ -10,8 +10,8 @@
 
 namespace camhead::bench {
 
-// A scene the benchmarks know by a short name: "ar_basic" (the reference
-// scene in ../shared/reference), "ar_demo" (scenes/ar_demo.json, with the
+// A scene the benchmarks know by a short name: "ar_basic" (the Cycles
+// reference scene, tests/assets/reference), "ar_demo" (scenes/ar_demo.json, with the
 // bunny), or either with "_primary" appended (primary_only() below).
 struct BenchScene {
   std::string name;
@@ -19,10 +19,9 @@ struct BenchScene {
   bool primary_only = false;
 };
 
-// ar_basic, ar_demo and their primary-only variants. The shared folder is
-// the CAMHEAD_SHARED_DIR environment variable if set, else the one the build
-// was configured with (../shared beside the source tree); the source tree
-// likewise from CAMHEAD_SOURCE_DIR.
+// ar_basic, ar_demo and their primary-only variants, in the source tree: the
+// CAMHEAD_SOURCE_DIR environment variable if set, else the one the build was
+// configured from.
 [[nodiscard]] std::vector<BenchScene> bench_scenes();
 [[nodiscard]] BenchScene find_bench_scene(const std::string &name_or_file);
 

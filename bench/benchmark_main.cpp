@@ -9,8 +9,8 @@
 //   camhead_benchmarks --benchmark_filter=.            (everything; hours on lavapipe)
 // Without --benchmark_repetitions each case runs 3 times and the mean,
 // median and spread are shown. --camhead_device=NAME|INDEX picks the Vulkan
-// device as GpuTracer does; CAMHEAD_SHARED_DIR and CAMHEAD_SOURCE_DIR in the
-// environment move the scene folders from where the build found them.
+// device as GpuTracer does; CAMHEAD_SOURCE_DIR in the environment moves the
+// scene folders from where the build found them.
 #include <cstring>
 #include <string>
 #include <string_view>

@@ -14,6 +14,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "data_dir.h"
+
 namespace camhead::pipeline {
 
 namespace {
@@ -33,7 +35,8 @@ public:
   explicit BoardReader(std::filesystem::path file) : file_(std::move(file)) {}
 
   Board read(const Json &root) {
-    keys(root, "", {"format", "version", "name", "lens"}, {"description"});
+    keys(root, "", {"format", "version", "name", "lens"},
+         {"description", "camera", "scene", "pose", "outputs", "render"});
     if (!root.at("format").is_string() || root.at("format").get<std::string>() != kFormat)
       fail("format", "must be \"" + std::string(kFormat) + "\"");
     const Json &version = root.at("version");
@@ -45,6 +48,23 @@ public:
     if (root.contains("description"))
       board.description = text(root.at("description"), "description", true);
     board.lens = read_lens(root.at("lens"), "lens");
+    if (root.contains("camera"))
+      board.camera = read_camera(root.at("camera"), "camera");
+    if (root.contains("scene"))
+      board.scene = path(root.at("scene"), "scene");
+    if (root.contains("pose"))
+      board.pose = read_pose(root.at("pose"), "pose");
+    if (root.contains("outputs")) {
+      const Json &outputs = root.at("outputs");
+      if (!outputs.is_array())
+        fail("outputs", "must be an array of output URIs (v4l2:/dev/videoN, file:PATH.y4m, ...)");
+      for (std::size_t i = 0; i < outputs.size(); ++i)
+        board.outputs.push_back(text(outputs[i], "outputs[" + std::to_string(i) + "]"));
+    }
+    if (root.contains("render"))
+      board.render = read_render(root.at("render"), "render");
+    if (board.camera && !board.scene)
+      fail("scene", "missing: a board with a camera needs the scene of its virtual objects");
     return board;
   }
 
@@ -138,6 +158,129 @@ private:
                "\"" + lens.sources[i].name + "\" is already the name of sources[" +
                    std::to_string(j) + "]; give each source its own name");
     return lens;
+  }
+
+  CameraConfig read_camera(const Json &d, const std::string &field) {
+    if (!d.is_object() || !d.contains("type"))
+      fail(child(field, "type"), "missing (sim or file)");
+    const std::string type = text(d.at("type"), child(field, "type"));
+    CameraConfig camera;
+    const auto with_common = [](Keys own) {
+      std::vector<std::string_view> all(own);
+      for (const std::string_view k : {"format", "width", "height", "sensor_width_mm"})
+        all.push_back(k);
+      return all;
+    };
+    if (type == "sim") {
+      const auto optional =
+          with_common({"fps", "samples", "disconnect_after_frames", "disconnect_s"});
+      keys_list(d, field, {"type"}, optional);
+      SimCameraConfig sim;
+      if (d.contains("fps"))
+        sim.fps = number(d.at("fps"), child(field, "fps"), 1.0, 240.0);
+      if (d.contains("samples"))
+        sim.samples = std::uint32_t(integer(d.at("samples"), child(field, "samples"), 1, 4096));
+      if (d.contains("disconnect_after_frames"))
+        sim.disconnect_after_frames = std::uint64_t(integer(
+            d.at("disconnect_after_frames"), child(field, "disconnect_after_frames"), 0, 1 << 30));
+      if (d.contains("disconnect_s"))
+        sim.disconnect_s = number(d.at("disconnect_s"), child(field, "disconnect_s"), 0.0, 3600.0);
+      camera.kind = sim;
+    } else if (type == "file") {
+      keys_list(d, field, {"type", "path"}, with_common({"loop", "realtime"}));
+      FileCameraConfig file;
+      file.path = path(d.at("path"), child(field, "path"));
+      if (d.contains("loop"))
+        file.loop = flag(d.at("loop"), child(field, "loop"));
+      if (d.contains("realtime"))
+        file.realtime = flag(d.at("realtime"), child(field, "realtime"));
+      camera.kind = file;
+    } else {
+      fail(child(field, "type"), "unknown camera \"" + type + "\" (sim or file)");
+    }
+    if (d.contains("format")) {
+      const std::string name = text(d.at("format"), child(field, "format"));
+      const std::optional<base::PixelFormat> format = base::parse_pixel_format(name);
+      if (!format || *format == base::PixelFormat::xrgb8888)
+        fail(child(field, "format"),
+             "unknown camera format \"" + name + "\" (yuyv, nv12, rgb24 or bgr24)");
+      camera.format = *format;
+    }
+    if (d.contains("width"))
+      camera.width = int(integer(d.at("width"), child(field, "width"), 2, 16384));
+    if (d.contains("height"))
+      camera.height = int(integer(d.at("height"), child(field, "height"), 2, 16384));
+    if (camera.width % 2 != 0 || camera.height % 2 != 0)
+      fail(child(field, "width"), "width and height must be even (" + std::to_string(camera.width) +
+                                      "x" + std::to_string(camera.height) + ")");
+    if (d.contains("sensor_width_mm"))
+      camera.sensor_width_mm =
+          number(d.at("sensor_width_mm"), child(field, "sensor_width_mm"), 1.0, 100.0);
+    return camera;
+  }
+
+  std::array<double, 3> vec3(const Json &v, const std::string &field) const {
+    if (!v.is_array() || v.size() != 3)
+      fail(field, "must be an array of 3 numbers");
+    std::array<double, 3> out{};
+    for (std::size_t i = 0; i < 3; ++i)
+      out[i] = number(v[i], field + "[" + std::to_string(i) + "]", -1e7, 1e7);
+    return out;
+  }
+
+  PoseConfig read_pose(const Json &d, const std::string &field) const {
+    keys(d, field, {"position", "look_at"}, {"up"});
+    PoseConfig pose;
+    pose.position = vec3(d.at("position"), child(field, "position"));
+    pose.look_at = vec3(d.at("look_at"), child(field, "look_at"));
+    if (d.contains("up"))
+      pose.up = vec3(d.at("up"), child(field, "up"));
+    if (pose.position == pose.look_at)
+      fail(child(field, "look_at"), "must differ from position");
+    return pose;
+  }
+
+  RenderConfig read_render(const Json &d, const std::string &field) const {
+    keys(d, field, {},
+         {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel", "adaptive"});
+    RenderConfig render;
+    if (d.contains("executor")) {
+      const std::string e = text(d.at("executor"), child(field, "executor"));
+      if (e == "auto")
+        render.executor = Executor::automatic;
+      else if (e == "cpu")
+        render.executor = Executor::cpu;
+      else if (e == "gpu")
+        render.executor = Executor::gpu;
+      else
+        fail(child(field, "executor"), "must be \"auto\", \"cpu\" or \"gpu\", not \"" + e + "\"");
+    }
+    const auto rpp = [&](const char *key) {
+      return std::uint32_t(integer(d.at(key), child(field, key), 1, 4096));
+    };
+    if (d.contains("rays_per_pixel"))
+      render.rays_per_pixel = rpp("rays_per_pixel");
+    if (d.contains("min_rays_per_pixel"))
+      render.min_rays_per_pixel = rpp("min_rays_per_pixel");
+    if (d.contains("max_rays_per_pixel"))
+      render.max_rays_per_pixel = rpp("max_rays_per_pixel");
+    if (render.min_rays_per_pixel > render.max_rays_per_pixel)
+      fail(child(field, "min_rays_per_pixel"), "must not exceed max_rays_per_pixel (" +
+                                                   std::to_string(render.max_rays_per_pixel) + ")");
+    if (d.contains("adaptive"))
+      render.adaptive = flag(d.at("adaptive"), child(field, "adaptive"));
+    return render;
+  }
+
+  void keys_list(const Json &d, const std::string &field, Keys required,
+                 const std::vector<std::string_view> &optional) const {
+    for (const auto &[k, v] : d.items())
+      if (std::find(required.begin(), required.end(), k) == required.end() &&
+          std::find(optional.begin(), optional.end(), k) == optional.end())
+        fail(child(field, k), "unknown field");
+    for (const std::string_view k : required)
+      if (!d.contains(k))
+        fail(child(field, k), "missing");
   }
 
   LensSourceConfig read_source(const Json &d, const std::string &field) {
@@ -263,9 +406,15 @@ private:
 std::filesystem::path resolve_board(std::string_view name_or_path) {
   const std::string s(name_or_path);
   const bool bare_name = s.find('/') == std::string::npos && s.find('.') == std::string::npos;
-  if (bare_name)
-    return std::filesystem::path(CAMHEAD_BOARD_DIR) / (s + ".json");
-  return s;
+  if (!bare_name)
+    return s;
+  const std::filesystem::path dir = data_dir();
+  if (dir.empty())
+    throw BoardError(s, "(board name)",
+                     "no camhead data folder found (one holding board/sim.json); searched:\n" +
+                         describe_data_dir_search() +
+                         "set CAMHEAD_DATA_DIR, or give the board file's path");
+  return dir / "board" / (s + ".json");
 }
 
 Board parse_board(std::string_view json_text, const std::filesystem::path &file) {

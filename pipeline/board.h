@@ -19,6 +19,7 @@
 // hal::lens::LensEncoder.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -27,6 +28,8 @@
 #include <string_view>
 #include <variant>
 #include <vector>
+
+#include "camhead/base/video_format.h"
 
 namespace camhead::pipeline {
 
@@ -100,15 +103,71 @@ struct LensConfig {
   std::vector<LensSourceConfig> sources;
 };
 
+// The simulated camera (hal/camera/sim): the board's scene's real objects
+// rendered through the board's lens at each exposure.
+struct SimCameraConfig {
+  double fps = 25.0;
+  std::uint32_t samples = 2; // rays per pixel of the simulated world
+  // Fault option: the camera goes away after this many frames, for
+  // disconnect_s, and comes back.
+  std::optional<std::uint64_t> disconnect_after_frames;
+  double disconnect_s = 1.0;
+};
+
+// A Y4M video or PNG sequence played as the camera (hal/camera/file).
+struct FileCameraConfig {
+  std::filesystem::path path;
+  bool loop = true;
+  bool realtime = true; // false: as fast as frames are taken
+};
+
+using CameraKind = std::variant<SimCameraConfig, FileCameraConfig>;
+
+struct CameraConfig {
+  CameraKind kind;
+  base::PixelFormat format = base::PixelFormat::yuyv;
+  int width = 720;
+  int height = 576;
+  double sensor_width_mm = 36.0; // the width the lens projects onto
+};
+
+// Where the camera is; the scene file's camera when the board gives none
+// (tracking is to come).
+struct PoseConfig {
+  std::array<double, 3> position{0.0, 0.0, 0.0};
+  std::array<double, 3> look_at{0.0, 0.0, -1.0};
+  std::array<double, 3> up{0.0, 1.0, 0.0};
+};
+
+enum class Executor { automatic, cpu, gpu };
+
+struct RenderConfig {
+  Executor executor = Executor::automatic;
+  // Rays per pixel: chosen per frame within [min, max] to keep the camera's
+  // rate (FrameBudget), or fixed.
+  std::uint32_t min_rays_per_pixel = 1;
+  std::uint32_t max_rays_per_pixel = 64;
+  std::optional<std::uint32_t> rays_per_pixel;
+  bool adaptive = false;
+};
+
 struct Board {
   std::string name;
   std::string description;
   std::filesystem::path file; // where it was loaded from
   LensConfig lens;
+  // The live pipeline (`camhead run`); a board without a camera serves only
+  // the lens commands.
+  std::optional<CameraConfig> camera;
+  std::optional<std::filesystem::path> scene; // virtual objects and the real proxy
+  std::optional<PoseConfig> pose;
+  std::vector<std::string> outputs; // output URIs, as `camhead run --output`
+  RenderConfig render;
 };
 
-// "sim" and the other names in board/ resolve to board/<name>.json next to
-// the binary's source tree (CAMHEAD_BOARD_DIR); anything else is a path.
+// "sim" and the other names in board/ resolve to board/<name>.json in the
+// data folder (data_dir.h); anything with a '/' or a '.' is a path. Throws
+// BoardError when a name is given and no data folder is found.
 [[nodiscard]] std::filesystem::path resolve_board(std::string_view name_or_path);
 
 // Loads and validates a board file. Throws BoardError.

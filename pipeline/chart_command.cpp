@@ -640,19 +640,20 @@ void add_bench_chart_command(CLI::App &bench) {
     method_list += "\n  " + std::string(m.name) + ": " + m.description + "; rpp " + budgets;
   }
   CLI::App *cmd = bench.add_subcommand(
-      "chart", "Speed versus accuracy: renders each scene with each method at each budget,\n"
-               "times the frames on the GPU (median after warm-up; by the device's timestamps\n"
-               "where it has them) and measures the relative RMSE of the composite against a\n"
-               "converged CPU reference, over all pixels and near depth edges. Writes\n"
-               "DIR/chart.csv and DIR/chart_<scene>.png (log-log).\n"
-               "The references are cached in DIR/chart_cache, so a rerun only re-times.\n"
-               "Methods:" +
-                   method_list +
-                   "\nExamples (2 CPU cores, lavapipe: the first takes over half an hour, the\n"
-                   "second a few minutes):\n"
-                   "  camhead bench chart ../shared/reference/ar_basic.json --scale 0.5 -o bench\n"
-                   "  camhead bench chart ../shared/reference/ar_basic.json --scale 0.25 \\\n"
-                   "      --methods uniform,adaptive --frames 3 --warmup 1 -o /tmp/chart");
+      "chart",
+      "Speed versus accuracy: renders each scene with each method at each budget,\n"
+      "times the frames on the GPU (median after warm-up; by the device's timestamps\n"
+      "where it has them) and measures the relative RMSE of the composite against a\n"
+      "converged CPU reference, over all pixels and near depth edges. Writes\n"
+      "DIR/chart.csv and DIR/chart_<scene>.png (log-log).\n"
+      "The references are cached in DIR/chart_cache, so a rerun only re-times.\n"
+      "Methods:" +
+          method_list +
+          "\nExamples (2 CPU cores, lavapipe: the first takes over half an hour, the\n"
+          "second a few minutes):\n"
+          "  camhead bench chart tests/assets/reference/ar_basic.json --scale 0.5 -o bench\n"
+          "  camhead bench chart tests/assets/reference/ar_basic.json --scale 0.25 \\\n"
+          "      --methods uniform,adaptive --frames 3 --warmup 1 -o /tmp/chart");
   cmd->add_option("scenes", args->scenes, "Scene files")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->out_dir, "Output folder (created if absent)")
       ->capture_default_str();

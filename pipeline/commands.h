@@ -10,6 +10,7 @@ void add_devices_command(CLI::App &app);   // camhead devices
 void add_bench_command(CLI::App &app);     // camhead bench
 void add_calibrate_command(CLI::App &app); // camhead calibrate
 void add_lens_command(CLI::App &app);      // camhead lens monitor | record
+void add_run_command(CLI::App &app);       // camhead run
 
 // The exit status the chosen subcommand left (0 = success).
 [[nodiscard]] int exit_code();

@@ -232,8 +232,25 @@ CompiledScene compile_scene(const Scene &scene) {
   return out;
 }
 
-gpu::FrameParams make_frame_params(const Scene &scene, int samples) {
+FrameCamera scene_camera(const Scene &scene) {
   const CameraDesc &cam = scene.camera;
+  FrameCamera camera;
+  camera.position = cam.position;
+  camera.look_at = cam.look_at;
+  camera.up = cam.up;
+  camera.focus_distance_m = cam.focus_distance_m;
+  camera.f_number = cam.f_number;
+  camera.focal_length_mm = cam.focal_length_mm;
+  camera.projection_focal_length_mm = cam.focal_length_mm;
+  camera.sensor_width_mm = cam.sensor_width_mm;
+  return camera;
+}
+
+gpu::FrameParams make_frame_params(const Scene &scene, int samples) {
+  return make_frame_params(scene, scene_camera(scene), samples);
+}
+
+gpu::FrameParams make_frame_params(const Scene &scene, const FrameCamera &cam, int samples) {
   const RenderSettings &r = scene.render;
   // look_at_matrix(): camera -Z toward the target, x = up x z, y = z x x.
   const glm::vec3 forward = glm::normalize(cam.look_at - cam.position);
@@ -251,12 +268,16 @@ gpu::FrameParams make_frame_params(const Scene &scene, int samples) {
   constexpr float kFarthestFocusM = 1e6f;
   const float focus = cam.focus_distance_m > 0.0f ? std::min(cam.focus_distance_m, kFarthestFocusM)
                                                   : 1.0f; // also NaN
-  // Cycles' projection: magnification set by the focal length alone.
-  const float focal_px = cam.focal_length_mm * float(r.width) / cam.sensor_width_mm;
+  // Cycles' projection: magnification set by the focal length alone; with
+  // breathing data, by the projection focal length.
+  const float projection_mm =
+      cam.projection_focal_length_mm > 0.0f ? cam.projection_focal_length_mm : cam.focal_length_mm;
+  const float focal_px = projection_mm * float(r.width) / cam.sensor_width_mm;
+  const glm::vec3 pupil = cam.position + cam.entrance_pupil_offset_m * forward;
 
   const auto spp = std::uint32_t(samples > 0 ? samples : r.samples);
   gpu::FrameParams fp{};
-  fp.cam_position = gpu::vec4(cam.position, 0.0f);
+  fp.cam_position = gpu::vec4(pupil, 0.0f);
   fp.cam_right = gpu::vec4(right, 0.0f);
   fp.cam_up = gpu::vec4(up, 0.0f);
   fp.cam_forward = gpu::vec4(forward, 0.0f);

@@ -56,4 +56,8 @@ struct CpuKernel {
 [[nodiscard]] CpuKernel make_cpu_kernel(const CompiledScene &scene, const FrameParams &frame,
                                         std::vector<BvhNode> &nodes);
 
+// The frame part of make_cpu_kernel() alone, for a kernel that renders frame
+// after frame of one scene.
+void set_cpu_frame(CpuKernel &kernel, const CompiledScene &scene, const FrameParams &frame);
+
 } // namespace camhead::renderer::cpu

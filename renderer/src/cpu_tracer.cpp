@@ -45,13 +45,19 @@ cpu::CpuKernel cpu::make_cpu_kernel(const CompiledScene &scene, const gpu::Frame
   static const gpu::Material placeholder_material{};
   kernel.materials = scene.materials.empty() ? &placeholder_material : scene.materials.data();
   kernel.lights = scene.lights.data();
+  cpu::set_cpu_frame(kernel, scene, frame);
+  return kernel;
+}
+
+void cpu::set_cpu_frame(CpuKernel &kernel, const CompiledScene &scene,
+                        const gpu::FrameParams &frame) {
   kernel.frame = frame;
   kernel.frame.cam_position -= glm::vec4(scene.origin, 0.0f); // into the compiled frame
   kernel.frame.tracing.y = 0u;                                // uniform unless set below
   // On a CPU the test costs less than the samples it saves, however much of
   // the frame the scene covers (layout.h).
   kernel.frame.tracing.w |= TRACING_SKIP_EMPTY_PIXELS;
-  return kernel;
+  kernel.sample_counts = nullptr;
 }
 
 namespace {

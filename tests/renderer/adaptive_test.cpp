@@ -40,8 +40,7 @@ void expect_near_budget(std::uint64_t total, std::size_t pixels, std::uint64_t b
 }
 
 renderer::Scene reference_scene(const std::string &name, int divisor) {
-  return test::downscaled(renderer::load_scene(test::shared_dir() / "reference" / (name + ".json")),
-                          divisor);
+  return test::downscaled(renderer::load_scene(test::reference_dir() / (name + ".json")), divisor);
 }
 
 TEST(AdaptiveAllocation, NoisyPixelsGetMoreAndTheTotalIsTheBudgetInExpectation) {

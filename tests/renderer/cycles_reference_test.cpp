@@ -1,4 +1,4 @@
-// camhead against Blender Cycles (../shared/reference): at 1024 rays per
+// camhead against Blender Cycles (tests/assets/reference): at 1024 rays per
 // pixel every layer of the reference scenes matches the Cycles render to a
 // relative RMSE of 1 % or better. The Cycles images are independent ground
 // truth: another renderer, another sampler, the same scene description.
@@ -18,7 +18,7 @@ constexpr int reference_rpp = 1024;
 constexpr double tolerance = 0.01;
 
 std::filesystem::path reference(const std::string &name) {
-  return test::shared_dir() / "reference" / name;
+  return test::reference_dir() / name;
 }
 
 // compare.py's relRMSE on the red channel of `image`, for the mask layer,

@@ -33,8 +33,8 @@ void expect_plate_passes_through(const Image &composite, const Image &plate) {
 
 TEST(PassThrough, PlateIsUntouchedWithoutVirtualObjectsOnGpu) {
   CAMHEAD_REQUIRE_VULKAN();
-  const Scene scene = without_virtual_objects(
-      renderer::load_scene(test::shared_dir() / "reference" / "ar_basic.json"));
+  const Scene scene =
+      without_virtual_objects(renderer::load_scene(test::reference_dir() / "ar_basic.json"));
   ASSERT_TRUE(scene.plate);
   for (int rpp : {1, 5, 16}) {
     SCOPED_TRACE(testing::Message() << rpp << " rpp");
@@ -45,9 +45,8 @@ TEST(PassThrough, PlateIsUntouchedWithoutVirtualObjectsOnGpu) {
 }
 
 TEST(PassThrough, PlateIsUntouchedWithoutVirtualObjectsOnCpu) {
-  const Scene scene = test::downscaled(without_virtual_objects(renderer::load_scene(
-                                           test::shared_dir() / "reference" / "ar_basic.json")),
-                                       4);
+  const Scene scene = test::downscaled(
+      without_virtual_objects(renderer::load_scene(test::reference_dir() / "ar_basic.json")), 4);
   for (int rpp : {1, 3}) {
     SCOPED_TRACE(testing::Message() << rpp << " rpp");
     expect_plate_passes_through(test::render_cpu(scene, rpp).composite, *scene.plate);

@@ -23,7 +23,7 @@ namespace {
 // blurred over tens of pixels.
 renderer::Scene sparse_scene() {
   renderer::Scene scene =
-      test::downscaled(renderer::load_scene(test::shared_dir() / "reference" / "ar_basic.json"), 4);
+      test::downscaled(renderer::load_scene(test::reference_dir() / "ar_basic.json"), 4);
   std::erase_if(scene.objects, [](const renderer::Object &o) { return o.name == "ground"; });
   scene.camera.f_number = 1.4f;
   scene.camera.focus_distance_m = 6.0f;

@@ -20,8 +20,8 @@ class Executors : public ::testing::TestWithParam<std::string> {};
 TEST_P(Executors, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
   CAMHEAD_REQUIRE_VULKAN();
   constexpr int rpp = 16;
-  renderer::Scene scene = test::downscaled(
-      renderer::load_scene(test::shared_dir() / "reference" / (GetParam() + ".json")), 4);
+  renderer::Scene scene =
+      test::downscaled(renderer::load_scene(test::reference_dir() / (GetParam() + ".json")), 4);
   const renderer::RenderResult gpu = test::render_gpu(scene, rpp);
   const renderer::RenderResult cpu = test::render_cpu(scene, rpp);
   scene.render.seed += 1;

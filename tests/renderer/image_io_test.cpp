@@ -25,8 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kShared = fs::path(CAMHEAD_SHARED_DIR) / "reference";
-
 std::string read_bytes(const fs::path &path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -202,8 +200,8 @@ TEST_F(ImageIo, Reads16BitPng) {
 }
 
 TEST_F(ImageIo, ReferenceExrLoadsAndAgreesWithItsPng) {
-  const Image exr = read_image(kShared / "boxes_1024.exr"); // half float, ZIP, RGB
-  const Image png = read_image(kShared / "boxes_1024.png");
+  const Image exr = read_image(test::reference_dir() / "boxes_1024.exr"); // half float, ZIP, RGB
+  const Image png = read_image(test::reference_dir() / "boxes_1024.png");
   ASSERT_EQ(exr.width, 720);
   ASSERT_EQ(exr.height, 576);
   ASSERT_EQ(png.data.size(), exr.data.size());
@@ -221,9 +219,9 @@ TEST_F(ImageIo, ReferenceExrLoadsAndAgreesWithItsPng) {
   EXPECT_LT(mean, 0.5);
   EXPECT_LT(off_by_more, exr.data.size() / 1000);
 
-  const Image plate = read_image(kShared / "ar_basic_plate.exr");
+  const Image plate = read_image(test::reference_dir() / "ar_basic_plate.exr");
   EXPECT_EQ(plate.width, 720);
-  const Image mask = read_image(kShared / "ar_basic_mask.exr");
+  const Image mask = read_image(test::reference_dir() / "ar_basic_mask.exr");
   for (const float v : mask.data)
     ASSERT_TRUE(v >= 0.0f && v <= 1.0f) << v;
 }
@@ -269,7 +267,7 @@ TEST_F(ImageIo, DamagedFilesRaiseImageError) {
   EXPECT_TRUE(read_fails(write("text.exr", "not an image")));
   EXPECT_TRUE(read_fails(write("text.png", "not an image")));
   EXPECT_TRUE(read_fails(write("image.bmp", "BM")));
-  const std::string exr = read_bytes(kShared / "ar_basic_mask.exr");
+  const std::string exr = read_bytes(test::reference_dir() / "ar_basic_mask.exr");
   for (const std::size_t n : {std::size_t(0), std::size_t(4), std::size_t(8), std::size_t(100),
                               std::size_t(400), exr.size() / 2, exr.size() - 1})
     EXPECT_TRUE(read_fails(write("cut.exr", exr.substr(0, n)))) << n;

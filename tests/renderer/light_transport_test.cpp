@@ -1,5 +1,5 @@
 // Light transport as Cycles does it for these scenes, reproducing the values
-// that ../shared/reference/README.md ("What Cycles does") measured on Cycles.
+// that tests/assets/reference/README.md ("What Cycles does") measured on Cycles.
 #include <cstdio>
 
 #include "test_support.h"

@@ -31,7 +31,7 @@ TEST(SobolSampler, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
   CAMHEAD_REQUIRE_VULKAN();
   constexpr int rpp = 16;
   const renderer::Scene scene =
-      test::downscaled(renderer::load_scene(test::shared_dir() / "reference" / "ar_basic.json"), 4);
+      test::downscaled(renderer::load_scene(test::reference_dir() / "ar_basic.json"), 4);
   const renderer::CompiledScene compiled = renderer::compile_scene(scene);
   renderer::GpuTracer tracer;
   tracer.load(compiled);

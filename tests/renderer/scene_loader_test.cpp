@@ -20,10 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kShared = fs::path(CAMHEAD_SHARED_DIR) / "reference";
-
 TEST(SceneLoader, LoadsBoxesReference) {
-  const Scene s = load_scene(kShared / "boxes.json");
+  const Scene s = load_scene(test::reference_dir() / "boxes.json");
   EXPECT_EQ(s.render.width, 720);
   EXPECT_EQ(s.render.height, 576);
   EXPECT_EQ(s.render.samples, 64);
@@ -59,7 +57,7 @@ TEST(SceneLoader, LoadsBoxesReference) {
 }
 
 TEST(SceneLoader, LoadsArBasicReferenceWithPlate) {
-  const Scene s = load_scene(kShared / "ar_basic.json");
+  const Scene s = load_scene(test::reference_dir() / "ar_basic.json");
   EXPECT_EQ(s.render.samples, 1024);
   EXPECT_FLOAT_EQ(s.camera.f_number, 2.0f);
   EXPECT_FLOAT_EQ(s.camera.focus_distance_m, 2.0f);
@@ -75,7 +73,7 @@ TEST(SceneLoader, LoadsArBasicReferenceWithPlate) {
   EXPECT_EQ(s.plate->height, 576);
   EXPECT_EQ(s.plate->channels, 3);
   // Same pixels as reading the plate directly.
-  EXPECT_EQ(s.plate->data, read_image(kShared / "ar_basic_plate.exr").data);
+  EXPECT_EQ(s.plate->data, read_image(test::reference_dir() / "ar_basic_plate.exr").data);
 }
 
 TEST(SceneLoader, FillsTheReferenceDefaults) {

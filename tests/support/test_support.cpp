@@ -16,8 +16,8 @@ namespace camhead::test {
 std::filesystem::path source_dir() {
   return CAMHEAD_SOURCE_DIR;
 }
-std::filesystem::path shared_dir() {
-  return CAMHEAD_SHARED_DIR;
+std::filesystem::path reference_dir() {
+  return source_dir() / "tests" / "assets" / "reference";
 }
 
 bool have_vulkan() {

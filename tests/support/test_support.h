@@ -1,5 +1,5 @@
 // Shared helpers of the camhead tests: locating files, rendering on either
-// executor, and image metrics as ../shared/reference/compare.py defines them.
+// executor, and image metrics as tests/assets/reference/compare.py defines them.
 #pragma once
 
 #include <filesystem>
@@ -14,9 +14,10 @@
 
 namespace camhead::test {
 
-// Repository and ../shared folders, fixed at configure time.
+// The repository, fixed at configure time, and its copy of the Cycles
+// reference scenes and renders (tests/assets/reference/README.md).
 [[nodiscard]] std::filesystem::path source_dir();
-[[nodiscard]] std::filesystem::path shared_dir();
+[[nodiscard]] std::filesystem::path reference_dir();
 
 // True when a Vulkan device is present; tests needing one GTEST_SKIP otherwise.
 [[nodiscard]] bool have_vulkan();

@@ -8,6 +8,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "camhead/renderer/frame_camera.h"
 #include "camhead/renderer/gpu_layout.h"
 #include "camhead/renderer/scene.h"
 
@@ -38,5 +39,9 @@ struct CompiledScene {
 // distance beyond 1e6 m, +infinity included, is focus at 1e6 m (the scene
 // loader's limit); one that is not > 0 (or NaN) is a 1 m stand-in.
 [[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, int samples = 0);
+// The same for a live frame's camera; the scene supplies the image size,
+// render settings and lights.
+[[nodiscard]] gpu::FrameParams make_frame_params(const Scene &scene, const FrameCamera &camera,
+                                                 int samples = 0);
 
 } // namespace camhead::renderer

@@ -1,17 +1,11 @@
 // The clock every lens reading is stamped on (EncoderReading::t_ns) and that
-// frames are matched against: CLOCK_MONOTONIC, which never jumps with NTP or
-// a settimeofday, in nanoseconds. Any thread.
+// frames are matched against: base's CLOCK_MONOTONIC in nanoseconds.
 #pragma once
 
-#include <cstdint>
-#include <ctime>
+#include "camhead/base/monotonic_clock.h"
 
 namespace camhead::hal::lens {
 
-[[nodiscard]] inline std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
+using base::monotonic_ns;
 
 } // namespace camhead::hal::lens

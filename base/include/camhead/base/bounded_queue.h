@@ -1,0 +1,78 @@
+// A bounded queue between two pipeline threads in which the newest item wins:
+// a full queue drops its oldest item to take a new one, and says so, so that
+// a stage slower than its producer works on the latest frame, never on a
+// backlog, and every drop is counted by whoever pushed.
+//
+// Thread safety: any number of producers and consumers.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <utility>
+
+namespace camhead::base {
+
+template <typename T> class BoundedQueue {
+public:
+  explicit BoundedQueue(std::size_t capacity) : capacity_(capacity > 0 ? capacity : 1) {}
+
+  // Adds `item`; when the queue is full the oldest item is taken out and
+  // returned (the caller counts it as dropped and releases what it holds).
+  // After close() the item itself comes back.
+  std::optional<T> push(T item) {
+    std::optional<T> dropped;
+    {
+      std::lock_guard lock(mutex_);
+      if (closed_)
+        return std::optional<T>(std::move(item));
+      if (items_.size() == capacity_) {
+        dropped.emplace(std::move(items_.front()));
+        items_.pop_front();
+      }
+      items_.push_back(std::move(item));
+    }
+    ready_.notify_one();
+    return dropped;
+  }
+
+  // The oldest item, waiting at most `timeout`; empty on time-out, or once
+  // the queue is closed and drained.
+  std::optional<T> pop(std::chrono::nanoseconds timeout) {
+    std::unique_lock lock(mutex_);
+    if (!ready_.wait_for(lock, timeout, [&] { return !items_.empty() || closed_; }))
+      return std::nullopt;
+    if (items_.empty())
+      return std::nullopt;
+    std::optional<T> item(std::move(items_.front()));
+    items_.pop_front();
+    return item;
+  }
+
+  // Wakes every waiting pop(); later pushes are refused. Items still queued
+  // can be popped.
+  void close() {
+    {
+      std::lock_guard lock(mutex_);
+      closed_ = true;
+    }
+    ready_.notify_all();
+  }
+
+  [[nodiscard]] bool closed() const {
+    std::lock_guard lock(mutex_);
+    return closed_;
+  }
+
+private:
+  const std::size_t capacity_;
+  mutable std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<T> items_;
+  bool closed_ = false;
+};
+
+} // namespace camhead::base

@@ -1,0 +1,72 @@
+// A recorded take played as a camera: a Y4M file, or a sequence of PNGs.
+//
+// What is played, by `path`:
+//   a file starting "YUV4MPEG2 "  Y4M; 4:2:0 is delivered as nv12 (Cb and Cr
+//                                 interleaved), 4:2:2 as yuyv (packed), bt709,
+//                                 the range XCOLORRANGE states (default
+//                                 limited). The header is read strictly
+//                                 (camhead/hal/video_file/y4m_header.h).
+//   a pattern, "take/%05d.png"    frames numbered from 0 or 1 (whichever exists)
+//                                 up to the first number that is missing
+//   a folder                      every *.png in it, sorted by name
+//   a PNG file                    a single frame (with loop: a still camera)
+// PNGs are delivered as rgb24 (8-bit sRGB as stored); every frame must have
+// the size of the first, at most 16384 pixels a side.
+//
+// Errors: open_file_camera throws FileCameraError ("FILE: FIELD: REASON")
+// for anything it can see at open: an unreadable file, a bad header, a
+// first frame that is missing or short. Once open, nothing throws: a frame
+// that is short or garbled ends the stream (`ended`, connected false,
+// errors 1) and status().detail says which file and frame, as
+// "take.y4m:frame 12: truncated: 8192 of 622080 bytes".
+//
+// Timing: the rate is FileCameraOptions::fps, or else the Y4M's F, or 25
+// for PNGs. With `realtime`, frame i+1 is delivered one interval after frame
+// i was due, stamped with CLOCK_MONOTONIC when it is delivered; a consumer
+// more than a frame behind restarts the schedule rather than getting a burst
+// (a file never drops frames). Without `realtime`, frames come as fast as
+// they are asked for and stamps are the first delivery's time plus exactly
+// sequence * interval, so that offline runs are reproducible. A file says
+// nothing about exposure: each frame is taken as exposed for a whole
+// interval from its stamp (mark start_of_exposure, exposure_ns = interval).
+// sequence counts every delivered frame from 0, across loops.
+//
+// Buffers: three, allocated at open. A caller holding all three gets
+// `timeout` until it releases one. release() frees a buffer only for the
+// frame it holds now: a second release of a frame, a stale one (the buffer
+// has since carried a newer frame) or an index that is not ours are ignored
+// and not counted, since they are caller bugs with nothing to recover.
+//
+// Thread safety: as CameraSource (wait_frame from one thread, release and
+// status from any).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "camhead/hal/camera/camera_source.h"
+
+namespace camhead::hal::camera {
+
+struct FileCameraOptions {
+  std::filesystem::path path;
+  bool loop = false;
+  bool realtime = true;
+  // 0: the file's own rate (Y4M header), 25 for image sequences; otherwise
+  // 0.01 to 1000 frames a second.
+  double fps = 0;
+};
+
+// "FILE: FIELD: REASON", e.g. "take.y4m: header: W missing".
+class FileCameraError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+inline constexpr int kFileCameraBuffers = 3;
+
+[[nodiscard]] std::unique_ptr<CameraSource> open_file_camera(const FileCameraOptions &options);
+
+} // namespace camhead::hal::camera

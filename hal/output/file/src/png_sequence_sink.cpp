@@ -1,0 +1,120 @@
+// The PNG sequence sink; see file_sink.h.
+#include <mutex>
+#include <optional>
+#include <system_error>
+#include <vector>
+
+#include "camhead/hal/output/file/file_sink.h"
+#include "camhead/hal/video_file/frame_pattern.h"
+#include "camhead/hal/video_file/png_frame.h"
+#include "partial_file.h"
+
+namespace camhead::hal::output {
+namespace {
+
+using video_file::FramePattern;
+
+class PngSequenceSink final : public FrameSink {
+public:
+  PngSequenceSink(FramePattern pattern, base::VideoFormat format)
+      : pattern_(std::move(pattern)), format_(format), frame_(base::frame_bytes(format)) {
+    status_.connected = true;
+    status_.detail = name() + ": ready";
+  }
+
+  std::string name() const override { return "png " + pattern_.text(); }
+  base::VideoFormat format() const override { return format_; }
+
+  std::span<std::uint8_t> acquire() override {
+    if (closed_)
+      return {};
+    acquired_ = true;
+    return frame_;
+  }
+
+  bool submit(std::int64_t) override {
+    if (closed_)
+      return fail("submit after close");
+    if (!acquired_)
+      return fail("submit without acquire");
+    acquired_ = false;
+    if (!video_file::encode_png_rgb(frame_, format_.width, format_.height, base::row_bytes(format_),
+                                    png_))
+      return fail("cannot encode PNG (out of memory)");
+    const std::filesystem::path target = pattern_.path(next_);
+    std::string error;
+    std::optional<PartialFile> file = PartialFile::create(target, error);
+    if (!file || !file->write(png_, error) || !file->commit(false, error))
+      return fail(target.string() + ": " + error);
+    ++next_;
+    const std::lock_guard lock(mutex_);
+    ++status_.frames;
+    return true;
+  }
+
+  bool close() override {
+    if (closed_)
+      return fail("closed twice");
+    closed_ = true;
+    const std::lock_guard lock(mutex_);
+    status_.connected = false;
+    status_.detail = name() + ": " + std::to_string(status_.frames) + " frames written";
+    return true;
+  }
+
+  SinkStatus status() const override {
+    const std::lock_guard lock(mutex_);
+    return status_;
+  }
+
+private:
+  bool fail(const std::string &reason) {
+    const std::lock_guard lock(mutex_);
+    ++status_.errors;
+    status_.detail = name() + ": " + reason;
+    return false;
+  }
+
+  const FramePattern pattern_;
+  const base::VideoFormat format_;
+  std::vector<std::uint8_t> frame_;
+  std::vector<std::uint8_t> png_;
+  std::uint64_t next_ = 0; // frames written, and the next file's number
+  bool acquired_ = false;
+  bool closed_ = false;
+
+  mutable std::mutex mutex_;
+  SinkStatus status_;
+};
+
+} // namespace
+
+std::unique_ptr<FrameSink> open_png_sequence_sink(const std::string &pattern,
+                                                  base::VideoFormat format) {
+  std::string error;
+  std::optional<FramePattern> parsed = FramePattern::parse(pattern, error);
+  if (!parsed)
+    throw FileSinkError(pattern + ": " + error);
+  if (format.pixel != base::PixelFormat::rgb24)
+    throw FileSinkError(pattern +
+                        ": format: " + std::string(base::pixel_format_name(format.pixel)) +
+                        " cannot be written as PNG; use rgb24");
+  const std::string reason = base::check_video_format(format);
+  if (!reason.empty())
+    throw FileSinkError(pattern + ": format: " + reason);
+
+  const std::filesystem::path first = parsed->path(0);
+  const std::filesystem::path folder = first.parent_path();
+  std::error_code ec;
+  if (!folder.empty() && !std::filesystem::create_directories(folder, ec) && ec)
+    throw FileSinkError(pattern + ": cannot create folder " + folder.string() + ": " +
+                        ec.message());
+  // Proves the folder writable now rather than at the first frame.
+  std::optional<PartialFile> probe = PartialFile::create(first, error);
+  if (!probe)
+    throw FileSinkError(pattern + ": " + error);
+  probe->discard();
+  return std::make_unique<PngSequenceSink>(std::move(*parsed), format);
+}
+
+} // namespace camhead::hal::output

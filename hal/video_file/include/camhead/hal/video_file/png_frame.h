@@ -1,0 +1,49 @@
+// PNG frames through stb_image: the whole file is read into memory first, the
+// size is taken from the header and checked before anything is decoded (a
+// few bytes can claim a 100000 x 100000 image), and decoding gives 8-bit RGB
+// whatever the file holds (grey, alpha and 16-bit are converted). Encoding
+// writes 8-bit RGB. Errors are values: the file camera calls these at play
+// time, where nothing may throw. Any thread.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace camhead::hal::video_file {
+
+// A 16384 x 16384 RGB PNG that does not compress at all is about 805 MB.
+inline constexpr std::size_t kMaxPngFileBytes = std::size_t(1) << 30;
+
+// Reads `path` into `bytes` (reused between frames, so that playing a
+// sequence does not reallocate). False with `error` ("read: REASON") on
+// failure.
+[[nodiscard]] bool read_whole_file(const std::filesystem::path &path,
+                                   std::vector<std::uint8_t> &bytes, std::string &error);
+
+struct PngSize {
+  int width = 0;
+  int height = 0;
+  bool operator==(const PngSize &) const = default;
+};
+
+// The size the PNG header states; empty with `error` if it is not a PNG.
+[[nodiscard]] std::optional<PngSize> png_size(std::span<const std::uint8_t> file,
+                                              std::string &error);
+
+// Decodes into `rgb`, width * 3 bytes a row, no padding, which must be
+// exactly the size of `expected` (what png_size said). False with `error`
+// when the data is corrupt or decodes to another size.
+[[nodiscard]] bool decode_png_rgb(std::span<const std::uint8_t> file, PngSize expected,
+                                  std::span<std::uint8_t> rgb, std::string &error);
+
+// Encodes 8-bit RGB rows of `stride` bytes into `png` (replaced). False only
+// when stb cannot (out of memory).
+[[nodiscard]] bool encode_png_rgb(std::span<const std::uint8_t> rgb, int width, int height,
+                                  std::size_t stride, std::vector<std::uint8_t> &png);
+
+} // namespace camhead::hal::video_file

@@ -1,0 +1,102 @@
+#include "output_uri.h"
+
+#include "camhead/hal/output/file/file_sink.h"
+#include "camhead/hal/output/null/null_sink.h"
+
+namespace camhead::pipeline {
+namespace {
+
+constexpr std::string_view kForms =
+    "(v4l2:/dev/videoN, drm:CARD[:CONNECTOR], file:PATH.y4m, file:DIR/%05d.png or null)";
+
+bool ends_with(std::string_view s, std::string_view tail) {
+  return s.size() >= tail.size() && s.substr(s.size() - tail.size()) == tail;
+}
+
+// Splits "TARGET?format=F" and sets spec.format from F (yuyv or nv12).
+std::string_view take_format(std::string_view uri, std::string_view rest, OutputSpec &spec) {
+  const std::size_t q = rest.find('?');
+  if (q == std::string_view::npos)
+    return rest;
+  const std::string_view option = rest.substr(q + 1);
+  constexpr std::string_view kKey = "format=";
+  if (option.substr(0, kKey.size()) != kKey)
+    throw OutputError(uri,
+                      "unknown option \"" + std::string(option) + "\" (only format=yuyv|nv12)");
+  const std::string_view name = option.substr(kKey.size());
+  if (name == "yuyv")
+    spec.format = base::PixelFormat::yuyv;
+  else if (name == "nv12")
+    spec.format = base::PixelFormat::nv12;
+  else
+    throw OutputError(uri, "format: \"" + std::string(name) + "\" is not yuyv or nv12");
+  return rest.substr(0, q);
+}
+
+} // namespace
+
+OutputSpec parse_output_uri(std::string_view uri) {
+  OutputSpec spec;
+  spec.uri = std::string(uri);
+  if (uri == "null") {
+    spec.kind = OutputKind::null;
+    return spec;
+  }
+  const std::size_t colon = uri.find(':');
+  if (colon == std::string_view::npos || colon + 1 == uri.size())
+    throw OutputError(uri, "not an output URI " + std::string(kForms));
+  const std::string_view scheme = uri.substr(0, colon);
+  std::string_view rest = uri.substr(colon + 1);
+  if (scheme == "v4l2") {
+    spec.kind = OutputKind::v4l2;
+    spec.target = std::string(take_format(uri, rest, spec));
+  } else if (scheme == "drm") {
+    spec.kind = OutputKind::drm;
+    spec.format = base::PixelFormat::xrgb8888;
+    spec.target = std::string(rest);
+  } else if (scheme == "file") {
+    if (ends_with(rest.substr(0, rest.find('?')), ".y4m")) {
+      spec.kind = OutputKind::y4m;
+      spec.target = std::string(take_format(uri, rest, spec));
+    } else if (ends_with(rest, ".png")) {
+      spec.kind = OutputKind::png;
+      spec.format = base::PixelFormat::rgb24;
+      spec.target = std::string(rest);
+      if (spec.target.find('%') == std::string::npos)
+        throw OutputError(uri, "a PNG sequence needs a frame number in its name, e.g. "
+                               "file:frames/%05d.png");
+    } else {
+      throw OutputError(uri, "a file output is PATH.y4m or DIR/%05d.png");
+    }
+  } else {
+    throw OutputError(uri, "unknown output \"" + std::string(scheme) + "\" " + std::string(kForms));
+  }
+  if (spec.target.empty())
+    throw OutputError(uri, "names no device or file");
+  return spec;
+}
+
+std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width, int height,
+                                                    double fps) {
+  base::VideoFormat format;
+  format.pixel = spec.format;
+  format.width = width;
+  format.height = height;
+  switch (spec.kind) {
+  case OutputKind::null:
+    return hal::output::open_null_sink(format);
+  case OutputKind::y4m:
+    return hal::output::open_y4m_sink(spec.target, format, fps);
+  case OutputKind::png:
+    return hal::output::open_png_sequence_sink(spec.target, format);
+  case OutputKind::v4l2:
+    throw OutputError(spec.uri, "the V4L2 loopback output is not built yet (issue 10, "
+                                "section 4); use file:PATH.y4m or null");
+  case OutputKind::drm:
+    throw OutputError(spec.uri, "the DRM/KMS output is not built yet (issue 10, section 4); use "
+                                "file:PATH.y4m or null");
+  }
+  throw OutputError(spec.uri, "unknown output kind");
+}
+
+} // namespace camhead::pipeline

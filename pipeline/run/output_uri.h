@@ -1,0 +1,46 @@
+// `camhead run --output URI` and a board's "outputs": which sink, where, in
+// which format.
+//
+//   v4l2:/dev/videoN[?format=yuyv|nv12]   the V4L2 loopback webcam
+//   drm:CARD[:CONNECTOR]                  HDMI through DRM/KMS
+//   file:PATH.y4m[?format=yuyv|nv12]      Y4M video (4:2:2 or 4:2:0)
+//   file:DIR/%05d.png                     PNG sequence, one file a frame
+//   null                                  nothing (benchmarks)
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "camhead/base/video_format.h"
+#include "camhead/hal/output/frame_sink.h"
+
+namespace camhead::pipeline {
+
+class OutputError : public std::runtime_error {
+public:
+  // "output URI: REASON"
+  OutputError(std::string_view uri, const std::string &reason)
+      : std::runtime_error(std::string(uri) + ": " + reason) {}
+};
+
+enum class OutputKind { v4l2, drm, y4m, png, null };
+
+struct OutputSpec {
+  std::string uri;
+  OutputKind kind = OutputKind::null;
+  std::string target; // device, card or file path / pattern
+  base::PixelFormat format = base::PixelFormat::yuyv;
+};
+
+// Throws OutputError naming the URI and what is wrong with it.
+[[nodiscard]] OutputSpec parse_output_uri(std::string_view uri);
+
+// Opens the sink at `width` x `height`, `fps` frames a second (for the
+// formats that carry a rate). Throws OutputError (or the backend's error,
+// which names the file or device).
+[[nodiscard]] std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width,
+                                                                  int height, double fps);
+
+} // namespace camhead::pipeline

@@ -1,0 +1,131 @@
+// camhead run: the live pipeline. A board's camera and lens in, composited
+// video out (pipeline/run/run_loop.h).
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "board.h"
+#include "camhead/lens_control/lens_profile.h"
+#include "camhead/renderer/scene_loader.h"
+#include "commands.h"
+#include "run/run_loop.h"
+
+namespace camhead::cli {
+namespace {
+
+struct RunArgs {
+  std::string board = "sim";
+  std::vector<std::string> outputs;
+  double duration_s = 0.0;
+  std::uint64_t frames = 0;
+  std::string stats;
+  std::string executor;
+  int threads = 0;
+};
+
+std::atomic<bool> stop_requested{false};
+
+extern "C" void on_stop_signal(int) {
+  stop_requested = true;
+}
+
+int run(const RunArgs &args) {
+  pipeline::RunOptions options;
+  try {
+    options.board = pipeline::load_board(pipeline::resolve_board(args.board));
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "board error: %s\n", e.what());
+    return 2;
+  }
+  options.outputs = args.outputs;
+  options.duration_s = args.duration_s;
+  options.frames = args.frames;
+  if (!args.stats.empty())
+    options.stats_file = args.stats;
+  if (args.executor == "cpu")
+    options.executor = pipeline::Executor::cpu;
+  else if (args.executor == "gpu")
+    options.executor = pipeline::Executor::gpu;
+  else if (args.executor == "auto")
+    options.executor = pipeline::Executor::automatic;
+  options.threads = args.threads;
+  options.stop = &stop_requested;
+
+  stop_requested = false;
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+  int status = 0;
+  try {
+    const pipeline::RunSummary s = pipeline::run_pipeline(options);
+    std::fprintf(stderr,
+                 "camhead run: %llu frames in, %llu out in %.1f s (%.1f fps out); dropped: "
+                 "camera %llu, render busy %llu, output busy %llu; render failures %llu, "
+                 "repeated frames %llu, placeholder frames %llu, output errors %llu, camera "
+                 "reconnects %llu\n",
+                 (unsigned long long)s.frames_in, (unsigned long long)s.frames_out, s.seconds,
+                 s.seconds > 0 ? double(s.frames_out) / s.seconds : 0.0,
+                 (unsigned long long)s.camera_dropped, (unsigned long long)s.render_busy,
+                 (unsigned long long)s.output_busy, (unsigned long long)s.render_failed,
+                 (unsigned long long)s.repeats, (unsigned long long)s.placeholders,
+                 (unsigned long long)s.sink_errors, (unsigned long long)s.camera_reconnects);
+    status = s.sink_errors > 0 ? 5 : 0;
+  } catch (const renderer::SceneError &e) {
+    std::fprintf(stderr, "scene error: %s\n", e.what());
+    status = 2;
+  } catch (const lens_control::ProfileError &e) {
+    std::fprintf(stderr, "lens profile error: %s\n", e.what());
+    status = 2;
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 3;
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  return status;
+}
+
+} // namespace
+
+void add_run_command(CLI::App &app) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App *cmd = app.add_subcommand(
+      "run", "The live pipeline: the board's camera and lens in, the virtual objects rendered\n"
+             "with the lens's depth of field at each frame's mid-exposure and composited into\n"
+             "the camera frame, out to every output. Stops at Ctrl-C (or SIGTERM), after\n"
+             "--duration or --frames, or when a camera file played once ends.\n"
+             "Outputs:\n"
+             "  file:PATH.y4m[?format=yuyv|nv12]  Y4M video (ffplay PATH.y4m, mpv PATH.y4m)\n"
+             "  file:DIR/%05d.png                 one PNG a frame\n"
+             "  null                              nothing (to measure the pipeline)\n"
+             "  v4l2:/dev/videoN, drm:CARD        the webcam and HDMI outputs (not built yet)\n"
+             "Examples:\n"
+             "  camhead run --duration 5 --output file:sim.y4m\n"
+             "  camhead run --board my-rig.json --frames 250 --record-stats stats.jsonl");
+  cmd->add_option("--board", args->board,
+                  "Board name in board/ (sim, ...) or a board file; its camera, scene,\n"
+                  "lens and outputs")
+      ->capture_default_str();
+  cmd->add_option("--output", args->outputs,
+                  "Output URI (repeat for more); replaces the board's outputs");
+  cmd->add_option("--duration", args->duration_s, "Stop after this many seconds")
+      ->check(CLI::Range(0.0, 1e7));
+  cmd->add_option("--frames", args->frames, "Stop after this many output frames")
+      ->check(CLI::Range(std::uint64_t(0), std::uint64_t(1) << 40));
+  cmd->add_option("--record-stats", args->stats,
+                  "Write one JSON object per output frame to FILE.jsonl: sequence, capture,\n"
+                  "exposure-middle and output times, the lens state, rays per pixel, drops\n"
+                  "and each stage's time");
+  cmd->add_option("--executor", args->executor,
+                  "auto (default: the board's), cpu, or gpu (not built yet for live frames)")
+      ->check(CLI::IsMember({"auto", "cpu", "gpu"}));
+  cmd->add_option("--threads", args->threads, "CPU executor threads (0: one per core)")
+      ->check(CLI::Range(0, 256));
+  cmd->callback([args] { set_exit_code(run(*args)); });
+}
+
+} // namespace camhead::cli

@@ -1,0 +1,39 @@
+// The camera of one live frame as a plain value: where the camera is and what
+// the physical lens is doing at that frame's mid-exposure. pipeline/ fills it
+// from the pose and lens_control's LensState; a scene file's camera is its
+// default (scene_camera()).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include "camhead/renderer/scene.h"
+
+namespace camhead::renderer {
+
+struct FrameCamera {
+  // The pose: the lens's reference plane (where the lens profile measures the
+  // entrance pupil from), the point it looks at and the up direction, world
+  // metres.
+  glm::vec3 position{0.0f};
+  glm::vec3 look_at{0.0f, 0.0f, -1.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  // Metres from the entrance pupil to the focal plane; +infinity allowed.
+  float focus_distance_m = 0.0f;
+  // 0 = pinhole.
+  float f_number = 0.0f;
+  // The lens's focal length: with the f-number it sets the aperture,
+  // f / (2 N) in radius.
+  float focal_length_mm = 35.0f;
+  // The focal length that reproduces the image scale (focus breathing); it
+  // sets the field of view. 0 = focal_length_mm.
+  float projection_focal_length_mm = 0.0f;
+  float sensor_width_mm = 36.0f;
+  // The entrance pupil, metres in front of `position` along the view axis:
+  // where the lens rays start and the focus distance is measured from.
+  float entrance_pupil_offset_m = 0.0f;
+};
+
+// The scene file's camera: pupil at its position, no breathing.
+[[nodiscard]] FrameCamera scene_camera(const Scene &scene);
+
+} // namespace camhead::renderer

@@ -1,0 +1,84 @@
+// The renderer as the live pipeline drives it: one scene loaded once, then a
+// frame at a time, each with its own camera (pose and lens at mid-exposure)
+// and its own plate (the camera frame in the camera's own pixel format), and
+// the composite written straight into each output's buffer in that output's
+// format. Everything a frame needs is made when the renderer is created:
+// nothing is allocated, compiled or thrown per frame; what goes wrong is the
+// returned status.
+//
+// Thread safety: one thread renders at a time.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "camhead/base/video_format.h"
+#include "camhead/renderer/adaptive.h"
+#include "camhead/renderer/frame_camera.h"
+#include "camhead/renderer/scene.h"
+
+namespace camhead::renderer {
+
+// A camera frame as it arrived, or an output buffer to fill.
+struct VideoFrame {
+  base::VideoFormat format;
+  std::span<const std::uint8_t> bytes;
+};
+struct VideoBuffer {
+  base::VideoFormat format;
+  std::span<std::uint8_t> bytes;
+};
+
+struct FrameRequest {
+  FrameCamera camera;
+  std::uint32_t rays_per_pixel = 1; // the mean, for adaptive frames
+  bool adaptive = false;
+  AdaptiveSampling adaptive_settings;
+  // The frame's own noise pattern; 0 takes the scene's render.seed.
+  std::uint32_t seed = 0;
+};
+
+enum class FrameStatus {
+  ok,
+  bad_input,   // a plate or output that does not fit the renderer (`detail` says how)
+  device_lost, // the GPU is gone: the renderer renders nothing more
+};
+
+struct FrameReport {
+  FrameStatus status = FrameStatus::ok;
+  std::string detail;
+  std::uint64_t camera_rays = 0;
+  // Where the frame's time went, seconds: converting the plate in, tracing
+  // (and compositing), converting the composite out.
+  double decode_s = 0.0;
+  double trace_s = 0.0;
+  double encode_s = 0.0;
+};
+
+class FrameRenderer {
+public:
+  virtual ~FrameRenderer() = default;
+  FrameRenderer() = default;
+  FrameRenderer(const FrameRenderer &) = delete;
+  FrameRenderer &operator=(const FrameRenderer &) = delete;
+
+  // "cpu reference, 2 threads", "gpu NVIDIA H100 80GB HBM3", for status lines.
+  [[nodiscard]] virtual std::string executor() const = 0;
+
+  // Renders one frame: `plate` is the camera image I_c (same size as the
+  // scene's render size), each of `outputs` gets the composite I_f in its
+  // own format (same size). The scene's own plate is not used; a plate
+  // without bytes is none, and the outputs get I_m (the scene as rendered).
+  [[nodiscard]] virtual FrameReport render(const FrameRequest &request, const VideoFrame &plate,
+                                           std::span<const VideoBuffer> outputs) = 0;
+};
+
+// The CPU reference tracer (cpu_tracer.h) as a frame renderer, on `threads`
+// threads (<= 0: one per hardware thread), kept for its lifetime. Throws
+// std::invalid_argument for a scene whose render size is not a video size.
+[[nodiscard]] std::unique_ptr<FrameRenderer> make_cpu_frame_renderer(const Scene &scene,
+                                                                     int threads = 0);
+
+} // namespace camhead::renderer

@@ -1,0 +1,26 @@
+// Camera frames into the linear plate, and the linear composite into output
+// frames, row by row on the CPU: renderer/shaders/video.glsl compiled as C++.
+// The row functions are what the frame renderer's threads run in parallel.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include <glm/vec4.hpp>
+
+#include "camhead/base/video_format.h"
+
+namespace camhead::renderer::video {
+
+// Row `y` of `frame` (format `format`, every plane) as linear RGB into
+// `out[0..width)`, w = 0. The caller has checked the format and the size.
+void decode_row(const base::VideoFormat &format, std::span<const std::uint8_t> frame, int y,
+                glm::vec4 *out);
+
+// The rows [y0, y1) of `image` (linear RGB, width x height, row-major) into
+// `frame`. For nv12, y0 is even and y1 even or the height: a chroma row is
+// the mean of two image rows.
+void encode_rows(const base::VideoFormat &format, std::span<std::uint8_t> frame,
+                 const glm::vec4 *image, int y0, int y1);
+
+} // namespace camhead::renderer::video
