@@ -24,6 +24,10 @@ packages=(
   # built from its source against its headers (all three from one release).
   qemu-system-x86 linux-image-amd64 linux-headers-amd64 linux-source-6.1
   busybox-static cpio kmod xz-utils
+  # The lab's virtual webcam (tests/vm/v4l2_loopback.sh): the package is the
+  # driver's source, which the lab builds against the same headers as
+  # gpio-sim (build_v4l2loopback.sh). Installing it also runs DKMS once.
+  v4l2loopback-dkms
 )
 
 if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then

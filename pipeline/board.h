@@ -29,14 +29,16 @@
 #include <variant>
 #include <vector>
 
+#include "camhead/base/config_error.h"
 #include "camhead/base/video_format.h"
 
 namespace camhead::pipeline {
 
-class BoardError : public std::runtime_error {
+// A board file that cannot be used (base/config_error.h).
+class BoardError : public base::ConfigError {
 public:
-  BoardError(const std::string &file, const std::string &field, const std::string &reason)
-      : std::runtime_error(file + ": " + field + ": " + reason) {}
+  using base::ConfigError::ConfigError;
+  explicit BoardError(const base::ConfigError &e) : base::ConfigError(e) {}
 };
 
 // A recorded lens trace played back in real time (the simulated rig).
@@ -44,6 +46,10 @@ struct TraceSourceConfig {
   std::filesystem::path file;
   bool loop = true;
   double speed = 1.0;
+  // The trace's time 0 at CLOCK_MONOTONIC 0 ("clock_origin": "monotonic"),
+  // so that the simulated camera films the lens the trace plays, and tests
+  // know the lens at any instant; else it starts when the rig starts.
+  bool monotonic_origin = false;
 };
 
 // The camhead USB lens-encoder board (docs/usb-lens-protocol.md).
@@ -121,7 +127,15 @@ struct FileCameraConfig {
   bool realtime = true; // false: as fast as frames are taken
 };
 
-using CameraKind = std::variant<SimCameraConfig, FileCameraConfig>;
+// A V4L2 capture device (hal/camera/v4l2): a USB webcam, an HDMI capture
+// card, a CSI sensor's video node.
+struct V4l2CameraConfig {
+  std::string device; // /dev/videoN or a /dev/v4l/by-id/... name
+  double fps = 0.0;   // 0: the driver's rate
+  int buffers = 4;
+};
+
+using CameraKind = std::variant<SimCameraConfig, FileCameraConfig, V4l2CameraConfig>;
 
 struct CameraConfig {
   CameraKind kind;

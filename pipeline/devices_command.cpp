@@ -1,20 +1,93 @@
-// camhead devices: what this machine offers the renderer.
+// camhead devices: what this machine offers a rig (cameras, outputs, lens
+// encoders, Vulkan devices), each with what to write in a board file or on
+// the command line to use it.
 #include <cstdio>
 #include <exception>
+#include <string>
 
+#include "camhead/hal/discovery/devices.h"
+#include "camhead/hal/lens/usb/usb_lens_protocol.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "commands.h"
 
 namespace camhead::cli {
 namespace {
 
+namespace discovery = hal::discovery;
+
 int exit_status = 0;
 
-int list_devices() {
+std::string joined(const std::vector<std::string> &items) {
+  std::string text;
+  for (const std::string &item : items)
+    text += (text.empty() ? "" : " ") + item;
+  return text;
+}
+
+void list_video(const std::vector<discovery::VideoNode> &nodes) {
+  std::printf("Cameras (board \"camera\": {\"type\": \"v4l2\", \"device\": ...}):\n");
+  int cameras = 0;
+  for (const discovery::VideoNode &n : nodes) {
+    if (!n.problem.empty()) {
+      std::printf("  %s: %s\n", n.path.c_str(), n.problem.c_str());
+      continue;
+    }
+    if (!n.capture)
+      continue;
+    ++cameras;
+    // A by-id name survives replugging into another port; prefer it.
+    const std::string name = n.links.empty() ? n.path : n.links.front();
+    std::printf("  %s  (%s, %s: %s)  formats %s\n", name.c_str(), n.path.c_str(), n.driver.c_str(),
+                n.card.c_str(), joined(n.formats).c_str());
+  }
+  if (cameras == 0)
+    std::printf("  none found (the simulated camera is always there: --board sim)\n");
+  std::printf("Webcam outputs (camhead run --output v4l2:DEVICE):\n");
+  int outputs = 0;
+  for (const discovery::VideoNode &n : nodes)
+    if (n.problem.empty() && n.output) {
+      ++outputs;
+      std::printf("  v4l2:%s  (%s: %s)\n", n.path.c_str(), n.driver.c_str(), n.card.c_str());
+    }
+  if (outputs == 0)
+    std::printf(
+        "  none found (modprobe v4l2loopback video_nr=10 exclusive_caps=1 "
+        "card_label=camhead;\n        systemd/camhead-v4l2loopback.conf is the options file)\n");
+}
+
+void list_displays(const std::vector<discovery::DisplayCard> &cards) {
+  std::printf("Displays (camhead run --output drm:CARD[:CONNECTOR]):\n");
+  if (cards.empty())
+    std::printf("  none found\n");
+  for (const discovery::DisplayCard &card : cards)
+    for (const discovery::DisplayConnector &c : card.connectors)
+      std::printf("  drm:%s:%s  (%s, %s)\n", card.card.c_str(), c.name.c_str(), card.driver.c_str(),
+                  c.status.c_str());
+}
+
+void list_lens_encoders() {
+  std::printf("Lens encoders (board \"lens\": \"sources\"):\n");
+  const auto boards =
+      discovery::list_usb_devices(hal::lens::kUsbLensVendorId, hal::lens::kUsbLensProductId);
+  for (const discovery::UsbDevice &b : boards)
+    std::printf("  {\"type\": \"usb\", \"vendor_id\": \"%04x\", \"product_id\": \"%04x\", "
+                "\"serial\": \"%s\"}  (USB %s, %s)\n",
+                b.vendor_id, b.product_id, b.serial.c_str(), b.sysfs_name.c_str(),
+                b.product.c_str());
+  const auto chips = discovery::list_gpio_chips();
+  for (const discovery::GpioChip &c : chips)
+    std::printf("  {\"type\": \"gpio\", \"chip\": \"%s\", ...}  (%s, %u lines)\n",
+                c.label.empty() ? c.name.c_str() : c.label.c_str(), c.name.c_str(), c.lines);
+  if (boards.empty() && chips.empty())
+    std::printf("  no USB lens board and no GPIO chip found; FreeD and OpenTrackIO sources "
+                "listen on UDP and need no device\n");
+}
+
+int list_vulkan() {
   try {
     const auto devices = renderer::list_gpu_devices();
     if (devices.empty()) {
-      std::printf("No Vulkan device found (install mesa-vulkan-drivers for lavapipe).\n");
+      std::printf("Vulkan devices: none (install mesa-vulkan-drivers for lavapipe).\n");
       return 1;
     }
     std::printf("Vulkan devices (camhead render --device INDEX|NAME):\n");
@@ -24,6 +97,13 @@ int list_devices() {
     std::fprintf(stderr, "Vulkan error: %s\n", e.what());
     return 3;
   }
+}
+
+int list_devices() {
+  list_video(discovery::list_video_nodes());
+  list_displays(discovery::list_display_cards());
+  list_lens_encoders();
+  return list_vulkan();
 }
 
 } // namespace
@@ -36,7 +116,9 @@ void set_exit_code(int code) {
 }
 
 void add_devices_command(CLI::App &app) {
-  CLI::App *cmd = app.add_subcommand("devices", "List the Vulkan devices the renderer can use");
+  CLI::App *cmd = app.add_subcommand(
+      "devices", "List the cameras, webcam and display outputs, lens encoders and Vulkan\n"
+                 "devices this machine has, with the board field or option that uses each");
   cmd->callback([] { set_exit_code(list_devices()); });
 }
 

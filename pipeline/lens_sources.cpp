@@ -55,7 +55,12 @@ private:
 };
 
 std::unique_ptr<hl::LensEncoder> open_trace(const TraceSourceConfig &c) {
-  return hl::TraceReplay::open(c.file, {.loop = c.loop, .speed = c.speed});
+  hl::TraceReplayOptions options;
+  options.loop = c.loop;
+  options.speed = c.speed;
+  if (c.monotonic_origin)
+    options.start_ns = 0;
+  return hl::TraceReplay::open(c.file, options);
 }
 
 std::unique_ptr<hl::LensEncoder> open_usb(const UsbSourceConfig &c) {

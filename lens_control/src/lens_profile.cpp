@@ -10,10 +10,6 @@
 
 namespace camhead::lens_control {
 
-ProfileError::ProfileError(std::string file, std::string field, std::string reason)
-    : std::runtime_error(file + ": " + (field.empty() ? "" : field + ": ") + reason),
-      file_(std::move(file)), field_(std::move(field)), reason_(std::move(reason)) {}
-
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -2,6 +2,7 @@
 
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/hal/output/null/null_sink.h"
+#include "camhead/hal/output/v4l2/v4l2_loopback_sink.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -90,8 +91,7 @@ std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int 
   case OutputKind::png:
     return hal::output::open_png_sequence_sink(spec.target, format);
   case OutputKind::v4l2:
-    throw OutputError(spec.uri, "the V4L2 loopback output is not built yet (issue 10, "
-                                "section 4); use file:PATH.y4m or null");
+    return hal::output::open_v4l2_loopback_sink(spec.target, format, fps);
   case OutputKind::drm:
     throw OutputError(spec.uri, "the DRM/KMS output is not built yet (issue 10, section 4); use "
                                 "file:PATH.y4m or null");

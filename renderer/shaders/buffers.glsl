@@ -16,8 +16,18 @@ layout(std140, binding = BINDING_FRAME) uniform Frame { FrameParams frame; };
 layout(std430, binding = BINDING_ACCUM_MIXED) buffer AccumMixed { vec4 accum_mixed[]; };
 layout(std430, binding = BINDING_ACCUM_REAL) buffer AccumReal { vec4 accum_real[]; };
 layout(std430, binding = BINDING_ACCUM_AUX) buffer AccumAux { vec4 accum_aux[]; };
+// The live frame's kernels write the plate (video_decode.comp) and read the
+// composite (video_encode.comp); the others only read one and write the other.
+#ifdef CAMHEAD_WRITES_PLATE
+layout(std430, binding = BINDING_PLATE) writeonly buffer Plate { vec4 plate[]; };
+#else
 layout(std430, binding = BINDING_PLATE) readonly buffer Plate { vec4 plate[]; };
+#endif
+#ifdef CAMHEAD_READS_COMPOSITE
+layout(std430, binding = BINDING_OUT_COMPOSITE) readonly buffer OutComposite { vec4 out_composite[]; };
+#else
 layout(std430, binding = BINDING_OUT_COMPOSITE) writeonly buffer OutComposite { vec4 out_composite[]; };
+#endif
 layout(std430, binding = BINDING_OUT_MIXED) writeonly buffer OutMixed { vec4 out_mixed[]; };
 layout(std430, binding = BINDING_OUT_REAL) writeonly buffer OutReal { vec4 out_real[]; };
 layout(std430, binding = BINDING_OUT_AUX) writeonly buffer OutAux { vec4 out_aux[]; };
@@ -28,6 +38,9 @@ layout(std430, binding = BINDING_ADAPTIVE_WEIGHTS) buffer AdaptiveWeights { floa
 layout(std430, binding = BINDING_ADAPTIVE_HISTOGRAM) buffer AdaptiveHistogram { uint adaptive_histogram[]; };
 layout(std430, binding = BINDING_ADAPTIVE_GROUPS) buffer AdaptiveGroups { float adaptive_groups[]; };
 layout(std430, binding = BINDING_ADAPTIVE_SOLUTION) buffer AdaptiveSolutionBuffer { AdaptiveSolution adaptive_solution; };
+layout(std140, binding = BINDING_VIDEO) uniform Video { VideoFrames video; };
+layout(std430, binding = BINDING_VIDEO_IN) readonly buffer VideoIn { uint video_in[]; };
+layout(std430, binding = BINDING_VIDEO_OUT) writeonly buffer VideoOut { uint video_out[]; };
 
 // Index of this invocation's pixel, or -1 outside the image.
 int pixel_index() {

@@ -118,7 +118,11 @@ struct FrameParams {
 #define BINDING_ADAPTIVE_HISTOGRAM 16 // uint pairs per bin: count, sum of in-bin offsets
 #define BINDING_ADAPTIVE_GROUPS 17    // float per 8x8 tile: sum of |pilot mean luminance|
 #define BINDING_ADAPTIVE_SOLUTION 18  // AdaptiveSolution
-#define BINDING_COUNT 19
+// Live frames (video.glsl, video_decode.comp, video_encode.comp).
+#define BINDING_VIDEO 19     // uniform VideoFrames
+#define BINDING_VIDEO_IN 20  // uint per 4 bytes: the camera frame as it came, rows packed
+#define BINDING_VIDEO_OUT 21 // uint per 4 bytes: the outputs one after another, rows packed
+#define BINDING_COUNT 22
 
 // Histogram bins of the adaptive weights: 16 per octave over every
 // non-negative float (adaptive.glsl).
@@ -130,6 +134,32 @@ struct FrameParams {
 struct AdaptiveSolution {
   vec4 solution;
   uvec4 rays;
+};
+
+// Video frame formats (base/video_format.h), VideoParams.format.x.
+#define VIDEO_YUYV 0u
+#define VIDEO_NV12 1u
+#define VIDEO_RGB24 2u
+#define VIDEO_BGR24 3u
+#define VIDEO_XRGB8888 4u
+#define VIDEO_MAX_OUTPUTS 4
+
+// One video frame in BINDING_VIDEO_IN or _OUT.
+//   format: x VIDEO_*, y VIDEO_MATRIX_*, z VIDEO_RANGE_* (video.glsl), w the
+//           frame's first uint in its buffer
+//   size:   x width (a multiple of 4), y height (even), z bytes per row
+//           (packed, so a multiple of 4), w unused
+// The kernels work on blocks of 4 x 2 pixels, which every format fills with
+// whole uints: no two invocations write one word.
+struct VideoParams {
+  uvec4 format;
+  uvec4 size;
+};
+
+// frames[0] is the camera frame, frames[1 + k] output k; count.x outputs.
+struct VideoFrames {
+  VideoParams frames[1 + VIDEO_MAX_OUTPUTS];
+  uvec4 count;
 };
 
 // The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to

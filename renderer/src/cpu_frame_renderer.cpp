@@ -14,6 +14,7 @@
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "cpu_kernel.h"
+#include "frame_checks.h"
 #include "video_codec.h"
 #include "worker_pool.h"
 
@@ -24,20 +25,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// Why a frame of `format` (`bytes` long) cannot be a plate or an output of a
-// width x height render, or empty.
-std::string check_frame(const base::VideoFormat &format, std::size_t bytes, int width, int height) {
-  if (std::string reason = base::check_video_format(format); !reason.empty())
-    return reason;
-  if (format.width != width || format.height != height)
-    return base::describe(format) + " is not the render size " + std::to_string(width) + "x" +
-           std::to_string(height);
-  if (bytes < base::frame_bytes(format))
-    return base::describe(format) + " needs " + std::to_string(base::frame_bytes(format)) +
-           " bytes, not " + std::to_string(bytes);
-  return {};
 }
 
 class CpuFrameRenderer final : public FrameRenderer {
@@ -66,15 +53,10 @@ public:
     const int width = scene_.render.width;
     const int height = scene_.render.height;
     const bool has_plate = !plate.bytes.empty();
-    if (std::string reason = check_frame(plate.format, plate.bytes.size(), width, height);
-        has_plate && !reason.empty())
-      return bad_input("camera frame: " + reason);
-    for (const VideoBuffer &out : outputs)
-      if (std::string reason = check_frame(out.format, out.bytes.size(), width, height);
-          !reason.empty())
-        return bad_input("output: " + reason);
+    if (std::string reason = check_frames(plate, outputs, width, height); !reason.empty())
+      return bad_frame(std::move(reason));
     if (request.rays_per_pixel == 0)
-      return bad_input("0 rays per pixel");
+      return bad_frame("0 rays per pixel");
 
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
@@ -138,13 +120,6 @@ private:
   static Scene without_plate(Scene scene) {
     scene.plate.reset();
     return scene;
-  }
-
-  static FrameReport bad_input(std::string detail) {
-    FrameReport report;
-    report.status = FrameStatus::bad_input;
-    report.detail = std::move(detail);
-    return report;
   }
 
   // Samples [first, end) of every pixel into the accumulators, cleared first

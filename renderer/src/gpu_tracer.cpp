@@ -20,6 +20,8 @@
 #include "camhead/renderer/bvh.h"
 #include "resolve_spv.h"
 #include "trace_spv.h"
+#include "video_decode_spv.h"
+#include "video_encode_spv.h"
 #include "vulkan_context.h"
 
 namespace camhead::renderer {
@@ -61,6 +63,7 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   std::array<VkDescriptorType, BINDING_COUNT> types{};
   types.fill(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
   types[BINDING_FRAME] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  types[BINDING_VIDEO] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   return types;
 }
 
@@ -73,6 +76,47 @@ constexpr std::array<int, 4> kOutputs = {BINDING_OUT_COMPOSITE, BINDING_OUT_MIXE
                                          BINDING_OUT_AUX};
 constexpr std::array<int, 3> kAccumulators = {BINDING_ACCUM_MIXED, BINDING_ACCUM_REAL,
                                               BINDING_ACCUM_AUX};
+
+// The largest frame of any format: 4 bytes per pixel (xrgb8888).
+VkDeviceSize max_video_bytes(std::size_t pixels) {
+  return VkDeviceSize(4) * pixels;
+}
+
+std::uint32_t video_format_code(base::PixelFormat pixel) {
+  switch (pixel) {
+  case base::PixelFormat::yuyv:
+    return VIDEO_YUYV;
+  case base::PixelFormat::nv12:
+    return VIDEO_NV12;
+  case base::PixelFormat::rgb24:
+    return VIDEO_RGB24;
+  case base::PixelFormat::bgr24:
+    return VIDEO_BGR24;
+  case base::PixelFormat::xrgb8888:
+    return VIDEO_XRGB8888;
+  }
+  return VIDEO_YUYV;
+}
+
+// A frame as the video kernels see it: packed rows starting at `first_word`.
+gpu::VideoParams video_params(const base::VideoFormat &f, std::uint32_t first_word) {
+  gpu::VideoParams v{};
+  v.format = gpu::uvec4(video_format_code(f.pixel), f.matrix == base::ColorMatrix::bt601 ? 0u : 1u,
+                        f.range == base::ColorRange::full ? 1u : 0u, first_word);
+  v.size = gpu::uvec4(std::uint32_t(f.width), std::uint32_t(f.height),
+                      std::uint32_t(base::packed_stride(f.pixel, f.width)), 0u);
+  return v;
+}
+
+// Rows of `height` (plus NV12's chroma rows) between two strides.
+void copy_rows(const std::uint8_t *from, std::size_t from_stride, std::uint8_t *to,
+               std::size_t to_stride, const base::VideoFormat &f) {
+  const std::size_t row = base::packed_stride(f.pixel, f.width);
+  const std::size_t rows =
+      std::size_t(f.height) + (f.pixel == base::PixelFormat::nv12 ? std::size_t(f.height) / 2 : 0);
+  for (std::size_t y = 0; y < rows; ++y)
+    std::memcpy(to + y * to_stride, from + y * from_stride, row);
+}
 
 } // namespace
 
@@ -102,7 +146,8 @@ struct GpuTracer::Impl {
 
   void load(const CompiledScene &scene);
   RenderResult render(const gpu::FrameParams &requested, const ProgressFn &progress,
-                      LayerSelection layers, const AdaptiveSampling *adaptive);
+                      LayerSelection layers, const AdaptiveSampling *adaptive,
+                      const VideoJob *video = nullptr);
   // Records commands into a command buffer.
   using Recorder = std::function<void(VkCommandBuffer)>;
   // Adds samples [0, end) of `frame` to the accumulators in batches sized by
@@ -133,22 +178,26 @@ struct GpuTracer::Impl {
   vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
   vk::UniquePipeline adaptive_shares;
+  vk::UniquePipeline video_decode;
+  vk::UniquePipeline video_encode;
   vk::CommandRunner commands;
   vk::Buffer frame_uniform;
+  vk::Buffer video_uniform;
   // 0: the frame's first command, 1: its last; 2, 3: around the adaptive
   // allocation (adaptive frames only).
   vk::TimestampQueries timestamps;
   std::array<vk::Buffer, BINDING_COUNT> buffers; // by binding; BINDING_FRAME unused
   // The kOutputs one after another, then the display image, the sample
-  // counts and the adaptive solution.
+  // counts, the adaptive solution and the encoded video outputs.
   vk::Buffer readback;
 
   bool loaded = false;
   std::uint32_t width = 0;
   std::uint32_t height = 0;
   bool has_plate = false;
-  gpu::uvec4 counts{};    // primitives, nodes, lights
-  glm::vec3 origin{0.0f}; // CompiledScene::origin of the loaded scene
+  glm::uvec2 video_blocks{0}; // 4 x 2 pixel blocks of the video kernels
+  gpu::uvec4 counts{};        // primitives, nodes, lights
+  glm::vec3 origin{0.0f};     // CompiledScene::origin of the loaded scene
   // Batch sizes, one per kind of pass, for the loaded scene.
   BatchSizer uniform_sizer;
   BatchSizer second_pass_sizer;
@@ -171,12 +220,23 @@ GpuTracer::Impl::Impl(const std::string &wanted)
       adaptive_shares(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                          .spirv = adaptive_shares_spv,
                                                          .name = "adaptive_shares.comp"})),
+      video_decode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                      .spirv = video_decode_spv,
+                                                      .name = "video_decode.comp"})),
+      video_encode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                      .spirv = video_encode_spv,
+                                                      .name = "video_encode.comp"})),
       commands(device), frame_uniform(device, {.size = sizeof(gpu::FrameParams),
                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                                .memory = vk::MemoryUse::upload,
                                                .name = "frame parameters"}),
+      video_uniform(device, {.size = sizeof(gpu::VideoFrames),
+                             .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                             .memory = vk::MemoryUse::upload,
+                             .name = "video frame parameters"}),
       timestamps(device, 4) {
   descriptors.write(BINDING_FRAME, frame_uniform);
+  descriptors.write(BINDING_VIDEO, video_uniform);
 }
 
 void GpuTracer::Impl::load(const CompiledScene &scene) {
@@ -220,7 +280,8 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   upload(BINDING_NODES, bytes_of(nodes), sizeof(gpu::BvhNode), "BVH nodes");
   upload(BINDING_MATERIALS, bytes_of(scene.materials), sizeof(gpu::Material), "materials");
   upload(BINDING_LIGHTS, bytes_of(scene.lights), sizeof(gpu::Light), "lights");
-  upload(BINDING_PLATE, bytes_of(scene.plate), sizeof(gpu::vec4), "plate");
+  // Full size even without a plate: a live frame's camera image goes there.
+  upload(BINDING_PLATE, bytes_of(scene.plate), layer_bytes, "plate");
   uploader.flush(commands);
 
   for (const int binding : kAccumulators)
@@ -253,18 +314,30 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
       device, {.size = pixels * sizeof(std::uint32_t),
                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                .name = "display output"});
+  // The camera frame is written by the host straight into memory the kernel
+  // reads (no staging copy); the outputs come back through the read-back.
+  buffers[BINDING_VIDEO_IN] = vk::Buffer(device, {.size = max_video_bytes(pixels),
+                                                  .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                                  .memory = vk::MemoryUse::upload,
+                                                  .name = "camera frame"});
+  buffers[BINDING_VIDEO_OUT] = vk::Buffer(
+      device, {.size = VIDEO_MAX_OUTPUTS * max_video_bytes(pixels),
+               .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+               .name = "video outputs"});
   readback = vk::Buffer(device, {.size = layer_bytes * kOutputs.size() + 2 * pixels * 4 +
-                                         sizeof(gpu::AdaptiveSolution),
+                                         sizeof(gpu::AdaptiveSolution) +
+                                         VIDEO_MAX_OUTPUTS * max_video_bytes(pixels),
                                  .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                  .memory = vk::MemoryUse::readback,
                                  .name = "read-back"});
   for (int binding = 0; binding < BINDING_COUNT; ++binding)
-    if (binding != BINDING_FRAME)
+    if (binding != BINDING_FRAME && binding != BINDING_VIDEO)
       descriptors.write(binding, buffers[binding]);
 
   width = std::uint32_t(scene.width);
   height = std::uint32_t(scene.height);
   has_plate = !scene.plate.empty();
+  video_blocks = glm::uvec2((width + 3) / 4, (height + 1) / 2);
   counts = gpu::uvec4(scene.primitives.size(), scene.nodes.size(), scene.lights.size(), 0);
   origin = scene.origin;
   uniform_sizer = {};
@@ -285,7 +358,8 @@ void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeli
 }
 
 RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const ProgressFn &progress,
-                                     LayerSelection selection, const AdaptiveSampling *adaptive) {
+                                     LayerSelection selection, const AdaptiveSampling *adaptive,
+                                     const VideoJob *video) {
   const Clock::time_point start = Clock::now();
   if (!loaded)
     throw GpuError("GpuTracer::render() before a successful load()");
@@ -304,6 +378,31 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   frame.image.z = requested.image.z != 0 && has_plate ? 1u : 0u;
   frame.image.w = counts.z;
 
+  // A live frame: the camera frame into the plate on the device, and the
+  // composite into each output's format (video_decode.comp, video_encode.comp).
+  const bool decode_plate = video != nullptr && !video->plate.bytes.empty();
+  const std::size_t video_outputs = video != nullptr ? video->outputs.size() : 0;
+  const VkDeviceSize video_slot_bytes = max_video_bytes(std::size_t(width) * height);
+  if (video != nullptr) {
+    if (video_outputs > VIDEO_MAX_OUTPUTS)
+      throw GpuError("a frame for " + std::to_string(video_outputs) + " outputs; at most " +
+                     std::to_string(VIDEO_MAX_OUTPUTS));
+    gpu::VideoFrames params{};
+    if (decode_plate) {
+      params.frames[0] = video_params(video->plate.format, 0);
+      copy_rows(video->plate.bytes.data(), base::row_bytes(video->plate.format),
+                static_cast<std::uint8_t *>(buffers[BINDING_VIDEO_IN].mapped()),
+                base::packed_stride(video->plate.format.pixel, int(width)), video->plate.format);
+    }
+    for (std::size_t k = 0; k < video_outputs; ++k)
+      params.frames[1 + k] =
+          video_params(video->outputs[k].format, std::uint32_t(k * video_slot_bytes / 4));
+    params.count = gpu::uvec4(std::uint32_t(video_outputs), 0u, 0u, 0u);
+    std::memcpy(video_uniform.mapped(), &params, sizeof params);
+    frame.image.z = decode_plate ? 1u : 0u;
+  }
+  const glm::uvec2 video_groups((video_blocks.x + 7) / 8, (video_blocks.y + 7) / 8);
+
   // Where the read-back buffer holds what comes back.
   const VkDeviceSize layer_bytes = buffers[BINDING_OUT_AUX].size();
   const VkDeviceSize display_offset = kOutputs.size() * layer_bytes;
@@ -311,18 +410,35 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   const VkDeviceSize counts_offset = display_offset + display_bytes;
   const VkDeviceSize counts_bytes = buffers[BINDING_SAMPLE_COUNTS].size();
   const VkDeviceSize solution_offset = counts_offset + counts_bytes;
+  const VkDeviceSize video_offset = solution_offset + sizeof(gpu::AdaptiveSolution);
 
   // The frame's first commands: the clear, and the first timestamp.
   const auto begin_frame = [&](VkCommandBuffer command_buffer) {
     timestamps.reset(command_buffer);
     timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
     record_clear(command_buffer);
+    if (decode_plate) {
+      dispatch(command_buffer, video_decode.get(), video_groups);
+      vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_SHADER_READ_BIT);
+    }
   };
   // Its last: the resolve kernel (which reads sampling.z and tracing.y alone,
   // so it shares the last batch's uniform and submission), the copies to the
   // read-back buffer and the second timestamp.
   const auto end_frame = [&](VkCommandBuffer command_buffer) {
     dispatch(command_buffer, resolve.get());
+    if (video_outputs > 0) {
+      vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_SHADER_READ_BIT);
+      vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, video_encode.get());
+      const VkDescriptorSet set = descriptors.get();
+      vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(),
+                              0, 1, &set, 0, nullptr);
+      vkCmdDispatch(command_buffer, video_groups.x, video_groups.y, std::uint32_t(video_outputs));
+    }
     vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                        VK_ACCESS_TRANSFER_READ_BIT);
@@ -341,6 +457,13 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
       if (selection.sample_counts)
         copy(BINDING_SAMPLE_COUNTS, counts_offset, counts_bytes);
       copy(BINDING_ADAPTIVE_SOLUTION, solution_offset, sizeof(gpu::AdaptiveSolution));
+    }
+    for (std::size_t k = 0; k < video_outputs; ++k) {
+      base::VideoFormat packed = video->outputs[k].format;
+      packed.stride = 0; // the kernel's rows
+      const VkBufferCopy region{k * video_slot_bytes, video_offset + k * video_slot_bytes,
+                                base::frame_bytes(packed)};
+      vkCmdCopyBuffer(command_buffer, buffers[BINDING_VIDEO_OUT].get(), readback.get(), 1, &region);
     }
     vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
@@ -411,6 +534,12 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
       const auto *shares = reinterpret_cast<const std::uint32_t *>(mapped + counts_offset);
       result.sample_counts.assign(shares, shares + std::size_t(width) * height);
     }
+  }
+  for (std::size_t k = 0; k < video_outputs; ++k) {
+    const VideoBuffer &out = video->outputs[k];
+    copy_rows(mapped + video_offset + k * video_slot_bytes,
+              base::packed_stride(out.format.pixel, out.format.width), out.bytes.data(),
+              base::row_bytes(out.format), out.format);
   }
   timings.unpack_s = seconds_since(unpacking);
   result.timings = timings;
@@ -500,6 +629,14 @@ void GpuTracer::load(const CompiledScene &scene) {
 RenderResult GpuTracer::render(const gpu::FrameParams &frame, const ProgressFn &progress,
                                LayerSelection layers) {
   return impl_->render(frame, progress, layers, nullptr);
+}
+
+RenderResult GpuTracer::render_video(const gpu::FrameParams &frame, const VideoFrame &plate,
+                                     std::span<const VideoBuffer> outputs,
+                                     const AdaptiveSampling *adaptive) {
+  const VideoJob job{plate, outputs};
+  return impl_->render(frame, {}, LayerSelection{false, false, false, false, false, false},
+                       adaptive, &job);
 }
 
 RenderResult GpuTracer::render_adaptive(const gpu::FrameParams &frame,

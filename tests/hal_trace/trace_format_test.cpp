@@ -150,12 +150,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadTrace{"time_with_bare_dot", HEAD "1.,1,,,,,\n", 3, "t_s", "not a decimal"},
         BadTrace{"missing_time", HEAD ",1,,,,,\n", 3, "t_s", "empty"},
         BadTrace{"huge_time", HEAD "12345678901,1,,,,,\n", 3, "t_s", "too large"},
-        BadTrace{"fractional_counts", HEAD "0,1.5,,,,,\n", 3, "focus", "not an integer"},
-        BadTrace{"counts_beyond_int32", HEAD "0,,4294967296,,,,\n", 3, "iris", "32-bit"},
-        BadTrace{"text_counts", HEAD "0,,,wide,,,\n", 3, "zoom", "not an integer"},
+        BadTrace{"fractional_counts", HEAD "0,1.5,,,,,\n", 3, "focus", "must be an integer within"},
+        BadTrace{"counts_beyond_int32", HEAD "0,,4294967296,,,,\n", 3, "iris",
+                 "must be an integer within -2147483648 .. 2147483647"},
+        BadTrace{"text_counts", HEAD "0,,,wide,,,\n", 3, "zoom", "must be an integer within"},
         BadTrace{"zero_distance", HEAD "0,,,,0,,\n", 3, "focus_m", "must be > 0"},
-        BadTrace{"nan_f_stop", HEAD "0,,,,,nan,\n", 3, "f_stop", "not a number"},
-        BadTrace{"infinite_focal_length", HEAD "0,,,,,,inf\n", 3, "focal_mm", "not a finite"},
+        BadTrace{"nan_f_stop", HEAD "0,,,,,nan,\n", 3, "f_stop", "must be a finite number"},
+        BadTrace{"infinite_focal_length", HEAD "0,,,,,,inf\n", 3, "focal_mm",
+                 "must be a finite number"},
         BadTrace{"negative_infinity", HEAD "0,,,,-inf,,\n", 3, "focus_m", "must be > 0"},
         BadTrace{"too_few_cells", HEAD "0,1,2\n", 3, "row", "expected 7 fields"},
         BadTrace{"too_many_cells", HEAD "0,1,2,3,4,5,6,7\n", 3, "row", "found 8"}),
@@ -168,19 +170,21 @@ TEST(LensTraceFormat, WholeFileProblemsNameTheFile) {
     (void)parse_lens_trace("", "empty.csv");
     FAIL();
   } catch (const TraceError &e) {
-    EXPECT_EQ(std::string(e.what()).rfind("empty.csv: empty file", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("empty.csv: (file): empty (a trace starts with", 0), 0u)
+        << e.what();
   }
   try {
     (void)parse_lens_trace("# camhead lens trace v1\n# only comments\n", "nohead.csv");
     FAIL();
   } catch (const TraceError &e) {
-    EXPECT_EQ(std::string(e.what()).rfind("nohead.csv: no header row", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("nohead.csv: header: missing (expected e.g. t_s,", 0), 0u)
+        << e.what();
   }
   try {
     (void)read_lens_trace("/nonexistent/camhead/trace.csv");
     FAIL();
   } catch (const TraceError &e) {
-    EXPECT_EQ(std::string(e.what()), "/nonexistent/camhead/trace.csv: cannot open the file");
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/camhead/trace.csv: (file): cannot be opened");
   }
 }
 

@@ -159,12 +159,12 @@ TEST(CalibrationPerZoom, MisuseNamesFileLineOrTable) {
     std::string want;
   } cases[] = {
       {kHeader + "iris,0,,2.8,,,0\n", false,
-       "/virtual/zoom_marks.csv:2: column zoom_counts: not used by iris rows"},
-      {kHeader + "focus,0,1,,,,x\n", false, ":2: column zoom_counts: not an integer"},
+       "/virtual/zoom_marks.csv:2: zoom_counts: not used by iris rows"},
+      {kHeader + "focus,0,1,,,,x\n", false, ":2: zoom_counts: must be an integer within"},
       {kHeader + focus(0, "1", 0) + "focus,10,2,,,,\n" + kIrisZoom, false,
-       ":3: column zoom_counts: give zoom_counts on every focus row or on none (line 2 has one)"},
+       ":3: zoom_counts: give zoom_counts on every focus row or on none (line 2 has one)"},
       {kHeader + focus(0, "1", 0) + focus(10, "2", 0) + focus(0, "1", 500) + kIrisZoom, false,
-       ":4: column zoom_counts: no zoom row at counts 500"},
+       ":4: zoom_counts: no zoom row at counts 500"},
       {kHeader + focus(0, "1", 0) + focus(10, "2", 0) + kIrisZoom, false,
        "/virtual/zoom_marks.csv: focus at zoom counts 900: no focus measurements"},
       {kHeader + focus(0, "1", 0) + focus(0, "2", 0) + focus(0, "1", 900) + focus(10, "2", 900) +

@@ -190,24 +190,25 @@ TEST(Calibration, MalformedLinesNameFileLineAndColumn) {
   const struct {
     std::string text, want;
   } cases[] = {
-      {head + "focus,0,abc,,,\n", "/virtual/marks.csv:4: column distance_m: not a number"},
-      {head + "focus,12.5,1,,,\n", ":4: column counts: not an integer"},
-      {head + "focus,99999999999,1,,,\n", ":4: column counts: outside the 32-bit"},
-      {head + "focal,0,1,,,\n", ":4: column axis: must be focus, iris or zoom"},
-      {head + "focus,0,1,,\n", ":4: expected 6 fields as in the header, found 5"},
-      {head + "focus,0,1,2.8,,\n", ":4: column f_number: not used by focus rows"},
-      {head + "focus,0,,,,\n", ":4: column distance_m: missing"},
-      {head + "focus,0,-1,,,\n", ":4: column distance_m: must be > 0"},
-      {head + "iris,0,,nan,,\n", ":4: column f_number: not a finite number"},
-      {head + "iris,0,,200,,\n", ":4: column f_number: must be >= 0.5 and <= 128"},
-      {head + "iris,0,,2.8,2.5,\n", ":4: column t_stop: must be >= f_number"},
-      {head + "iris,0,,2.8,3,\niris,5,,4,,\n", ":5: column t_stop: give t_stop on every iris row"},
-      {head + "zoom,0,,,,inf\n", ":4: column focal_length_mm: not a finite number"},
-      {"axis,counts,distance\n", "/virtual/marks.csv:1: column distance: unknown column"},
-      {"axis,counts,counts\n", ":1: column counts: appears twice"},
-      {"axis,distance_m\n", ":1: column counts: missing from the header"},
-      {"axis,counts,distance_m\niris,0,\n", ":2: column f_number: missing from the header"},
-      {"# nothing\n", "/virtual/marks.csv: no header row"},
+      {head + "focus,0,abc,,,\n", "/virtual/marks.csv:4: distance_m: must be a number or inf"},
+      {head + "focus,12.5,1,,,\n",
+       ":4: counts: must be an integer within -2147483648 .. 2147483647"},
+      {head + "focus,99999999999,1,,,\n", ":4: counts: must be an integer within -2147483648 .. "},
+      {head + "focal,0,1,,,\n", ":4: axis: must be focus, iris or zoom"},
+      {head + "focus,0,1,,\n", ":4: row: expected 6 fields as in the header, found 5"},
+      {head + "focus,0,1,2.8,,\n", ":4: f_number: not used by focus rows"},
+      {head + "focus,0,,,,\n", ":4: distance_m: missing"},
+      {head + "focus,0,-1,,,\n", ":4: distance_m: must be > 0 and <= 100000"},
+      {head + "iris,0,,nan,,\n", ":4: f_number: must be a finite number"},
+      {head + "iris,0,,200,,\n", ":4: f_number: must be within 0.5 .. 128"},
+      {head + "iris,0,,2.8,2.5,\n", ":4: t_stop: must be >= f_number"},
+      {head + "iris,0,,2.8,3,\niris,5,,4,,\n", ":5: t_stop: give t_stop on every iris row"},
+      {head + "zoom,0,,,,inf\n", ":4: focal_length_mm: must be a finite number"},
+      {"axis,counts,distance\n", "/virtual/marks.csv:1: distance: unknown column"},
+      {"axis,counts,counts\n", ":1: counts: appears twice"},
+      {"axis,distance_m\n", ":1: counts: missing from the header"},
+      {"axis,counts,distance_m\niris,0,\n", ":2: f_number: missing from the header"},
+      {"# nothing\n", "/virtual/marks.csv: header: missing (expected e.g. axis,counts,"},
   };
   for (const auto &c : cases) {
     const std::string got = error_of(c.text);
@@ -273,7 +274,7 @@ TEST(Calibration, UnreadableFileIsAnError) {
     (void)read_measurements("/nonexistent/marks.csv");
     FAIL() << "no error";
   } catch (const CalibrationError &e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/marks.csv: cannot read the file");
+    EXPECT_STREQ(e.what(), "/nonexistent/marks.csv: (file): cannot be opened");
   }
 }
 

@@ -78,7 +78,7 @@ const std::vector<BadCase> kCases = {
     {"unknown top-level field", [](Json &j) { j["focsu"] = 1; }, "focsu"},
     {"both zoom and prime", [](Json &j) { j["zoom"] = zoom_base()["zoom"]; }, "prime"},
     {"neither zoom nor prime", [](Json &j) { j.erase("prime"); }, "zoom"},
-    {"root is an array", [](Json &j) { j = Json::array(); }, ""},
+    {"root is an array", [](Json &j) { j = Json::array(); }, "(top level)"},
     // Focus table.
     {"focus missing", [](Json &j) { j.erase("focus"); }, "focus"},
     {"focus not an array", [](Json &j) { j["focus"] = Json::object(); }, "focus"},
@@ -283,6 +283,26 @@ TEST(ProfileErrors, SyntaxErrorsAndMissingFiles) {
     ADD_FAILURE() << "loaded a missing file";
   } catch (const ProfileError &e) {
     EXPECT_EQ(e.file(), "/nonexistent/lens.json");
+  }
+}
+
+TEST(ProfileErrors, NonFiniteAndHugeLiteralsFailOnTheirField) {
+  // nlohmann refuses these while parsing; the reader names the field instead.
+  const std::string text = example().dump();
+  const std::string key = "\"focal_length_mm\":";
+  ASSERT_NE(text.find(key), std::string::npos);
+  for (const std::string &literal :
+       {std::string("1e999"), std::string("NaN"), std::string("NaN4"), std::string(400, '7')}) {
+    std::string t = text;
+    const std::size_t at = t.find(key) + key.size();
+    t.replace(at, t.find_first_of(",}", at) - at, literal);
+    try {
+      (void)LensProfile::parse(t, kSource);
+      ADD_FAILURE() << literal.substr(0, 20) << " accepted";
+    } catch (const ProfileError &e) {
+      EXPECT_STREQ(e.what(),
+                   "/virtual/bad_lens.json: prime.focal_length_mm: must be a finite number");
+    }
   }
 }
 

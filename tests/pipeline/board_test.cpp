@@ -101,6 +101,15 @@ TEST(Board, ErrorsNameTheFileAndTheField) {
             file + "lens.sources[0].speed: must be within 0.01 .. 100");
 }
 
+TEST(Board, IntegersGivenAsFloatsOrHugeNumbersNameTheRange) {
+  const std::string port =
+      "/rigs/test.json: lens.sources[0].port: must be an integer within 1 .. 65535";
+  for (const std::string &value :
+       {std::string("8.0"), std::string("1e999"), std::string(400, '9'), std::string("NaN4")})
+    EXPECT_EQ(error_of(with_source(R"({"type": "freed", "port": )" + value + "}")), port)
+        << value.substr(0, 20);
+}
+
 TEST(Board, MissingFileIsNamed) {
   try {
     static_cast<void>(load_board("/nonexistent/rig.json"));

@@ -75,7 +75,19 @@ std::vector<std::uint8_t> render_through(FrameRenderer &renderer, const VideoFor
   return bytes;
 }
 
+enum class Executor { cpu, gpu };
+
+// The frame renderer of `executor`, or null (the test skips) without Vulkan.
+std::unique_ptr<FrameRenderer> make_renderer(Executor executor, const Scene &scene) {
+  if (executor == Executor::cpu)
+    return make_cpu_frame_renderer(scene, 2);
+  if (!test::have_vulkan())
+    return nullptr;
+  return make_gpu_frame_renderer(scene);
+}
+
 struct SameFormat {
+  Executor executor;
   PixelFormat pixel;
   base::ColorRange range;
 };
@@ -85,7 +97,9 @@ class FramePassThroughSameFormat : public ::testing::TestWithParam<SameFormat> {
 TEST_P(FramePassThroughSameFormat, EveryByteLeavesAsItCame) {
   const int w = 64, h = 48;
   const Scene scene = real_only(w, h);
-  auto renderer = make_cpu_frame_renderer(scene, 2);
+  auto renderer = make_renderer(GetParam().executor, scene);
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
   const VideoFormat f = format(GetParam().pixel, w, h, GetParam().range);
   const std::vector<std::uint8_t> plate = noise_frame(f, 7);
   const std::vector<std::uint8_t> out = render_through(*renderer, f, plate, f);
@@ -95,23 +109,34 @@ TEST_P(FramePassThroughSameFormat, EveryByteLeavesAsItCame) {
   EXPECT_EQ(differ, 0u) << "of " << plate.size() << " bytes, " << base::describe(f);
 }
 
-INSTANTIATE_TEST_SUITE_P(Formats, FramePassThroughSameFormat,
-                         ::testing::Values(SameFormat{PixelFormat::yuyv, base::ColorRange::limited},
-                                           SameFormat{PixelFormat::yuyv, base::ColorRange::full},
-                                           SameFormat{PixelFormat::nv12, base::ColorRange::limited},
-                                           SameFormat{PixelFormat::rgb24, base::ColorRange::full},
-                                           SameFormat{PixelFormat::bgr24, base::ColorRange::full},
-                                           SameFormat{PixelFormat::xrgb8888,
-                                                      base::ColorRange::full}),
+std::vector<SameFormat> same_formats() {
+  std::vector<SameFormat> all;
+  for (const Executor e : {Executor::cpu, Executor::gpu})
+    for (const auto &[pixel, range] : {std::pair{PixelFormat::yuyv, base::ColorRange::limited},
+                                       std::pair{PixelFormat::yuyv, base::ColorRange::full},
+                                       std::pair{PixelFormat::nv12, base::ColorRange::limited},
+                                       std::pair{PixelFormat::rgb24, base::ColorRange::full},
+                                       std::pair{PixelFormat::bgr24, base::ColorRange::full},
+                                       std::pair{PixelFormat::xrgb8888, base::ColorRange::full}})
+      all.push_back({e, pixel, range});
+  return all;
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, FramePassThroughSameFormat, ::testing::ValuesIn(same_formats()),
                          [](const auto &param_info) {
-                           return std::string(base::pixel_format_name(param_info.param.pixel)) +
-                                  (param_info.param.range == base::ColorRange::full ? "_full"
-                                                                                    : "_limited");
+                           const SameFormat &f = param_info.param;
+                           return std::string(f.executor == Executor::cpu ? "cpu_" : "gpu_") +
+                                  std::string(base::pixel_format_name(f.pixel)) +
+                                  (f.range == base::ColorRange::full ? "_full" : "_limited");
                          });
 
-TEST(FramePassThrough, YuyvToNv12IsWithinOneCodeValue) {
+class FramePassThrough : public ::testing::TestWithParam<Executor> {};
+
+TEST_P(FramePassThrough, YuyvToNv12IsWithinOneCodeValue) {
   const int w = 64, h = 48;
-  auto renderer = make_cpu_frame_renderer(real_only(w, h), 2);
+  auto renderer = make_renderer(GetParam(), real_only(w, h));
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
   const VideoFormat in = format(PixelFormat::yuyv, w, h);
   const VideoFormat out = format(PixelFormat::nv12, w, h);
   // In-gamut content: a YUYV frame made from an NV12-compatible one would
@@ -137,17 +162,25 @@ TEST(FramePassThrough, YuyvToNv12IsWithinOneCodeValue) {
   EXPECT_LE(worst_chroma, 1) << "twice the code against the sum of the two rows' codes";
 }
 
-TEST(FramePassThrough, OnlyWhatTheVirtualObjectTouchesChanges) {
-  // A virtual ball in the top-left corner, no light to cast its shadow, no
-  // mirror to show it: the rest of the frame must be the camera's.
-  const int w = 96, h = 64;
+// A virtual ball in the top-left corner, no light for a shadow, no mirror.
+Scene scene_with_ball(int w, int h, glm::vec3 ball) {
   Scene scene = real_only(w, h);
   scene.lights.clear();
   scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
   scene.materials.push_back({"glow", MaterialType::emission, glm::vec3(2.0f), 1.5f});
-  const glm::vec3 ball(-1.2f, 0.7f, -3.0f);
   scene.objects.push_back(test::sphere("ball", ball, 0.2f, 2, false));
-  auto renderer = make_cpu_frame_renderer(scene, 2);
+  return scene;
+}
+
+TEST_P(FramePassThrough, OnlyWhatTheVirtualObjectTouchesChanges) {
+  // Nothing lights a shadow of the ball or shows it in a mirror: the rest
+  // of the frame must be the camera's.
+  const int w = 96, h = 64;
+  const glm::vec3 ball(-1.2f, 0.7f, -3.0f);
+  const Scene scene = scene_with_ball(w, h, ball);
+  auto renderer = make_renderer(GetParam(), scene);
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
   const VideoFormat f = format(PixelFormat::yuyv, w, h);
   const std::vector<std::uint8_t> plate = noise_frame(f, 3);
   const std::vector<std::uint8_t> out = render_through(*renderer, f, plate, f, 4);
@@ -167,8 +200,10 @@ TEST(FramePassThrough, OnlyWhatTheVirtualObjectTouchesChanges) {
   EXPECT_GT(changed_inside, 20u) << "the ball must show";
 }
 
-TEST(FrameRenderer, RefusesFramesOfAnotherSizeOrTooFewBytes) {
-  auto renderer = make_cpu_frame_renderer(real_only(32, 16), 1);
+TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
+  auto renderer = make_renderer(GetParam(), real_only(32, 16));
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
   const VideoFormat right = format(PixelFormat::yuyv, 32, 16);
   const VideoFormat wrong = format(PixelFormat::yuyv, 16, 16);
   std::vector<std::uint8_t> plate(base::frame_bytes(right), 128), out(base::frame_bytes(right));
@@ -185,6 +220,68 @@ TEST(FrameRenderer, RefusesFramesOfAnotherSizeOrTooFewBytes) {
   r = renderer->render(request, {right, plate}, std::span(&small, 1));
   EXPECT_EQ(r.status, FrameStatus::bad_input);
   EXPECT_NE(r.detail.find("output"), std::string::npos) << r.detail;
+}
+
+INSTANTIATE_TEST_SUITE_P(Executors, FramePassThrough,
+                         ::testing::Values(Executor::cpu, Executor::gpu),
+                         [](const auto &param_info) {
+                           return std::string(param_info.param == Executor::cpu ? "cpu" : "gpu");
+                         });
+
+// One model, two executors: the same frame in every output format from the
+// CPU reference and the GPU tracer, within one code value (float rounding
+// differs between a C++ compiler and a shader compiler; the rays are the
+// same).
+TEST(FrameExecutors, GpuAndCpuGiveTheSameCodes) {
+  if (!test::have_vulkan())
+    GTEST_SKIP() << "no Vulkan device";
+  const int w = 96, h = 64;
+  const Scene scene = scene_with_ball(w, h, {-0.2f, 0.1f, -2.5f});
+  auto cpu = make_cpu_frame_renderer(scene, 2);
+  auto gpu = make_gpu_frame_renderer(scene);
+  const VideoFormat in = format(PixelFormat::nv12, w, h);
+  const std::vector<std::uint8_t> plate = noise_frame(in, 9);
+  for (const PixelFormat pixel : {PixelFormat::yuyv, PixelFormat::nv12, PixelFormat::rgb24,
+                                  PixelFormat::bgr24, PixelFormat::xrgb8888}) {
+    const VideoFormat out = format(pixel, w, h);
+    const std::vector<std::uint8_t> a = render_through(*cpu, in, plate, out, 8);
+    const std::vector<std::uint8_t> b = render_through(*gpu, in, plate, out, 8);
+    int worst = 0;
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      worst = std::max(worst, std::abs(int(a[i]) - int(b[i])));
+      differ += a[i] != b[i];
+    }
+    EXPECT_LE(worst, 1) << base::pixel_format_name(pixel);
+    EXPECT_LT(differ, a.size() / 100) << base::pixel_format_name(pixel) << ": " << differ << " of "
+                                      << a.size() << " bytes differ";
+  }
+}
+
+// Rows padded beyond their pixels (a V4L2 driver's bytesperline) are read
+// and written as such, and the padding is left alone.
+TEST(FrameExecutors, PaddedRowsPassThrough) {
+  const int w = 64, h = 32;
+  for (const Executor e : {Executor::cpu, Executor::gpu}) {
+    auto renderer = make_renderer(e, real_only(w, h));
+    if (!renderer)
+      continue;
+    VideoFormat f = format(PixelFormat::nv12, w, h);
+    f.stride = w + 32;
+    const std::vector<std::uint8_t> plate = noise_frame(f, 4);
+    const std::vector<std::uint8_t> out = render_through(*renderer, f, plate, f);
+    std::size_t differ = 0, padding_touched = 0;
+    for (std::size_t row = 0; row < std::size_t(h) * 3 / 2; ++row)
+      for (std::size_t x = 0; x < std::size_t(f.stride); ++x) {
+        const std::size_t i = row * std::size_t(f.stride) + x;
+        if (x < std::size_t(w))
+          differ += plate[i] != out[i];
+        else
+          padding_touched += out[i] != 0xAB;
+      }
+    EXPECT_EQ(differ, 0u) << (e == Executor::cpu ? "cpu" : "gpu");
+    EXPECT_EQ(padding_touched, 0u) << (e == Executor::cpu ? "cpu" : "gpu");
+  }
 }
 
 } // namespace

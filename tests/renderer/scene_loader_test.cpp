@@ -153,8 +153,8 @@ TEST(SceneLoader, ErrorNamesFileFieldAndReason) {
   } catch (const SceneError &e) {
     EXPECT_EQ(e.file(), "/virtual/scene.json");
     EXPECT_EQ(e.field(), "objects[2].radius");
-    EXPECT_EQ(e.reason(), "must be > 0");
-    EXPECT_STREQ(e.what(), "/virtual/scene.json: objects[2].radius: must be > 0");
+    EXPECT_EQ(e.reason(), "must be > 0 and <= 1e+06");
+    EXPECT_STREQ(e.what(), "/virtual/scene.json: objects[2].radius: must be > 0 and <= 1e+06");
   }
 }
 

@@ -136,13 +136,14 @@ TEST(LensExtremes, SceneFilesRejectFocusThatIsNoDistance) {
     const char *message;
   } cases[] = {
       {R"(, "f_number": 2, "focus_distance_m": 0)",
-       "lens.json: camera.focus_distance_m: must be > 0"},
+       "lens.json: camera.focus_distance_m: must be > 0 and <= 1e+06"},
       {R"(, "f_number": 2, "focus_distance_m": -1)",
-       "lens.json: camera.focus_distance_m: must be > 0"},
+       "lens.json: camera.focus_distance_m: must be > 0 and <= 1e+06"},
       {R"(, "f_number": 2, "focus_distance_m": 2e6)",
-       "lens.json: camera.focus_distance_m: must be <= 1e+06"},
+       "lens.json: camera.focus_distance_m: must be > 0 and <= 1e+06"},
       {R"(, "f_number": 2)", "lens.json: camera.focus_distance_m: missing"},
-      {R"(, "f_number": -1, "focus_distance_m": 1)", "lens.json: camera.f_number: must be >= 0"},
+      {R"(, "f_number": -1, "focus_distance_m": 1)",
+       "lens.json: camera.f_number: must be within 0 .. 1000"},
   };
   for (const auto &c : cases) {
     try {

@@ -1,168 +1,114 @@
 // The strict lens-trace reader. See lens_trace.h and README.md for the format.
-#include <algorithm>
-#include <array>
-#include <charconv>
+// Lines, header and numbers are base's strict CSV reader (config_csv.h); the
+// format line and the exact decimal seconds are the trace's own.
 #include <cmath>
-#include <fstream>
-#include <iterator>
+#include <cstdint>
 #include <limits>
 #include <optional>
 
+#include "camhead/base/config_csv.h"
 #include "camhead/hal/lens/trace/lens_trace.h"
 
 namespace camhead::hal::lens {
 namespace {
 
+using base::CsvReader;
+using base::CsvRow;
+using base::Range;
+
+// In the order of kNames, whose index columns() gives.
 enum class Column { t_s, focus, iris, zoom, focus_m, f_stop, focal_mm };
-constexpr std::array<std::string_view, 7> kNames = {"t_s",     "focus",  "iris",    "zoom",
-                                                    "focus_m", "f_stop", "focal_mm"};
+const std::vector<std::string_view> kNames = {"t_s",     "focus",  "iris",    "zoom",
+                                              "focus_m", "f_stop", "focal_mm"};
 
 constexpr std::string_view kVersionPrefix = "# camhead lens trace v";
 // Nine integer digits of seconds: 31 years of trace, far inside int64 ns.
 constexpr std::size_t kMaxSecondDigits = 9;
 
-std::string_view trim(std::string_view s) {
-  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
-  while (!s.empty() && space(s.front())) {
-    s.remove_prefix(1);
-  }
-  while (!s.empty() && space(s.back())) {
-    s.remove_suffix(1);
-  }
-  return s;
-}
-
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> cells;
-  for (std::size_t start = 0;;) {
-    const std::size_t comma = line.find(',', start);
-    cells.push_back(trim(line.substr(start, comma - start)));
-    if (comma == std::string_view::npos) {
-      return cells;
-    }
-    start = comma + 1;
-  }
-}
-
 bool all_digits(std::string_view s) {
-  return std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+  for (const char c : s) {
+    if (c < '0' || c > '9') {
+      return false;
+    }
+  }
+  return true;
 }
 
 class Reader {
 public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
+  Reader(const std::string &source, std::string_view text) : csv_(source, text) {}
 
-  LensTrace read(std::string_view text) {
-    LensTrace out{source_, {}};
-    std::size_t pos = 0;
-    while (pos < text.size()) {
-      const std::size_t nl = std::min(text.find('\n', pos), text.size());
-      const std::string_view line = trim(text.substr(pos, nl - pos));
-      pos = nl + 1;
-      ++line_;
-      if (line_ == 1) {
-        version(line);
-      } else if (line.empty() || line.front() == '#') {
-        continue;
-      } else if (columns_.empty()) {
-        header(split(line));
-      } else {
-        out.readings.push_back(row(split(line)));
-      }
+  LensTrace read() {
+    LensTrace out{csv_.file(), {}};
+    const std::optional<std::string_view> first = csv_.next_line();
+    if (!first) {
+      throw TraceError(csv_.file(), 0, "(file)",
+                       "empty (a trace starts with \"" + std::string(kTraceMagic) + "\")");
     }
-    if (line_ == 0) {
-      throw TraceError(source_, 0, "",
-                       "empty file (a trace starts with \"" + std::string(kTraceMagic) + "\")");
-    }
-    if (columns_.empty()) {
-      throw TraceError(source_, 0, "",
-                       "no header row (expected e.g. " + std::string(kTraceColumns) + ")");
+    version(*first);
+    csv_.read_header(kNames, kTraceColumns);
+    csv_.require_column("t_s", "every row needs a time");
+    while (const std::optional<CsvRow> cells = csv_.next_row()) {
+      out.readings.push_back(row(*cells));
     }
     return out;
   }
 
 private:
-  [[noreturn]] void fail(std::string_view field, const std::string &reason) const {
-    throw TraceError(source_, line_, std::string(field), reason);
-  }
-
   void version(std::string_view line) const {
     if (line == kTraceMagic) {
       return;
     }
     if (line.substr(0, kVersionPrefix.size()) == kVersionPrefix) {
-      fail("version", "version " + std::string(line.substr(kVersionPrefix.size() - 1)) +
-                          " is not supported (this reader reads v1)");
+      csv_.fail("version", "version " + std::string(line.substr(kVersionPrefix.size() - 1)) +
+                               " is not supported (this reader reads v1)");
     }
-    fail("format",
-         "not a camhead lens trace: the first line must be \"" + std::string(kTraceMagic) + "\"");
+    csv_.fail("format", "not a camhead lens trace: the first line must be \"" +
+                            std::string(kTraceMagic) + "\"");
   }
 
-  void header(const std::vector<std::string_view> &cells) {
-    for (const std::string_view name : cells) {
-      const auto it = std::find(kNames.begin(), kNames.end(), name);
-      if (name.empty()) {
-        fail("header", "empty column name");
-      }
-      if (it == kNames.end()) {
-        fail(name, "unknown column (known: " + std::string(kTraceColumns) + ")");
-      }
-      const auto column = static_cast<Column>(it - kNames.begin());
-      if (std::find(columns_.begin(), columns_.end(), column) != columns_.end()) {
-        fail(name, "appears twice in the header");
-      }
-      columns_.push_back(column);
-    }
-    if (std::find(columns_.begin(), columns_.end(), Column::t_s) == columns_.end()) {
-      fail("t_s", "missing from the header (every row needs a time)");
-    }
-  }
-
-  EncoderReading row(const std::vector<std::string_view> &cells) {
-    if (cells.size() != columns_.size()) {
-      fail("row", "expected " + std::to_string(columns_.size()) +
-                      " fields as in the header, found " + std::to_string(cells.size()));
-    }
+  EncoderReading row(const CsvRow &cells) {
     EncoderReading r;
     for (std::size_t i = 0; i < cells.size(); ++i) {
       const std::string_view v = cells[i];
-      const Column c = columns_[i];
+      const auto c = static_cast<Column>(csv_.columns()[i]);
       if (v.empty()) {
         if (c == Column::t_s) {
-          fail("t_s", "empty (every row needs a time)");
+          csv_.fail("t_s", "empty (every row needs a time)");
         }
         continue;
       }
+      const std::string_view name = kNames[csv_.columns()[i]];
       switch (c) {
       case Column::t_s:
         r.t_ns = seconds(v);
         break;
       case Column::focus:
-        r.focus = counts(v, c);
+        r.focus = counts(v, name);
         break;
       case Column::iris:
-        r.iris = counts(v, c);
+        r.iris = counts(v, name);
         break;
       case Column::zoom:
-        r.zoom = counts(v, c);
+        r.zoom = counts(v, name);
         break;
       case Column::focus_m:
-        r.focus_distance_m = positive(v, c, /*infinity_allowed=*/true);
+        r.focus_distance_m = csv_.number(v, name, Range::above(0.0), /*infinity_allowed=*/true);
         break;
       case Column::f_stop:
-        r.f_stop = positive(v, c, false);
+        r.f_stop = csv_.number(v, name, Range::above(0.0));
         break;
       case Column::focal_mm:
-        r.focal_length_mm = positive(v, c, false);
+        r.focal_length_mm = csv_.number(v, name, Range::above(0.0));
         break;
       }
     }
     if (previous_t_ && r.t_ns < *previous_t_) {
-      fail("t_s",
-           "time runs backwards: earlier than the row on line " + std::to_string(previous_line_));
+      csv_.fail("t_s", "time runs backwards: earlier than the row on line " +
+                           std::to_string(previous_line_));
     }
     previous_t_ = r.t_ns;
-    previous_line_ = line_;
+    previous_line_ = csv_.line();
     return r;
   }
 
@@ -170,7 +116,7 @@ private:
   // 99999999.99... ns and break the writer's round trip.
   std::int64_t seconds(std::string_view v) const {
     if (v.front() == '-') {
-      fail("t_s", "negative (trace time starts at 0)");
+      csv_.fail("t_s", "negative (trace time starts at 0)");
     }
     const std::size_t dot = v.find('.');
     const std::string_view whole = v.substr(0, dot);
@@ -178,10 +124,11 @@ private:
         dot == std::string_view::npos ? std::string_view{} : v.substr(dot + 1);
     if (whole.empty() || !all_digits(whole) || !all_digits(fraction) ||
         (dot != std::string_view::npos && fraction.empty())) {
-      fail("t_s", "\"" + std::string(v) + "\" is not a decimal number of seconds (e.g. 0.01)");
+      csv_.fail("t_s", "\"" + std::string(v) + "\" is not a decimal number of seconds (e.g. 0.01)");
     }
     if (whole.size() > kMaxSecondDigits) {
-      fail("t_s", "too large (at most " + std::to_string(kMaxSecondDigits) + " digits of seconds)");
+      csv_.fail("t_s",
+                "too large (at most " + std::to_string(kMaxSecondDigits) + " digits of seconds)");
     }
     std::int64_t ns = 0;
     for (const char c : whole) {
@@ -195,38 +142,12 @@ private:
     return ns * 1'000'000'000 + frac + (round_up ? 1 : 0);
   }
 
-  std::int32_t counts(std::string_view v, Column c) const {
-    std::int64_t n = 0;
-    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
-    if (ec != std::errc{} || end != v.data() + v.size()) {
-      fail(kNames[static_cast<std::size_t>(c)], "\"" + std::string(v) + "\" is not an integer");
-    }
-    if (n < std::numeric_limits<std::int32_t>::min() ||
-        n > std::numeric_limits<std::int32_t>::max()) {
-      fail(kNames[static_cast<std::size_t>(c)], "outside the 32-bit encoder range");
-    }
-    return static_cast<std::int32_t>(n);
+  std::int32_t counts(std::string_view v, std::string_view name) const {
+    return static_cast<std::int32_t>(csv_.integer(v, name, std::numeric_limits<std::int32_t>::min(),
+                                                  std::numeric_limits<std::int32_t>::max()));
   }
 
-  double positive(std::string_view v, Column c, bool infinity_allowed) const {
-    const std::string_view name = kNames[static_cast<std::size_t>(c)];
-    double x = 0.0;
-    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-    if (ec != std::errc{} || end != v.data() + v.size() || std::isnan(x)) {
-      fail(name, "\"" + std::string(v) + "\" is not a number");
-    }
-    if (std::isinf(x) && !(infinity_allowed && x > 0)) {
-      fail(name, infinity_allowed ? "must be > 0 (inf for infinity)" : "not a finite number");
-    }
-    if (!(x > 0.0)) {
-      fail(name, "must be > 0");
-    }
-    return x;
-  }
-
-  std::string source_;
-  int line_ = 0;
-  std::vector<Column> columns_;
+  CsvReader csv_;
   std::optional<std::int64_t> previous_t_;
   int previous_line_ = 0;
 };
@@ -234,17 +155,19 @@ private:
 } // namespace
 
 LensTrace parse_lens_trace(std::string_view text, const std::string &source) {
-  return Reader(source).read(text);
+  try {
+    return Reader(source, text).read();
+  } catch (const base::ConfigError &e) {
+    throw TraceError(e);
+  }
 }
 
 LensTrace read_lens_trace(const std::filesystem::path &path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in.is_open()) {
-    throw TraceError(path.string(), 0, "", "cannot open the file");
-  }
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) {
-    throw TraceError(path.string(), 0, "", "cannot read the file");
+  std::string text;
+  try {
+    text = base::read_config_file(path);
+  } catch (const base::ConfigError &e) {
+    throw TraceError(e);
   }
   return parse_lens_trace(text, path.string());
 }

@@ -1,4 +1,4 @@
-// The lens-trace writer and TraceError. See lens_trace.h for the format.
+// The lens-trace writer. See lens_trace.h for the format.
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -49,11 +49,6 @@ struct FileCloser {
 };
 
 } // namespace
-
-TraceError::TraceError(std::string file, int line, std::string field, std::string reason)
-    : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : "") + ": " +
-                         (field.empty() ? "" : field + ": ") + reason),
-      file_(std::move(file)), line_(line), field_(std::move(field)), reason_(std::move(reason)) {}
 
 std::string format_trace_header(std::string_view comment) {
   std::string out(kTraceMagic);

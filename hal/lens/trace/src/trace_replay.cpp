@@ -34,7 +34,8 @@ ReplayClock &monotonic_replay_clock() {
 
 TraceReplay::TraceReplay(LensTrace trace, TraceReplayOptions options)
     : trace_(std::move(trace)), loop_enabled_(options.loop), speed_(options.speed),
-      clock_(options.clock != nullptr ? options.clock : &monotonic_replay_clock()) {
+      clock_(options.clock != nullptr ? options.clock : &monotonic_replay_clock()),
+      start_option_(options.start_ns) {
   if (trace_.readings.empty()) {
     throw TraceError(trace_.source, 0, "", "no readings to replay");
   }
@@ -68,6 +69,24 @@ std::int64_t TraceReplay::due_ns(std::size_t index, std::uint64_t loop) const {
   return start_ns_ + (speed_ == 1.0 ? offset : std::llround(static_cast<double>(offset) / speed_));
 }
 
+void TraceReplay::join(std::int64_t from_ns) {
+  if (due_ns(0, 0) >= from_ns)
+    return;
+  if (loop_enabled_ && period_ns_ > 0) {
+    const double period = double(period_ns_) / speed_;
+    loop_ = std::uint64_t(std::max(0.0, std::floor(double(from_ns - start_ns_) / period)));
+  }
+  index_ = 0;
+  // A trace that is over by then delivers nothing.
+  while (!finished_ && due_ns(index_, loop_) < from_ns) {
+    if (++index_ == trace_.readings.size()) {
+      index_ = 0;
+      ++loop_;
+      finished_ = !loop_enabled_;
+    }
+  }
+}
+
 std::size_t TraceReplay::emit_due(std::int64_t now, std::vector<EncoderReading> &out) {
   std::size_t emitted = 0;
   while (!finished_ && emitted < kMaxBurst) {
@@ -93,7 +112,8 @@ void TraceReplay::poll(std::chrono::milliseconds timeout, std::vector<EncoderRea
   const std::int64_t now = clock_->now_ns();
   if (!started_) {
     started_ = true;
-    start_ns_ = now;
+    start_ns_ = start_option_.value_or(now);
+    join(now - kJoinHistoryNs);
   }
   if (emit_due(now, out) > 0) {
     return;

@@ -22,31 +22,25 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "camhead/base/config_error.h"
 #include "camhead/lens_control/lens_profile.h"
 
 namespace camhead::lens_control {
 
 // Measurements that cannot be turned into a profile. what() reads
-// "FILE:LINE: column COLUMN: REASON" for a problem on one CSV line (without
-// "column COLUMN: " when the whole line is wrong), and "FILE: AXIS: REASON"
-// for a problem of one axis as a whole (line() == 0), e.g. too few points.
-class CalibrationError : public std::runtime_error {
+// "FILE:LINE: COLUMN: REASON" for a problem on one CSV line ("header" or
+// "row" as the column when the whole line is wrong), and "FILE: AXIS: REASON"
+// for a problem of one axis as a whole (line() == 0), e.g. too few points
+// (base/config_error.h).
+class CalibrationError : public base::ConfigError {
 public:
-  CalibrationError(std::string file, int line, std::string column, std::string reason);
-  [[nodiscard]] const std::string &file() const { return file_; }
-  [[nodiscard]] int line() const { return line_; }
-  [[nodiscard]] const std::string &column() const { return column_; }
-  [[nodiscard]] const std::string &reason() const { return reason_; }
-
-private:
-  std::string file_;
-  int line_ = 0;
-  std::string column_, reason_;
+  using base::ConfigError::ConfigError;
+  explicit CalibrationError(const base::ConfigError &e) : base::ConfigError(e) {}
+  [[nodiscard]] const std::string &column() const { return field(); }
 };
 
 enum class CalibrationAxis { focus, iris, zoom };

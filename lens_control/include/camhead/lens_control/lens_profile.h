@@ -24,28 +24,23 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "camhead/base/config_error.h"
 #include "camhead/lens_control/lens_state.h"
 #include "camhead/lens_control/monotone_curve.h"
 
 namespace camhead::lens_control {
 
 // A profile file that cannot be used. what() reads "FILE: FIELD: REASON", where
-// FIELD is a JSON path such as focus[3].distance_m (empty for whole-file
-// problems such as unreadable files or JSON syntax errors).
-class ProfileError : public std::runtime_error {
+// FIELD is a JSON path such as focus[3].distance_m, or "(file)" / "(JSON)"
+// when the file cannot be read or parsed (base/config_error.h).
+class ProfileError : public base::ConfigError {
 public:
-  ProfileError(std::string file, std::string field, std::string reason);
-  [[nodiscard]] const std::string &file() const { return file_; }
-  [[nodiscard]] const std::string &field() const { return field_; }
-  [[nodiscard]] const std::string &reason() const { return reason_; }
-
-private:
-  std::string file_, field_, reason_;
+  using base::ConfigError::ConfigError;
+  explicit ProfileError(const base::ConfigError &e) : base::ConfigError(e) {}
 };
 
 class LensProfile {

@@ -81,4 +81,11 @@ public:
 [[nodiscard]] std::unique_ptr<FrameRenderer> make_cpu_frame_renderer(const Scene &scene,
                                                                      int threads = 0);
 
+// The GPU tracer (gpu_tracer.h) as a frame renderer on `device` (as
+// GpuTracer's constructor takes it), the conversions on the device too.
+// Throws GpuError, or std::invalid_argument for a render width that is not
+// a multiple of 4 or an odd height.
+[[nodiscard]] std::unique_ptr<FrameRenderer>
+make_gpu_frame_renderer(const Scene &scene, const std::string &device = {});
+
 } // namespace camhead::renderer

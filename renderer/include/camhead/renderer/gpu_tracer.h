@@ -8,6 +8,7 @@
 
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/render_result.h"
 
 namespace camhead::renderer {
@@ -58,7 +59,20 @@ public:
                                              const ProgressFn &progress = {},
                                              LayerSelection layers = LayerSelection::all());
 
+  // A live frame (frame_renderer.h): `plate` in its own pixel format is
+  // converted into the linear plate on the device, and the composite into
+  // each of `outputs` (at most VIDEO_MAX_OUTPUTS, layout.h); nothing else is
+  // read back. Sizes as the loaded scene, width a multiple of 4 (the kernels
+  // work on 4 x 2 blocks); the caller checks. A plate without bytes is none.
+  [[nodiscard]] RenderResult render_video(const gpu::FrameParams &frame, const VideoFrame &plate,
+                                          std::span<const VideoBuffer> outputs,
+                                          const AdaptiveSampling *adaptive = nullptr);
+
 private:
+  struct VideoJob {
+    VideoFrame plate;
+    std::span<const VideoBuffer> outputs;
+  };
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -2,25 +2,20 @@
 #pragma once
 
 #include <filesystem>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "camhead/base/config_error.h"
 #include "camhead/renderer/scene.h"
 
 namespace camhead::renderer {
 
 // A scene file that cannot be used. what() reads "FILE: FIELD: REASON", where
-// FIELD is a JSON path such as objects[2].radius.
-class SceneError : public std::runtime_error {
+// FIELD is a JSON path such as objects[2].radius (base/config_error.h).
+class SceneError : public base::ConfigError {
 public:
-  SceneError(std::string file, std::string field, std::string reason);
-  [[nodiscard]] const std::string &file() const { return file_; }
-  [[nodiscard]] const std::string &field() const { return field_; }
-  [[nodiscard]] const std::string &reason() const { return reason_; }
-
-private:
-  std::string file_, field_, reason_;
+  using base::ConfigError::ConfigError;
+  explicit SceneError(const base::ConfigError &e) : base::ConfigError(e) {}
 };
 
 // Loads a scene with its meshes and plate. Throws SceneError on any problem

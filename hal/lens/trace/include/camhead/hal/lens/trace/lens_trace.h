@@ -24,11 +24,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "camhead/base/config_error.h"
 #include "camhead/hal/lens/lens_encoder.h"
 
 namespace camhead::hal::lens {
@@ -36,21 +36,14 @@ namespace camhead::hal::lens {
 inline constexpr std::string_view kTraceMagic = "# camhead lens trace v1";
 inline constexpr std::string_view kTraceColumns = "t_s,focus,iris,zoom,focus_m,f_stop,focal_mm";
 
-// A trace file that cannot be used. what() reads "FILE:LINE: FIELD: REASON";
-// "FILE:LINE: REASON" without a field, "FILE: REASON" for a problem of the
-// whole file (line() == 0), such as an unreadable file.
-class TraceError : public std::runtime_error {
+// A trace file that cannot be used. what() reads "FILE:LINE: FIELD: REASON"
+// for a line of it, "FILE: FIELD: REASON" for the file as a whole
+// (line() == 0; FIELD "(file)" when it cannot be read), and "FILE: REASON"
+// for a trace that cannot be replayed or written (base/config_error.h).
+class TraceError : public base::ConfigError {
 public:
-  TraceError(std::string file, int line, std::string field, std::string reason);
-  [[nodiscard]] const std::string &file() const { return file_; }
-  [[nodiscard]] int line() const { return line_; }
-  [[nodiscard]] const std::string &field() const { return field_; }
-  [[nodiscard]] const std::string &reason() const { return reason_; }
-
-private:
-  std::string file_;
-  int line_ = 0;
-  std::string field_, reason_;
+  using base::ConfigError::ConfigError;
+  explicit TraceError(const base::ConfigError &e) : base::ConfigError(e) {}
 };
 
 struct LensTrace {

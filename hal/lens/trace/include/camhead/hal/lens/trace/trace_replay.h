@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,13 @@ struct TraceReplayOptions {
   bool loop = false;
   double speed = 1.0;           // > 0 and finite: 2 plays twice as fast
   ReplayClock *clock = nullptr; // not owned, must outlive the replay; null = monotonic
+  // The instant on the replay clock at which the first reading is due; empty:
+  // the first poll. A start in the past joins the replay where it would be by
+  // now: the first poll delivers the readings due in the last kJoinHistoryNs
+  // (history for a lens state a frame ago), not the ones before. With 0 on
+  // the monotonic clock, every replay of a trace on the machine plays the
+  // same lens at the same instant (the simulated camera films it so).
+  std::optional<std::int64_t> start_ns;
 };
 
 class TraceReplay final : public LensEncoder {
@@ -71,10 +79,13 @@ public:
   [[nodiscard]] std::int64_t period_ns() const { return period_ns_; }
 
   static constexpr std::size_t kMaxBurst = 4096;
+  static constexpr std::int64_t kJoinHistoryNs = 250'000'000;
 
 private:
   [[nodiscard]] std::int64_t due_ns(std::size_t index, std::uint64_t loop) const;
   std::size_t emit_due(std::int64_t now, std::vector<EncoderReading> &out);
+  // Skips the readings due before from_ns (a start in the past).
+  void join(std::int64_t from_ns);
 
   LensTrace trace_;
   bool loop_enabled_ = false;
@@ -84,6 +95,7 @@ private:
 
   bool started_ = false, finished_ = false;
   std::int64_t start_ns_ = 0;
+  std::optional<std::int64_t> start_option_;
   std::size_t index_ = 0; // next reading to deliver
   std::uint64_t loop_ = 0;
   std::uint64_t delivered_ = 0;

@@ -1,0 +1,76 @@
+// A V4L2 device node as the camera and the loopback sink hold it: the file
+// descriptor with its owner (closed once), ioctls retried when a signal
+// interrupts them, and what the driver says it is. Errors are values, the
+// reason alone ("cannot open: No such file or directory"); the caller adds
+// the device's name, since the backends must not throw once open.
+//
+// Thread safety: a DeviceFile is one thread's, or guarded by its owner;
+// ioctl() may be called from several threads at once (the kernel serialises
+// them), close() only while no other thread uses the descriptor.
+#pragma once
+
+#include <cerrno>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <sys/ioctl.h>
+
+namespace camhead::hal::v4l2 {
+
+// strerror(err), thread-safe.
+[[nodiscard]] std::string errno_text(int err);
+
+class DeviceFile {
+public:
+  DeviceFile() = default;
+  explicit DeviceFile(int fd) : fd_(fd) {}
+  ~DeviceFile() { close(); }
+  DeviceFile(DeviceFile &&other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
+  DeviceFile &operator=(DeviceFile &&other) noexcept;
+  DeviceFile(const DeviceFile &) = delete;
+  DeviceFile &operator=(const DeviceFile &) = delete;
+
+  [[nodiscard]] int fd() const { return fd_; }
+  [[nodiscard]] bool is_open() const { return fd_ >= 0; }
+  void close();
+
+  // ioctl(fd, request, &arg), again while EINTR; false with errno set.
+  template <class Arg> [[nodiscard]] bool ioctl(unsigned long request, Arg &arg) const {
+    int result = 0;
+    do {
+      result = ::ioctl(fd_, request, &arg);
+    } while (result < 0 && errno == EINTR);
+    return result == 0;
+  }
+
+private:
+  int fd_ = -1;
+};
+
+// Opens `path` (a /dev node or a udev link to one, followed) read-write,
+// non-blocking, close-on-exec. Refuses what is not a character device, so a
+// regular file named by mistake is not truncated or written to.
+[[nodiscard]] DeviceFile open_device(const std::string &path, std::string &error);
+
+// VIDIOC_QUERYCAP. `caps` are the capabilities of this node (device_caps
+// where the driver gives them, not those of the whole device).
+struct DeviceInfo {
+  std::string driver; // "vivid", "uvcvideo", "v4l2 loopback"
+  std::string card;
+  std::string bus;
+  std::uint32_t caps = 0;
+};
+// Empty with `error` when the node does not answer QUERYCAP: "not a V4L2
+// device (VIDIOC_QUERYCAP: Inappropriate ioctl for device)".
+[[nodiscard]] std::optional<DeviceInfo> query_device(const DeviceFile &file, std::string &error);
+
+// "video capture, streaming" for messages: the capability bits camhead
+// cares about, in words.
+[[nodiscard]] std::string caps_text(std::uint32_t caps);
+
+// True for the errors that mean the device itself is gone (unplugged, its
+// driver unbound or unloaded), not that one request failed.
+[[nodiscard]] bool is_device_gone(int err);
+
+} // namespace camhead::hal::v4l2

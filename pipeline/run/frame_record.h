@@ -1,0 +1,35 @@
+// The per-frame record of `camhead run --record-stats`: one JSON object a
+// line for every frame sent to the outputs (README.md, "The live pipeline").
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+namespace camhead::pipeline {
+
+// What the record says of one composite.
+struct FrameRecord {
+  std::uint64_t sequence = 0;
+  std::int64_t capture_ns = 0;
+  std::int64_t exposure_mid_ns = 0;
+  std::int64_t delivered_ns = 0; // when the camera handed the frame over
+  std::int64_t render_start_ns = 0;
+  std::int64_t render_end_ns = 0;
+  double focus_m = 0.0, f_number = 0.0, focal_length_mm = 0.0;
+  bool lens_fresh = false;
+  std::uint32_t rpp = 0;
+  std::uint64_t camera_rays = 0;
+  std::uint64_t dropped_before = 0; // camera, render-busy and output-busy drops since the last
+  double decode_s = 0.0, trace_s = 0.0, encode_s = 0.0;
+};
+
+// One line per frame sent, in the outputs' order: `output_frame` is its index
+// in every output (a Y4M file's frame number). A composite's line has every
+// field; a repeat or a placeholder only its kind and time.
+void write_composite_record(std::FILE *out, std::uint64_t output_frame, const FrameRecord &r,
+                            std::int64_t output_ns, const std::string &executor);
+void write_filler_record(std::FILE *out, std::uint64_t output_frame, const char *kind,
+                         std::int64_t output_ns);
+
+} // namespace camhead::pipeline

@@ -1,0 +1,139 @@
+#include "rig_setup.h"
+
+#include <stdexcept>
+#include <string>
+#include <variant>
+
+#include "camhead/hal/camera/file/file_camera.h"
+#include "camhead/hal/camera/sim/simulated_camera.h"
+#include "camhead/hal/camera/v4l2/v4l2_camera.h"
+#include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/scene_loader.h"
+#include "lens_camera.h"
+#include "trace_lens.h"
+
+namespace camhead::pipeline {
+
+using hal::camera::CameraSource;
+
+namespace {
+
+renderer::Scene real_world_of(renderer::Scene scene) {
+  std::erase_if(scene.objects, [](const renderer::Object &o) { return !o.real; });
+  return scene;
+}
+
+// The simulated camera's picture: the scene's real objects through the lens
+// at each exposure's middle, rendered by its own frame renderer, with a new
+// noise pattern every frame as a sensor has. The lens is the physical truth
+// where the board's trace gives it (trace_lens.h), else what the lens chain
+// says.
+std::unique_ptr<CameraSource> open_sim_camera(const SimCameraConfig &sim,
+                                              const base::VideoFormat &format,
+                                              const renderer::Scene &scene,
+                                              const renderer::FrameCamera &pose,
+                                              const LensHub &lens, std::optional<TraceLens> truth,
+                                              Executor executor, int threads) {
+  auto world = std::shared_ptr<renderer::FrameRenderer>(
+      make_renderer(executor, real_world_of(scene), threads));
+  hal::camera::SimulatedCameraOptions options;
+  options.format = format;
+  options.fps = sim.fps;
+  options.disconnect_after_frames = sim.disconnect_after_frames;
+  options.disconnect_s = sim.disconnect_s;
+  const std::uint32_t samples = sim.samples;
+  auto generator = [world, format, pose, samples, &lens,
+                    truth = std::move(truth)](std::int64_t start_ns, std::int64_t exposure_ns,
+                                              std::span<std::uint8_t> out) {
+    const std::int64_t mid = start_ns + exposure_ns / 2;
+    renderer::FrameRequest request;
+    request.camera = lens_camera(pose, truth ? truth->state_at(mid) : lens.state_at(mid).state);
+    request.rays_per_pixel = samples;
+    request.seed = std::uint32_t(start_ns / 1000) | 1u;
+    const renderer::VideoBuffer target{format, out};
+    (void)world->render(request, {format, {}}, std::span(&target, 1));
+  };
+  return hal::camera::open_simulated_camera(options, std::move(generator));
+}
+
+} // namespace
+
+renderer::Scene load_run_scene(const Board &board) {
+  renderer::Scene scene = renderer::load_scene(*board.scene);
+  // The camera decides the frame; the scene's plate is for stills.
+  scene.render.width = board.camera->width;
+  scene.render.height = board.camera->height;
+  scene.plate.reset();
+  return scene;
+}
+
+renderer::FrameCamera base_camera(const Board &board, const renderer::Scene &scene) {
+  renderer::FrameCamera camera = renderer::scene_camera(scene);
+  if (board.pose) {
+    const auto v = [](const std::array<double, 3> &a) {
+      return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
+    };
+    camera.position = v(board.pose->position);
+    camera.look_at = v(board.pose->look_at);
+    camera.up = v(board.pose->up);
+  }
+  camera.sensor_width_mm = float(board.camera->sensor_width_mm);
+  return camera;
+}
+
+Executor choose_executor(Executor wanted) {
+  if (wanted != Executor::automatic)
+    return wanted;
+  try {
+    for (const renderer::GpuDeviceInfo &device : renderer::list_gpu_devices())
+      if (device.type == "discrete" || device.type == "integrated")
+        return Executor::gpu;
+  } catch (const std::exception &) {
+    // No Vulkan at all: the CPU it is.
+  }
+  return Executor::cpu;
+}
+
+std::unique_ptr<renderer::FrameRenderer> make_renderer(Executor executor,
+                                                       const renderer::Scene &scene, int threads) {
+  if (executor == Executor::gpu)
+    return renderer::make_gpu_frame_renderer(scene);
+  return renderer::make_cpu_frame_renderer(scene, threads);
+}
+
+std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Scene &scene,
+                                          const renderer::FrameCamera &pose, const LensHub &lens,
+                                          Executor executor, int threads) {
+  const CameraConfig &c = *board.camera;
+  base::VideoFormat format;
+  format.pixel = c.format;
+  format.width = c.width;
+  format.height = c.height;
+  if (const auto *sim = std::get_if<SimCameraConfig>(&c.kind))
+    return open_sim_camera(*sim, format, scene, pose, lens, TraceLens::of_board(board), executor,
+                           threads);
+  if (const auto *v4l2 = std::get_if<V4l2CameraConfig>(&c.kind))
+    return hal::camera::open_v4l2_camera({.device = v4l2->device,
+                                          .format = c.format,
+                                          .width = c.width,
+                                          .height = c.height,
+                                          .fps = v4l2->fps,
+                                          .buffers = v4l2->buffers});
+  const auto &file = std::get<FileCameraConfig>(c.kind);
+  auto camera = hal::camera::open_file_camera(
+      {.path = file.path, .loop = file.loop, .realtime = file.realtime, .fps = 0.0});
+  const base::VideoFormat got = camera->format();
+  if (got.width != c.width || got.height != c.height)
+    throw std::runtime_error(board.file.string() + ": camera: " + file.path.string() + " is " +
+                             std::to_string(got.width) + "x" + std::to_string(got.height) +
+                             ", the board says " + std::to_string(c.width) + "x" +
+                             std::to_string(c.height));
+  return camera;
+}
+
+double camera_fps(const CameraSource &camera) {
+  const std::int64_t interval = camera.frame_interval_ns();
+  return interval > 0 ? 1e9 / double(interval) : 25.0;
+}
+
+} // namespace camhead::pipeline

@@ -1,0 +1,43 @@
+// What `camhead run` opens before the first frame, from a board: the scene at
+// the camera's size, the pose, the executor, the frame renderer and the
+// camera (the simulated one filming the scene's real objects). Everything
+// here throws, naming the board field, file or device at fault; nothing
+// after it does.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "board.h"
+#include "camhead/hal/camera/camera_source.h"
+#include "camhead/renderer/frame_camera.h"
+#include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/scene.h"
+#include "lens_hub.h"
+
+namespace camhead::pipeline {
+
+// The board's scene, rendered at the camera's size, without its plate.
+[[nodiscard]] renderer::Scene load_run_scene(const Board &board);
+
+// The scene's camera moved to the board's pose, on the camera's sensor.
+[[nodiscard]] renderer::FrameCamera base_camera(const Board &board, const renderer::Scene &scene);
+
+// `automatic` resolved: a hardware GPU where there is one; without one the
+// CPU reference, 2-5x faster than lavapipe on the same cores
+// (bench/RESULTS.md).
+[[nodiscard]] Executor choose_executor(Executor wanted);
+
+[[nodiscard]] std::unique_ptr<renderer::FrameRenderer>
+make_renderer(Executor executor, const renderer::Scene &scene, int threads);
+
+// The board's camera. The simulated one renders the scene's real objects on
+// `executor` through the lens at each exposure (trace_lens.h, or `lens`).
+[[nodiscard]] std::unique_ptr<hal::camera::CameraSource>
+open_camera(const Board &board, const renderer::Scene &scene, const renderer::FrameCamera &pose,
+            const LensHub &lens, Executor executor, int threads);
+
+// The camera's rate, 25 where it does not say.
+[[nodiscard]] double camera_fps(const hal::camera::CameraSource &camera);
+
+} // namespace camhead::pipeline

@@ -1,0 +1,49 @@
+// The lens a trace plays, at any instant: the physical truth of the
+// simulated rig. The simulated camera films the real world through this
+// lens, while the virtual objects get what the lens chain (encoder, filter,
+// time alignment) makes of the same trace, as on a real rig; a chain that
+// lags shows as a mismatch between real and virtual blur.
+//
+// Only for a trace replayed with its time 0 at CLOCK_MONOTONIC 0 (board
+// "clock_origin": "monotonic"): then the replay's reading i of loop k is due
+// at (t_i - t_0 + k period) / speed, and this reads the same instant.
+//
+// Thread safety: immutable; any thread.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "board.h"
+#include "camhead/hal/lens/trace/lens_trace.h"
+#include "camhead/lens_control/lens_profile.h"
+#include "camhead/lens_control/lens_state.h"
+
+namespace camhead::pipeline {
+
+class TraceLens {
+public:
+  // The board's first lens source, when it is such a trace; else empty.
+  // Throws as the trace and profile readers do.
+  [[nodiscard]] static std::optional<TraceLens> of_board(const Board &board);
+
+  // The lens at CLOCK_MONOTONIC instant t_ns: each axis's counts linear
+  // between the readings around it (across a loop's wrap too), through the
+  // profile.
+  [[nodiscard]] lens_control::LensState state_at(std::int64_t t_ns) const;
+
+private:
+  TraceLens(hal::lens::LensTrace trace, lens_control::LensProfile profile,
+            const TraceSourceConfig &config);
+  [[nodiscard]] std::optional<double>
+  counts_at(std::optional<std::int32_t> hal::lens::EncoderReading::*axis,
+            std::int64_t trace_ns) const;
+
+  hal::lens::LensTrace trace_;
+  lens_control::LensProfile profile_;
+  double speed_;
+  bool loop_;
+  std::int64_t period_ns_ = 0; // as TraceReplay: the span plus one mean interval
+};
+
+} // namespace camhead::pipeline

@@ -1,0 +1,48 @@
+// What both frame renderers refuse (frame_renderer.h), worded alike.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "camhead/base/video_format.h"
+#include "camhead/renderer/frame_renderer.h"
+
+namespace camhead::renderer {
+
+// Why a frame of `format` (`bytes` long) cannot be a plate or an output of a
+// width x height render, or empty.
+[[nodiscard]] inline std::string check_frame(const base::VideoFormat &format, std::size_t bytes,
+                                             int width, int height) {
+  if (std::string reason = base::check_video_format(format); !reason.empty())
+    return reason;
+  if (format.width != width || format.height != height)
+    return base::describe(format) + " is not the render size " + std::to_string(width) + "x" +
+           std::to_string(height);
+  if (bytes < base::frame_bytes(format))
+    return base::describe(format) + " needs " + std::to_string(base::frame_bytes(format)) +
+           " bytes, not " + std::to_string(bytes);
+  return {};
+}
+
+// The first problem with a frame's plate and outputs, or empty.
+[[nodiscard]] inline std::string
+check_frames(const VideoFrame &plate, std::span<const VideoBuffer> outputs, int width, int height) {
+  if (!plate.bytes.empty())
+    if (std::string reason = check_frame(plate.format, plate.bytes.size(), width, height);
+        !reason.empty())
+      return "camera frame: " + reason;
+  for (const VideoBuffer &out : outputs)
+    if (std::string reason = check_frame(out.format, out.bytes.size(), width, height);
+        !reason.empty())
+      return "output: " + reason;
+  return {};
+}
+
+[[nodiscard]] inline FrameReport bad_frame(std::string detail) {
+  FrameReport report;
+  report.status = FrameStatus::bad_input;
+  report.detail = std::move(detail);
+  return report;
+}
+
+} // namespace camhead::renderer

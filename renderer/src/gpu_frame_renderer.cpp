@@ -1,0 +1,94 @@
+// The GPU tracer as a live frame renderer (frame_renderer.h): the camera
+// frame's conversion, the trace and the outputs' conversion all on the
+// device, one submission for a steady frame (GpuTracer::render_video).
+#include <stdexcept>
+#include <string>
+
+#include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/gpu_tracer.h"
+#include "frame_checks.h"
+#include "vulkan_context.h"
+
+namespace camhead::renderer {
+namespace {
+
+class GpuFrameRenderer final : public FrameRenderer {
+public:
+  GpuFrameRenderer(const Scene &scene, const std::string &device)
+      : scene_(without_plate(scene)), tracer_(device) {
+    const int w = scene_.render.width;
+    const int h = scene_.render.height;
+    if (w <= 0 || h <= 0 || w % 4 != 0 || h % 2 != 0)
+      throw std::invalid_argument(scene.source.string() + ": render: size " + std::to_string(w) +
+                                  "x" + std::to_string(h) +
+                                  " is not one the GPU video kernels take (width a multiple of "
+                                  "4, even height)");
+    tracer_.load(compile_scene(scene_));
+  }
+
+  std::string executor() const override { return "gpu " + tracer_.device_name(); }
+
+  FrameReport render(const FrameRequest &request, const VideoFrame &plate,
+                     std::span<const VideoBuffer> outputs) override {
+    if (lost_)
+      return lost("the GPU was lost earlier");
+    if (std::string reason =
+            check_frames(plate, outputs, scene_.render.width, scene_.render.height);
+        !reason.empty())
+      return bad_frame(std::move(reason));
+    if (outputs.size() > VIDEO_MAX_OUTPUTS)
+      return bad_frame(std::to_string(outputs.size()) + " outputs; the GPU executor takes " +
+                       std::to_string(VIDEO_MAX_OUTPUTS));
+    if (request.rays_per_pixel == 0)
+      return bad_frame("0 rays per pixel");
+    gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
+    if (request.seed != 0)
+      frame.sampling.w = request.seed;
+    FrameReport report;
+    try {
+      const RenderResult result = tracer_.render_video(
+          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr);
+      report.camera_rays = result.camera_rays;
+      // The conversions run on the device inside the frame's one
+      // submission: their time is part of the trace time here.
+      report.trace_s = result.timings.device_s > 0.0 ? result.timings.device_s : result.seconds;
+      report.encode_s = result.timings.unpack_s; // the outputs' copy out of mapped memory
+    } catch (const vk::VulkanError &e) {
+      if (e.result() == VK_ERROR_DEVICE_LOST) {
+        lost_ = true;
+        return lost(e.what());
+      }
+      return bad_frame(e.what());
+    } catch (const std::exception &e) {
+      return bad_frame(e.what());
+    }
+    return report;
+  }
+
+private:
+  static Scene without_plate(Scene scene) {
+    scene.plate.reset();
+    return scene;
+  }
+
+  static FrameReport lost(std::string detail) {
+    FrameReport report;
+    report.status = FrameStatus::device_lost;
+    report.detail = std::move(detail);
+    return report;
+  }
+
+  Scene scene_;
+  GpuTracer tracer_;
+  bool lost_ = false;
+};
+
+} // namespace
+
+std::unique_ptr<FrameRenderer> make_gpu_frame_renderer(const Scene &scene,
+                                                       const std::string &device) {
+  return std::make_unique<GpuFrameRenderer>(scene, device);
+}
+
+} // namespace camhead::renderer

@@ -1,0 +1,68 @@
+// Driver sequence numbers to camhead frame numbers and drops
+// (hal/camera/v4l2/src/sequence_tracker.h).
+#include "sequence_tracker.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::hal::camera {
+namespace {
+
+TEST(SequenceTracker, ConsecutiveNumbersDropNothing) {
+  SequenceTracker tracker;
+  for (std::uint32_t s = 100; s < 110; ++s) {
+    const auto step = tracker.next(s);
+    EXPECT_EQ(step.sequence, s - 100u);
+    EXPECT_EQ(step.dropped, 0u);
+  }
+}
+
+TEST(SequenceTracker, GapsAreDroppedFramesAndKeptInTheNumbers) {
+  SequenceTracker tracker;
+  EXPECT_EQ(tracker.next(7).sequence, 0u);
+  const auto step = tracker.next(10); // 8 and 9 were made and never dequeued
+  EXPECT_EQ(step.dropped, 2u);
+  EXPECT_EQ(step.sequence, 3u);
+  EXPECT_EQ(tracker.next(11).sequence, 4u);
+}
+
+TEST(SequenceTracker, ACounterThatNeverMovesIsNotADrop) {
+  // v4l2loopback's mmap writers leave every number 0.
+  SequenceTracker tracker;
+  for (std::uint64_t i = 0; i < 5; ++i) {
+    const auto step = tracker.next(0);
+    EXPECT_EQ(step.sequence, i);
+    EXPECT_EQ(step.dropped, 0u);
+  }
+}
+
+TEST(SequenceTracker, WrappingAt32BitsIsOneStep) {
+  SequenceTracker tracker;
+  (void)tracker.next(0xffff'fffeu);
+  EXPECT_EQ(tracker.next(0xffff'ffffu).dropped, 0u);
+  const auto step = tracker.next(0);
+  EXPECT_EQ(step.dropped, 0u);
+  EXPECT_EQ(step.sequence, 2u);
+  EXPECT_EQ(tracker.next(2).dropped, 1u);
+}
+
+TEST(SequenceTracker, GoingBackIsARestartNotFourBillionDrops) {
+  SequenceTracker tracker;
+  (void)tracker.next(500);
+  const auto step = tracker.next(3);
+  EXPECT_EQ(step.dropped, 0u);
+  EXPECT_EQ(step.sequence, 1u);
+}
+
+TEST(SequenceTracker, AReopenedStreamCountsOnWithoutAGap) {
+  SequenceTracker tracker;
+  (void)tracker.next(40);
+  (void)tracker.next(41);
+  tracker.restart();
+  const auto first = tracker.next(5); // the new stream's first frame
+  EXPECT_EQ(first.sequence, 2u);
+  EXPECT_EQ(first.dropped, 0u);
+  EXPECT_EQ(tracker.next(7).dropped, 1u);
+}
+
+} // namespace
+} // namespace camhead::hal::camera
