@@ -28,6 +28,13 @@ packages=(
   # driver's source, which the lab builds against the same headers as
   # gpio-sim (build_v4l2loopback.sh). Installing it also runs DKMS once.
   v4l2loopback-dkms
+  # hal/camera/libcamera: the headers and library its module links
+  # (camhead itself opens the module at run time), and the vimc IPA module
+  # the lab's libcamera check packs (tests/vm/libcamera_vimc.sh).
+  libcamera-dev libcamera-ipa
+  # hal/output/drm: the kernel's DRM uapi headers (drm.h, drm_mode.h), which
+  # Debian ships in libdrm-dev only; nothing links libdrm.
+  libdrm-dev
 )
 
 if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then

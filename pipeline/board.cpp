@@ -100,7 +100,7 @@ private:
   }
 
   static CameraConfig read_camera(const JsonValue &d) {
-    const JsonValue type_value = d.at("type", "sim or file");
+    const JsonValue type_value = d.at("type", "sim, file, v4l2 or libcamera");
     const std::string type = type_value.string();
     CameraConfig camera;
     const auto with_common = [](Keys own) {
@@ -131,8 +131,25 @@ private:
       if (d.has("realtime"))
         file.realtime = d.at("realtime").boolean();
       camera.kind = file;
+    } else if (type == "v4l2") {
+      d.object({"type", "device"}, with_common({"fps", "buffers"}));
+      V4l2CameraConfig v4l2;
+      v4l2.device = d.at("device").string();
+      if (d.has("fps"))
+        v4l2.fps = d.at("fps").number(Range::within(0.0, 1000.0));
+      if (d.has("buffers"))
+        v4l2.buffers = int(d.at("buffers").integer(2, 8));
+      camera.kind = v4l2;
+    } else if (type == "libcamera") {
+      d.object({"type"}, with_common({"camera_id", "buffers"}));
+      LibcameraCameraConfig libcamera;
+      if (d.has("camera_id"))
+        libcamera.camera_id = d.at("camera_id").string();
+      if (d.has("buffers"))
+        libcamera.buffers = int(d.at("buffers").integer(2, 8));
+      camera.kind = libcamera;
     } else {
-      type_value.fail("unknown camera \"" + type + "\" (sim or file)");
+      type_value.fail("unknown camera \"" + type + "\" (sim, file, v4l2 or libcamera)");
     }
     if (const auto format = d.find("format")) {
       const std::string name = format->string();

@@ -135,7 +135,15 @@ struct V4l2CameraConfig {
   int buffers = 4;
 };
 
-using CameraKind = std::variant<SimCameraConfig, FileCameraConfig, V4l2CameraConfig>;
+// A camera through libcamera (hal/camera/libcamera): CSI sensors behind an
+// ISP (Raspberry Pi, Rockchip), or any camera libcamera supports.
+struct LibcameraCameraConfig {
+  std::string camera_id; // libcamera's id; empty: the first camera
+  int buffers = 4;
+};
+
+using CameraKind =
+    std::variant<SimCameraConfig, FileCameraConfig, V4l2CameraConfig, LibcameraCameraConfig>;
 
 struct CameraConfig {
   CameraKind kind;

@@ -5,6 +5,7 @@
 #include <exception>
 #include <string>
 
+#include "camhead/hal/camera/libcamera/libcamera_camera.h"
 #include "camhead/hal/discovery/devices.h"
 #include "camhead/hal/lens/usb/usb_lens_protocol.h"
 #include "camhead/renderer/gpu_tracer.h"
@@ -39,6 +40,16 @@ void list_video(const std::vector<discovery::VideoNode> &nodes) {
     const std::string name = n.links.empty() ? n.path : n.links.front();
     std::printf("  %s  (%s, %s: %s)  formats %s\n", name.c_str(), n.path.c_str(), n.driver.c_str(),
                 n.card.c_str(), joined(n.formats).c_str());
+  }
+  try {
+    for (const std::string &camera : hal::camera::list_libcamera_cameras()) {
+      ++cameras;
+      std::printf("  libcamera %s  (board \"camera\": {\"type\": \"libcamera\", \"camera_id\": "
+                  "...})\n",
+                  camera.c_str());
+    }
+  } catch (const std::exception &e) {
+    std::printf("  libcamera cameras not listed: %s\n", e.what());
   }
   if (cameras == 0)
     std::printf("  none found (the simulated camera is always there: --board sim)\n");

@@ -220,13 +220,23 @@ LensChannel::LensChannel(LensSourceConfig config, std::unique_ptr<hal::lens::Len
       tracker_(profile, tracker_config(config_)) {}
 
 std::size_t LensChannel::pump(std::chrono::milliseconds timeout) {
+  const std::size_t n = poll(timeout);
+  feed();
+  return n;
+}
+
+std::size_t LensChannel::poll(std::chrono::milliseconds timeout) {
   batch_.clear();
   encoder_->poll(timeout, batch_);
+  return batch_.size();
+}
+
+void LensChannel::feed() {
   for (const hal::lens::EncoderReading &r : batch_)
     tracker_.push(to_encoder_sample(r));
   if (!batch_.empty())
     last_ = batch_.back();
-  return batch_.size();
+  batch_.clear();
 }
 
 std::vector<LensChannel> open_lens_channels(const Board &board) {

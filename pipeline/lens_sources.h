@@ -45,6 +45,11 @@ public:
   // Polls the source once (at most `timeout`) and feeds every reading to the
   // tracker. Returns how many readings arrived.
   std::size_t pump(std::chrono::milliseconds timeout);
+  // pump() in two halves, for a thread that shares the tracker with others:
+  // poll() waits on the source and touches only this channel's own batch,
+  // so it can run outside a lock; feed() hands the batch to the tracker.
+  std::size_t poll(std::chrono::milliseconds timeout);
+  void feed();
 
   [[nodiscard]] const LensSourceConfig &config() const { return config_; }
   [[nodiscard]] const hal::lens::LensEncoder &encoder() const { return *encoder_; }

@@ -101,10 +101,13 @@ void add_run_command(CLI::App &app) {
              "Outputs:\n"
              "  file:PATH.y4m[?format=yuyv|nv12]  Y4M video (ffplay PATH.y4m, mpv PATH.y4m)\n"
              "  file:DIR/%05d.png                 one PNG a frame\n"
+             "  v4l2:/dev/videoN[?format=nv12]    the virtual webcam (v4l2loopback; YUYV default)\n"
+             "  drm:CARD[:CONNECTOR][?mode=WxH@Hz] HDMI through DRM/KMS (no compositor running)\n"
              "  null                              nothing (to measure the pipeline)\n"
-             "  v4l2:/dev/videoN, drm:CARD        the webcam and HDMI outputs (not built yet)\n"
+             "`camhead devices` lists the cameras and outputs this machine has.\n"
              "Examples:\n"
              "  camhead run --duration 5 --output file:sim.y4m\n"
+             "  camhead run --output v4l2:/dev/video10 --output drm:card0:HDMI-A-1\n"
              "  camhead run --board my-rig.json --frames 250 --record-stats stats.jsonl");
   cmd->add_option("--board", args->board,
                   "Board name in board/ (sim, ...) or a board file; its camera, scene,\n"

@@ -4,7 +4,8 @@
 
 namespace camhead::pipeline {
 
-LensHub::LensHub(const Board &board) : channels_(open_lens_channels(board)) {
+LensHub::LensHub(const Board &board)
+    : channels_(open_lens_channels(board)), connected_(channels_.size(), false) {
   thread_ = std::thread([this] { poll_loop(); });
 }
 
@@ -16,14 +17,17 @@ LensHub::~LensHub() {
 void LensHub::poll_loop() {
   using namespace std::chrono_literals;
   while (!stop_) {
-    {
-      // Short polls keep a frame's wait for the lock under a millisecond;
-      // the sources queue what arrives meanwhile.
+    // The waiting happens outside the lock; a frame asking for its lens
+    // state waits only for the readings to be handed to the tracker.
+    for (std::size_t i = 0; i < channels_.size(); ++i) {
+      LensChannel &channel = channels_[i];
+      channel.poll(channels_.size() == 1 ? 5ms : 1ms);
+      // A source's status is read here, on the thread that polls it.
+      const bool connected = channel.encoder().status().connected;
       std::lock_guard lock(mutex_);
-      for (LensChannel &channel : channels_)
-        channel.pump(1ms);
+      channel.feed();
+      connected_[i] = connected;
     }
-    std::this_thread::yield(); // let a waiting frame take the lock
   }
 }
 
@@ -32,7 +36,7 @@ LensSnapshot LensHub::state_at(std::int64_t t_ns) const {
   LensSnapshot snapshot;
   const LensChannel &lens = channels_.front();
   snapshot.state = lens.state_at(t_ns);
-  snapshot.connected = lens.encoder().status().connected;
+  snapshot.connected = connected_.front();
   snapshot.fresh = snapshot.connected && snapshot.state.all_fresh();
   return snapshot;
 }

@@ -42,8 +42,11 @@ public:
 private:
   void poll_loop();
 
-  mutable std::mutex mutex_; // guards channels_
+  // Guards the channels' trackers (feed, state_at) and the status reads; the
+  // sources themselves are polled by the lens thread alone.
+  mutable std::mutex mutex_;
   std::vector<LensChannel> channels_;
+  std::vector<bool> connected_; // each source's status().connected after its last poll
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

@@ -1,5 +1,6 @@
 #include "output_uri.h"
 
+#include "camhead/hal/output/drm/drm_sink.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/hal/output/null/null_sink.h"
 #include "camhead/hal/output/v4l2/v4l2_loopback_sink.h"
@@ -9,6 +10,26 @@ namespace {
 
 constexpr std::string_view kForms =
     "(v4l2:/dev/videoN, drm:CARD[:CONNECTOR], file:PATH.y4m, file:DIR/%05d.png or null)";
+
+// drm:CARD[:CONNECTOR][?mode=WxH[@Hz]]
+void take_drm(std::string_view uri, std::string_view rest, OutputSpec &spec) {
+  if (const std::size_t q = rest.find('?'); q != std::string_view::npos) {
+    const std::string_view option = rest.substr(q + 1);
+    constexpr std::string_view kKey = "mode=";
+    if (option.substr(0, kKey.size()) != kKey || option.size() == kKey.size())
+      throw OutputError(uri, "unknown option \"" + std::string(option) +
+                                 "\" (only mode=WxH or mode=WxH@Hz)");
+    spec.mode = std::string(option.substr(kKey.size()));
+    rest = rest.substr(0, q);
+  }
+  const std::size_t colon = rest.find(':');
+  spec.target = std::string(rest.substr(0, colon));
+  if (colon != std::string_view::npos) {
+    spec.connector = std::string(rest.substr(colon + 1));
+    if (spec.connector.empty())
+      throw OutputError(uri, "connector: empty (drm:CARD:CONNECTOR, e.g. drm:card0:HDMI-A-1)");
+  }
+}
 
 bool ends_with(std::string_view s, std::string_view tail) {
   return s.size() >= tail.size() && s.substr(s.size() - tail.size()) == tail;
@@ -54,7 +75,7 @@ OutputSpec parse_output_uri(std::string_view uri) {
   } else if (scheme == "drm") {
     spec.kind = OutputKind::drm;
     spec.format = base::PixelFormat::xrgb8888;
-    spec.target = std::string(rest);
+    take_drm(uri, rest, spec);
   } else if (scheme == "file") {
     if (ends_with(rest.substr(0, rest.find('?')), ".y4m")) {
       spec.kind = OutputKind::y4m;
@@ -93,8 +114,11 @@ std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int 
   case OutputKind::v4l2:
     return hal::output::open_v4l2_loopback_sink(spec.target, format, fps);
   case OutputKind::drm:
-    throw OutputError(spec.uri, "the DRM/KMS output is not built yet (issue 10, section 4); use "
-                                "file:PATH.y4m or null");
+    return hal::output::open_drm_sink({.card = spec.target,
+                                       .connector = spec.connector,
+                                       .width = width,
+                                       .height = height,
+                                       .mode = spec.mode});
   }
   throw OutputError(spec.uri, "unknown output kind");
 }

@@ -2,7 +2,8 @@
 // which format.
 //
 //   v4l2:/dev/videoN[?format=yuyv|nv12]   the V4L2 loopback webcam
-//   drm:CARD[:CONNECTOR]                  HDMI through DRM/KMS
+//   drm:CARD[:CONNECTOR][?mode=WxH[@Hz]]  HDMI through DRM/KMS (card: card0,
+//                                         /dev/dri/card0 or a driver name)
 //   file:PATH.y4m[?format=yuyv|nv12]      Y4M video (4:2:2 or 4:2:0)
 //   file:DIR/%05d.png                     PNG sequence, one file a frame
 //   null                                  nothing (benchmarks)
@@ -32,6 +33,8 @@ struct OutputSpec {
   OutputKind kind = OutputKind::null;
   std::string target; // device, card or file path / pattern
   base::PixelFormat format = base::PixelFormat::yuyv;
+  std::string connector; // drm: empty = the first connected
+  std::string mode;      // drm: empty = the connector's preferred mode
 };
 
 // Throws OutputError naming the URI and what is wrong with it.

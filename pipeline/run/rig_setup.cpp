@@ -5,6 +5,7 @@
 #include <variant>
 
 #include "camhead/hal/camera/file/file_camera.h"
+#include "camhead/hal/camera/libcamera/libcamera_camera.h"
 #include "camhead/hal/camera/sim/simulated_camera.h"
 #include "camhead/hal/camera/v4l2/v4l2_camera.h"
 #include "camhead/renderer/gpu_tracer.h"
@@ -119,6 +120,12 @@ std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Sc
                                           .height = c.height,
                                           .fps = v4l2->fps,
                                           .buffers = v4l2->buffers});
+  if (const auto *libcamera = std::get_if<LibcameraCameraConfig>(&c.kind))
+    return hal::camera::open_libcamera_camera({.camera_id = libcamera->camera_id,
+                                               .format = c.format,
+                                               .width = c.width,
+                                               .height = c.height,
+                                               .buffers = libcamera->buffers});
   const auto &file = std::get<FileCameraConfig>(c.kind);
   auto camera = hal::camera::open_file_camera(
       {.path = file.path, .loop = file.loop, .realtime = file.realtime, .fps = 0.0});

@@ -121,3 +121,59 @@ TEST(Board, MissingFileIsNamed) {
 
 } // namespace
 } // namespace camhead::pipeline
+
+namespace camhead::pipeline {
+namespace {
+
+// A board with a camera section and the live pipeline's other sections.
+std::string live(const std::string &camera, const std::string &more = "") {
+  return R"({"format": "camhead-board", "version": 1, "name": "t",
+             "lens": {"sources": [{"type": "freed"}]}, "scene": "s.json",
+             "camera": )" +
+         camera + more + "}";
+}
+
+TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
+  const auto expect = [](const std::string &json, const std::string &message) {
+    EXPECT_EQ(error_of(json), "/rigs/test.json: " + message) << json;
+  };
+  expect(live(R"({"type": "usb3"})"),
+         "camera.type: unknown camera \"usb3\" (sim, file, v4l2 or libcamera)");
+  expect(live(R"({"type": "sim", "format": "mjpeg"})"),
+         "camera.format: unknown camera format \"mjpeg\" (yuyv, nv12, rgb24 or bgr24)");
+  expect(live(R"({"type": "sim", "width": 721})"),
+         "camera.width: width and height must be even (721x576)");
+  expect(live(R"({"type": "sim", "fps": 0})"), "camera.fps: must be within 1 .. 240");
+  expect(live(R"({"type": "sim", "shutter": 180})"), "camera.shutter: unknown field");
+  expect(live(R"({"type": "file"})"), "camera.path: missing");
+  expect(live(R"({"type": "v4l2", "device": "/dev/video0", "buffers": 9})"),
+         "camera.buffers: must be an integer within 2 .. 8");
+  expect(live(R"({"type": "sim"})", R"(, "outputs": "file:x.y4m")"),
+         "outputs: must be an array of output URIs (v4l2:/dev/videoN, file:PATH.y4m, ...)");
+  expect(live(R"({"type": "sim"})", R"(, "render": {"executor": "tpu"})"),
+         "render.executor: must be \"auto\", \"cpu\" or \"gpu\", not \"tpu\"");
+  expect(live(R"({"type": "sim"})",
+              R"(, "render": {"min_rays_per_pixel": 9, "max_rays_per_pixel": 4})"),
+         "render.min_rays_per_pixel: must not exceed max_rays_per_pixel (4)");
+  expect(live(R"({"type": "sim"})", R"(, "pose": {"position": [0, 1, 0], "look_at": [0, 1, 0]})"),
+         "pose.look_at: must differ from position");
+  // A camera without a scene has nothing to composite.
+  EXPECT_EQ(error_of(R"({"format": "camhead-board", "version": 1, "name": "t",
+                        "lens": {"sources": [{"type": "freed"}]}, "camera": {"type": "sim"}})"),
+            "/rigs/test.json: scene: missing: a board with a camera needs the scene of its "
+            "virtual objects");
+}
+
+TEST(BoardLive, TheSimulatedRigHasACameraASceneAndAnOutput) {
+  const Board board = load_board(resolve_board("sim"));
+  ASSERT_TRUE(board.camera);
+  EXPECT_TRUE(std::holds_alternative<SimCameraConfig>(board.camera->kind));
+  EXPECT_EQ(board.camera->width, 720);
+  EXPECT_EQ(board.camera->height, 576);
+  ASSERT_TRUE(board.scene);
+  EXPECT_TRUE(std::filesystem::exists(*board.scene)) << board.scene->string();
+  EXPECT_EQ(board.outputs, std::vector<std::string>{"file:camhead_sim.y4m"});
+}
+
+} // namespace
+} // namespace camhead::pipeline

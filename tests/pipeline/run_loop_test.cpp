@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "board.h"
+#include "camhead/hal/lens/trace/lens_trace.h"
+#include "camhead/lens_control/lens_profile.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
 
@@ -70,6 +72,33 @@ TEST_F(RunLoop, LostCameraShowsThePlaceholderAndIsTakenUpAgain) {
   EXPECT_EQ(summary.camera_reconnects, 1u);
   EXPECT_GE(summary.placeholders, 2u) << "1.5 s without frames, a placeholder every 0.5 s";
   EXPECT_GT(summary.frames_out, 10u) << "frames after the camera came back";
+}
+
+TEST_F(RunLoop, LostLensSourceHoldsTheLastStateFlaggedStale) {
+  // The focus pull played once at 100x: over in 60 ms, then the source is
+  // gone (a finished trace reports itself disconnected).
+  RunOptions options;
+  options.board = board(R"({"type": "sim", "width": 32, "height": 16, "fps": 25})",
+                        real_scene(32, 16), R"(, "loop": false, "speed": 100)");
+  options.outputs = {"null"};
+  options.stats_file = dir_ / "stats.jsonl";
+  options.duration_s = 1.5;
+  options.status = nullptr;
+  (void)run_pipeline(options);
+  const hal::lens::LensTrace trace = hal::lens::read_lens_trace(kLenses / "sim_focus_pull.csv");
+  const auto profile = lens_control::LensProfile::load(kLenses / "example_35mm.json");
+  const double last_focus = profile.focus_distance_m(*trace.readings.back().focus).value;
+  std::size_t late = 0;
+  for (const CompositeRecord &r : recorded_composites(dir_ / "stats.jsonl")) {
+    if (r.output_frame < 5)
+      continue; // the trace may still have been playing
+    ++late;
+    EXPECT_FALSE(r.lens_fresh) << "output frame " << r.output_frame;
+    // In diopters, the unit blur goes with: near infinity a few counts of
+    // encoder noise, extrapolated for the chain's 20 ms, move metres.
+    EXPECT_NEAR(1.0 / r.focus_m, 1.0 / last_focus, 0.005) << "output frame " << r.output_frame;
+  }
+  EXPECT_GE(late, 5u);
 }
 
 TEST_F(RunLoop, RefusesABoardWithoutCameraOrOutput) {

@@ -45,6 +45,17 @@ if(vm_kernel)
   endif()
 endif()
 
+# v4l2loopback's source, from Debian's v4l2loopback-dkms (the newest
+# /usr/src/v4l2loopback-VERSION). Optional: without it the lab runs and the
+# vm.v4l2_loopback_* results skip, saying what to install.
+file(GLOB vm_v4l2loopback_sources /usr/src/v4l2loopback-*/v4l2loopback.c)
+set(vm_v4l2loopback_source "")
+if(vm_v4l2loopback_sources)
+  list(SORT vm_v4l2loopback_sources COMPARE NATURAL ORDER DESCENDING)
+  list(GET vm_v4l2loopback_sources 0 vm_v4l2loopback_c)
+  get_filename_component(vm_v4l2loopback_source ${vm_v4l2loopback_c} DIRECTORY)
+endif()
+
 # Tools (tool:package); sbin is searched too, where a non-root PATH leaves it out.
 foreach(pair qemu-system-x86_64:qemu-system-x86 busybox:busybox-static cpio:cpio gzip:gzip
     depmod:kmod modprobe:kmod make:make xz:xz-utils)
@@ -58,6 +69,16 @@ foreach(pair qemu-system-x86_64:qemu-system-x86 busybox:busybox-static cpio:cpio
     list(APPEND vm_missing "${tool} (${package})")
   endif()
 endforeach()
+# The host side of the display checks (screen_helper.py: QEMU monitor
+# screendumps). Optional: without it only the vm.drm_* screen results skip.
+# Debian's own first (clang-format depends on it), not a virtualenv's.
+find_program(CAMHEAD_VM_PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH)
+find_program(CAMHEAD_VM_PYTHON3 python3)
+set(vm_screen_args)
+if(CAMHEAD_VM_PYTHON3)
+  set(vm_screen_args --python3 ${CAMHEAD_VM_PYTHON3}
+    --screen-helper ${CMAKE_CURRENT_SOURCE_DIR}/screen_helper.py)
+endif()
 
 # --- vm.boot: boots once, leaves lab/results.txt; skips (77) where it cannot --
 set(lab_dir ${vm_lab_dir})
@@ -65,7 +86,9 @@ get_property(vm_scripts DIRECTORY PROPERTY vm_scripts)
 get_property(vm_results DIRECTORY PROPERTY vm_results)
 get_property(vm_programs DIRECTORY PROPERTY vm_programs)
 get_property(vm_modules DIRECTORY PROPERTY vm_modules)
+get_property(vm_packed_modules DIRECTORY PROPERTY vm_packed_modules)
 get_property(vm_libraries DIRECTORY PROPERTY vm_libraries)
+get_property(vm_files DIRECTORY PROPERTY vm_files)
 
 if(vm_missing)
   list(JOIN vm_missing ", " missing_text)
@@ -75,11 +98,19 @@ if(vm_missing)
     --skip "${skip_message}" --out-dir ${lab_dir})
 else()
   message(STATUS "Hardware lab (tests/vm): kernel ${vm_kernel}")
+  if(NOT vm_v4l2loopback_source)
+    message(STATUS "Hardware lab (tests/vm): vm.v4l2_loopback_* will skip, missing "
+      "/usr/src/v4l2loopback-* (v4l2loopback-dkms)")
+  endif()
   list(JOIN vm_results " " expect_text)
   add_test(NAME vm.boot COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/run_lab.sh
     --qemu ${CAMHEAD_VM_QEMU_SYSTEM_X86_64} --kernel /boot/vmlinuz-${vm_kernel}
     --initrd ${lab_dir}/initramfs.cpio.gz --out-dir ${lab_dir} --timeout 300
-    --expect "${expect_text}")
+    --expect "${expect_text}" ${vm_screen_args})
+  if(NOT CAMHEAD_VM_PYTHON3)
+    message(STATUS "Hardware lab (tests/vm): the vm.drm_* screendump results will skip, "
+      "missing python3")
+  endif()
 endif()
 # Boot and checks take ~15 s on an idle machine (~45 s built with ASan on a
 # busy one); TCG on a loaded CI machine can take several times that.
@@ -100,10 +131,44 @@ add_custom_command(OUTPUT ${lab_dir}/gpio-sim/gpio-sim.ko
   COMMENT "Building gpio-sim.ko for ${vm_kernel} out of tree"
   VERBATIM)
 
+# v4l2loopback.ko: Debian's DKMS source, built here (~3 s), loaded by its check.
+set(vm_extra_depends)
 set(vm_args)
+if(vm_v4l2loopback_source)
+  add_custom_command(OUTPUT ${lab_dir}/v4l2loopback/v4l2loopback.ko
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/build_v4l2loopback.sh
+      ${vm_v4l2loopback_source} ${vm_headers} ${lab_dir}/v4l2loopback
+    DEPENDS build_v4l2loopback.sh ${vm_v4l2loopback_source}/v4l2loopback.c
+      ${vm_headers}/Makefile
+    COMMENT "Building v4l2loopback.ko for ${vm_kernel} out of tree"
+    VERBATIM)
+  list(APPEND vm_extra_depends ${lab_dir}/v4l2loopback/v4l2loopback.ko)
+  list(APPEND vm_args --packed-extra-module ${lab_dir}/v4l2loopback/v4l2loopback.ko)
+endif()
+
+# vimc.ko: its folder of Debian's kernel source, built here (~10 s), loaded
+# by the libcamera check; only where that check has its program
+# (vm_build_vimc, CMakeLists.txt).
+if(vm_build_vimc)
+  add_custom_command(OUTPUT ${lab_dir}/vimc/vimc.ko
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/build_vimc.sh
+      ${vm_kernel_source} ${vm_headers} ${lab_dir}/vimc
+    DEPENDS build_vimc.sh ${vm_kernel_source} ${vm_headers}/Makefile
+    COMMENT "Building vimc.ko for ${vm_kernel} out of tree"
+    VERBATIM)
+  list(APPEND vm_extra_depends ${lab_dir}/vimc/vimc.ko)
+  list(APPEND vm_args --packed-extra-module ${lab_dir}/vimc/vimc.ko)
+endif()
+
 list(REMOVE_DUPLICATES vm_modules)
 foreach(module configfs ${vm_modules})
   list(APPEND vm_args --module ${module})
+endforeach()
+if(vm_packed_modules)
+  list(REMOVE_DUPLICATES vm_packed_modules)
+endif()
+foreach(module IN LISTS vm_packed_modules)
+  list(APPEND vm_args --packed-module ${module})
 endforeach()
 foreach(script IN LISTS vm_scripts)
   list(APPEND vm_args --check ${script})
@@ -115,13 +180,20 @@ list(REMOVE_DUPLICATES vm_libraries)
 foreach(library IN LISTS vm_libraries)
   list(APPEND vm_args --library ${library})
 endforeach()
+if(vm_files)
+  list(REMOVE_DUPLICATES vm_files)
+endif()
+foreach(file IN LISTS vm_files)
+  list(APPEND vm_args --file ${file})
+endforeach()
+list(APPEND vm_extra_depends ${vm_files})
 add_custom_command(OUTPUT ${lab_dir}/initramfs.cpio.gz
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/make_initramfs.sh
     --out ${lab_dir}/initramfs.cpio.gz --kernel ${vm_kernel}
     --busybox ${CAMHEAD_VM_BUSYBOX} --init ${CMAKE_CURRENT_SOURCE_DIR}/guest_init.sh
     --extra-module ${lab_dir}/gpio-sim/gpio-sim.ko ${vm_args}
   DEPENDS make_initramfs.sh guest_init.sh ${vm_scripts} ${vm_programs}
-    ${lab_dir}/gpio-sim/gpio-sim.ko /lib/modules/${vm_kernel}/modules.dep
+    ${lab_dir}/gpio-sim/gpio-sim.ko ${vm_extra_depends} /lib/modules/${vm_kernel}/modules.dep
     ${CAMHEAD_VM_BUSYBOX}
   COMMENT "Packing the hardware lab's initramfs"
   VERBATIM)

@@ -6,7 +6,9 @@
 # Passes on `RESULT NAME: PASS`; fails on FAIL, when the guest printed no
 # line for NAME (the check crashed, hung or never ran), or when SCRIPT, the
 # guest script that prints it, exited non-zero (a crash or a sanitizer report
-# after the line). Skips (77) when vm.boot skipped.
+# after the line). Skips (77) when vm.boot skipped, or when the guest printed
+# `RESULT NAME: SKIP reason` (a check whose part of the lab this machine
+# could not build).
 set -euo pipefail
 lab_dir=$1 name=$2 script=$3
 results="$lab_dir/results.txt" console="$lab_dir/console.log"
@@ -21,6 +23,10 @@ if head -n1 "$results" | grep -q '^SKIP '; then
 fi
 
 lines=$(grep -a "^RESULT $name: " "$results" || true)
+if grep -q "^RESULT $name: SKIP" <<<"$lines"; then
+  echo "$lines"
+  exit 77
+fi
 if [ -z "$lines" ]; then
   echo "no RESULT line for $name: the check crashed, hung or never ran; the guest console follows"
 elif ! grep -q "^RESULT $name: FAIL" <<<"$lines" && grep -q "^RESULT $name: PASS" <<<"$lines"; then

@@ -7,15 +7,26 @@
 #   make_initramfs.sh --out FILE --kernel K --busybox FILE --init FILE
 #       [--module NAME]... [--extra-module FILE.ko]... [--check FILE.sh]...
 #       [--program FILE]... [--library SONAME]...
+#       [--packed-module NAME]... [--packed-extra-module FILE.ko]...
+#       [--file PATH]...
+#
+# --module and --extra-module are loaded at boot; --packed-module and
+# --packed-extra-module are only packed (with their dependencies), for a
+# check that loads them itself with its own options (vivid, v4l2loopback).
 #
 # --library packs a library that a program opens at run time (dlopen), which
 # ldd cannot see: the hal backends' libusb-1.0.so.0 and libgpiod.so.2.
+#
+# --file packs any other file at the same path, with its mode and, for an
+# ELF file, the libraries ldd lists: plug-ins and data a library finds by a
+# path it was built with (libcamera's IPA modules and their configuration).
 #
 # The guest runs the checks in the order given.
 set -euo pipefail
 
 out='' kernel='' busybox='' init=''
 modules=() extra_modules=() checks=() programs=() libraries=()
+packed_modules=() packed_extra_modules=() files=()
 while [ $# -gt 0 ]; do
   case $1 in
   --out) out=$2 ;;
@@ -27,6 +38,9 @@ while [ $# -gt 0 ]; do
   --check) checks+=("$2") ;;
   --program) programs+=("$2") ;;
   --library) libraries+=("$2") ;;
+  --packed-module) packed_modules+=("$2") ;;
+  --packed-extra-module) packed_extra_modules+=("$2") ;;
+  --file) files+=("$2") ;;
   *)
     echo "make_initramfs.sh: unknown argument $1" >&2
     exit 2
@@ -73,7 +87,7 @@ install -m 755 "$init" "$root/init"
 # Modules: the kernel's own, found with the dependencies modprobe would load.
 moddir="lib/modules/$kernel"
 mkdir -p "$root/$moddir"
-for module in "${modules[@]}"; do
+for module in "${modules[@]}" "${packed_modules[@]}"; do
   # "insmod PATH" per module to load, "builtin NAME" for built-in ones; an
   # unknown module fails the build here rather than the check in the guest.
   depends=$(modprobe -S "$kernel" --show-depends "$module")
@@ -83,7 +97,7 @@ for module in "${modules[@]}"; do
     fi
   done <<<"$depends"
 done
-for module in "${extra_modules[@]}"; do
+for module in "${extra_modules[@]}" "${packed_extra_modules[@]}"; do
   install -D -m 644 "$module" "$root/$moddir/extra/$(basename "$module")"
 done
 for file in modules.builtin modules.builtin.modinfo modules.order; do
@@ -114,6 +128,12 @@ for soname in "${libraries[@]}"; do
   fi
   [ -e "$root$path" ] || install -D -m 755 "$(readlink -f "$path")" "$root$path"
   copy_libraries "$path"
+done
+for file in "${files[@]}"; do
+  install -D -m "$(stat -L -c %a "$file")" "$(readlink -f "$file")" "$root$file"
+  if [ "$(head -c 4 "$file" | tail -c 3)" = ELF ]; then
+    copy_libraries "$file"
+  fi
 done
 
 # newc is the format the kernel unpacks; sorted names and fixed times keep

@@ -6,6 +6,14 @@
 #   run_lab.sh --out-dir DIR --skip MESSAGE
 #   run_lab.sh --out-dir DIR --qemu QEMU --kernel VMLINUZ --initrd CPIO.GZ
 #              [--timeout SECONDS] [--expect "name name ..."]
+#              [--python3 PYTHON --screen-helper screen_helper.py]
+#
+# The guest has a display (-vga std: bochs-drm once loaded) and a second
+# serial port, its /dev/ttyS1, on a socket that screen_helper.py serves
+# while the guest runs: it takes screendumps through the QEMU monitor's
+# socket when a check asks (the drm checks), and leaves them in
+# OUT_DIR/screens with its log. Without --screen-helper nobody answers
+# there, and those checks skip their screen results.
 #
 # Exit status: 0 when the guest ran to the end (whatever its checks said: a
 # failing fixture would keep ctest from running, and reporting, the
@@ -14,6 +22,7 @@
 set -euo pipefail
 
 out_dir='' skip='' qemu='' kernel='' initrd='' timeout_s=300 expect=''
+python3='' screen_helper=''
 while [ $# -gt 0 ]; do
   case $1 in
   --out-dir) out_dir=$2 ;;
@@ -23,6 +32,8 @@ while [ $# -gt 0 ]; do
   --initrd) initrd=$2 ;;
   --timeout) timeout_s=$2 ;;
   --expect) expect=$2 ;;
+  --python3) python3=$2 ;;
+  --screen-helper) screen_helper=$2 ;;
   *)
     echo "run_lab.sh: unknown argument $1" >&2
     exit 2
@@ -55,16 +66,43 @@ fi
 # two emulated CPUs its latency has no bound (28 of 30 bursts of 12 edges
 # came out wrong when tried). One CPU also leaves the host's other core to
 # the tests ctest runs alongside, and boots no slower.
-# -nodefaults: no network card, VGA or option ROMs to probe; the serial port
-# is the guest's console. panic=-1 with -no-reboot turns a guest panic (PID 1
-# died) into qemu exiting instead of a hang.
+# -nodefaults: no network card or option ROMs to probe; the first serial port
+# is the guest's console. -vga std is the one display (the drm checks' HDMI
+# stand-in); the second serial port and the monitor socket are the screen
+# helper's. panic=-1 with -no-reboot turns a guest panic (PID 1 died) into
+# qemu exiting instead of a hang.
+# The sockets live in a folder of their own under /tmp: a socket path must
+# fit in 108 bytes, which a deep build folder may not.
+sockets=$(mktemp -d "${TMPDIR:-/tmp}/camhead-lab.XXXXXX")
+trap 'rm -rf "$sockets"' EXIT
+screens="$out_dir/screens"
+rm -rf "$screens"
+mkdir -p "$screens"
+helper_pid=''
+if [ -n "$screen_helper" ]; then
+  "$python3" "$screen_helper" --monitor "$sockets/monitor.sock" \
+    --control "$sockets/control.sock" --out-dir "$screens" >"$screens/helper.log" 2>&1 &
+  helper_pid=$!
+fi
 start=$(date +%s.%N)
 status=0
 timeout --kill-after=10 "$timeout_s" "$qemu" -accel tcg -m 1024 -smp 1 -nodefaults \
   -display none -no-reboot -serial "file:$console" \
+  -vga std -monitor "unix:$sockets/monitor.sock,server=on,wait=off" \
+  -chardev "socket,id=labctl,path=$sockets/control.sock,server=on,wait=off" \
+  -serial chardev:labctl \
   -kernel "$kernel" -initrd "$initrd" \
   -append "console=ttyS0 quiet loglevel=3 panic=-1" </dev/null || status=$?
 elapsed=$(echo "$start $(date +%s.%N)" | awk '{ printf "%.1f", $2 - $1 }')
+if [ -n "$helper_pid" ]; then
+  # It exits when qemu closes the sockets; a hung one is not waited for long.
+  for _ in $(seq 50); do
+    kill -0 "$helper_pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  kill "$helper_pid" 2>/dev/null || true
+  wait "$helper_pid" || true
+fi
 
 touch "$console"
 # The serial console ends lines with CR LF.
@@ -72,6 +110,11 @@ sed -i 's/\r$//' "$console"
 echo "---- guest console ($console) ----"
 cat "$console"
 echo "---- end of guest console ----"
+if [ -s "$screens/helper.log" ]; then
+  echo "---- screen helper ($screens/helper.log) ----"
+  cat "$screens/helper.log"
+  echo "---- end of screen helper ----"
+fi
 grep -a '^RESULT ' "$console" >"$results" || true
 
 if [ "$status" -eq 124 ] || [ "$status" -eq 137 ]; then

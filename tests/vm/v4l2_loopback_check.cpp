@@ -1,0 +1,213 @@
+// Hardware-lab check of the V4L2 loopback sink: frames written with
+// open_v4l2_loopback_sink() to v4l2loopback (loaded with exclusive_caps=1,
+// as Chrome needs it) are read back through open_v4l2_camera() on the same
+// node and compared byte for byte. One thread does both, a frame at a time,
+// so that the reader never falls behind the writer. Prints one RESULT line
+// per verdict:
+//
+//   v4l2_loopback_open        the sink sets the format; once it has written,
+//                             the node offers capture and the camera opens it
+//                             in the same format and colour; a second writer
+//                             is refused, saying why
+//   v4l2_loopback_round_trip  YUYV frames come back exact, in order, with
+//                             increasing sequence numbers and CLOCK_MONOTONIC
+//                             stamps, no short or dropped frames (the reader's
+//                             first frame is skipped: it may be stale)
+//   v4l2_loopback_nv12        the same in NV12, after everything was closed
+//                             (v4l2loopback then takes a new format)
+//   v4l2_loopback_close       close() leaves a black frame for the reader and
+//                             the node open to the next writer
+//
+//   camhead_v4l2_loopback_check DEVICE
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "camhead/base/monotonic_clock.h"
+#include "camhead/hal/camera/v4l2/v4l2_camera.h"
+#include "camhead/hal/output/v4l2/v4l2_loopback_sink.h"
+#include "vm_result.h"
+
+namespace {
+
+using namespace camhead::hal;
+using camhead::base::PixelFormat;
+using camhead::base::VideoFormat;
+using camhead::vm::print_result;
+using namespace std::chrono_literals;
+
+constexpr int kWidth = 320;
+constexpr int kHeight = 180;
+
+// Frame k: its number in the first four bytes, then bytes that differ from
+// every neighbour and from frame k - 1.
+void fill(std::span<std::uint8_t> frame, std::uint32_t k) {
+  for (std::size_t i = 0; i < frame.size(); ++i)
+    frame[i] = static_cast<std::uint8_t>(i * 7 + k * 13 + (i >> 9));
+  for (std::size_t i = 0; i < 4; ++i)
+    frame[i] = static_cast<std::uint8_t>(k >> (8 * i));
+}
+
+std::uint32_t number_of(std::span<const std::uint8_t> frame) {
+  std::uint32_t k = 0;
+  for (std::size_t i = 0; i < 4; ++i)
+    k |= std::uint32_t{frame[i]} << (8 * i);
+  return k;
+}
+
+std::string first_difference(std::span<const std::uint8_t> frame, std::uint32_t k) {
+  std::vector<std::uint8_t> want(frame.size());
+  fill(want, k);
+  for (std::size_t i = 0; i < frame.size(); ++i)
+    if (frame[i] != want[i])
+      return "frame " + std::to_string(k) + " differs at byte " + std::to_string(i);
+  return {};
+}
+
+bool write_frame(output::FrameSink &sink, std::uint32_t k) {
+  const std::span<std::uint8_t> buffer = sink.acquire();
+  if (buffer.empty())
+    return false;
+  fill(buffer, k);
+  return sink.submit(camhead::base::monotonic_ns());
+}
+
+struct Pair {
+  std::unique_ptr<output::FrameSink> sink;
+  std::unique_ptr<camera::CameraSource> camera;
+};
+
+// The sink, its first frame, then the reader (which exclusive_caps hides
+// until a writer has started).
+Pair open_pair(const std::string &device, PixelFormat pixel, std::string &error) {
+  Pair pair;
+  try {
+    pair.sink = output::open_v4l2_loopback_sink(device, VideoFormat{pixel, kWidth, kHeight}, 25);
+    if (!write_frame(*pair.sink, 0)) {
+      error = "first frame: " + pair.sink->status().detail;
+      return pair;
+    }
+    pair.camera =
+        camera::open_v4l2_camera(camera::V4l2CameraOptions{device, pixel, kWidth, kHeight, 0, 4});
+  } catch (const std::exception &e) {
+    error = e.what();
+  }
+  return pair;
+}
+
+// Writes frames 1..count, reading each back; "" when all came back exact.
+std::string round_trip(Pair &pair, std::uint32_t count) {
+  camera::CapturedFrame frame;
+  // The reader's first frame may be stale (hardware-lab.md): skipped.
+  if (pair.camera->wait_frame(2000ms, frame) != camera::CaptureResult::frame)
+    return "no first frame: " + pair.camera->status().detail;
+  std::uint64_t last_sequence = frame.sequence;
+  std::int64_t last_stamp = frame.timestamp_ns;
+  pair.camera->release(frame);
+  for (std::uint32_t k = 1; k <= count; ++k) {
+    if (!write_frame(*pair.sink, k))
+      return "frame " + std::to_string(k) + " not written: " + pair.sink->status().detail;
+    if (pair.camera->wait_frame(2000ms, frame) != camera::CaptureResult::frame)
+      return "frame " + std::to_string(k) + " not read: " + pair.camera->status().detail;
+    std::string problem;
+    const std::int64_t now = camhead::base::monotonic_ns();
+    if (number_of(frame.bytes) != k)
+      problem = "read frame " + std::to_string(number_of(frame.bytes)) + " for frame " +
+                std::to_string(k);
+    else if (problem = first_difference(frame.bytes, k); !problem.empty()) {
+    } else if (frame.sequence <= last_sequence)
+      problem =
+          "sequence " + std::to_string(frame.sequence) + " after " + std::to_string(last_sequence);
+    else if (frame.timestamp_ns <= last_stamp || frame.timestamp_ns > now ||
+             now - frame.timestamp_ns > 2'000'000'000)
+      problem =
+          "stamp " + std::to_string(frame.timestamp_ns) + " is not a later CLOCK_MONOTONIC time";
+    last_sequence = frame.sequence;
+    last_stamp = frame.timestamp_ns;
+    pair.camera->release(frame);
+    if (!problem.empty())
+      return problem;
+  }
+  const camera::CameraStatus status = pair.camera->status();
+  if (status.errors != 0 || status.dropped != 0)
+    return std::to_string(status.errors) + " short or corrupt frames, " +
+           std::to_string(status.dropped) + " dropped";
+  return {};
+}
+
+std::string describe(const Pair &pair) {
+  return pair.sink->status().detail + " | " + pair.camera->status().detail;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: camhead_v4l2_loopback_check DEVICE\n");
+    return 2;
+  }
+  const std::string device = argv[1];
+  std::string error;
+  Pair pair = open_pair(device, PixelFormat::yuyv, error);
+  if (!pair.camera) {
+    for (const char *name : {"v4l2_loopback_open", "v4l2_loopback_round_trip", "v4l2_loopback_nv12",
+                             "v4l2_loopback_close"})
+      print_result(name, false, error);
+    return 1;
+  }
+  std::string problem;
+  if (pair.camera->format() != pair.sink->format())
+    problem = "the reader sees " + camhead::base::describe(pair.camera->format()) +
+              ", the writer wrote " + camhead::base::describe(pair.sink->format());
+  std::string second;
+  try {
+    (void)output::open_v4l2_loopback_sink(device, VideoFormat{PixelFormat::yuyv, kWidth, kHeight},
+                                          25);
+    if (problem.empty())
+      problem = "a second writer was let in";
+  } catch (const output::V4l2SinkError &e) {
+    second = e.what();
+    if (problem.empty() && second.find("exclusive_caps") == std::string::npos)
+      problem = "a second writer was refused without saying why: " + second;
+  }
+  print_result("v4l2_loopback_open", problem.empty(),
+               problem + (problem.empty() ? "" : "; ") + describe(pair) +
+                   " | second writer: " + second);
+
+  problem = round_trip(pair, 8);
+  print_result("v4l2_loopback_round_trip", problem.empty(),
+               problem + (problem.empty() ? "8 frames exact; " : "; ") + describe(pair));
+
+  // close(): a black frame for the reader, the node free for a writer.
+  problem = pair.sink->close() ? "" : "close: " + pair.sink->status().detail;
+  camera::CapturedFrame frame;
+  if (problem.empty() && pair.camera->wait_frame(2000ms, frame) != camera::CaptureResult::frame)
+    problem = "no frame after close: " + pair.camera->status().detail;
+  if (problem.empty()) {
+    for (std::size_t i = 0; i < frame.bytes.size() && problem.empty(); ++i)
+      if (frame.bytes[i] != (i % 2 == 0 ? 16 : 128))
+        problem = "the last frame is not black at byte " + std::to_string(i);
+    pair.camera->release(frame);
+  }
+  if (problem.empty()) {
+    try {
+      auto next = output::open_v4l2_loopback_sink(
+          device, VideoFormat{PixelFormat::yuyv, kWidth, kHeight}, 25);
+      (void)next->close();
+    } catch (const output::V4l2SinkError &e) {
+      problem = std::string("the next writer is refused: ") + e.what();
+    }
+  }
+  print_result("v4l2_loopback_close", problem.empty(),
+               problem + (problem.empty() ? "black frame read back, next writer let in; " : "; ") +
+                   pair.sink->status().detail);
+
+  pair = {};
+  Pair nv12 = open_pair(device, PixelFormat::nv12, error);
+  problem = nv12.camera ? round_trip(nv12, 4) : error;
+  print_result("v4l2_loopback_nv12", problem.empty(),
+               problem + (problem.empty() ? "4 frames exact; " + describe(nv12) : ""));
+  return 0;
+}
