@@ -3,11 +3,14 @@
 
 Prints the median and 99th percentile (ms) of, per composite frame:
   camera    capture (start of exposure) -> the camera hands the frame over
-  wait      handed over -> rendering starts (queue, lens lookup)
+  queued    handed over -> the renderer is free (the previous frame done):
+            the newest frame's age when a busy renderer takes it
+  handoff   the renderer free (or the frame there, whichever is later) ->
+            rendering starts: queue wake-up, slot, lens lookup
   render    the frame renderer (decode, trace, encode)
   output    rendering done -> every output has it
   total     capture -> output
-  overhead  wait + output: the pipeline's own cost beyond rendering
+  overhead  handoff + output: the pipeline's own cost beyond rendering
 and the output rate, the rays per pixel and the drops.
 
     bench/pipeline_latency.py stats.jsonl [--skip N]
@@ -39,18 +42,23 @@ def main():
                 records.append(r)
             else:
                 fillers += 1
-    records = records[args.skip:]
+    # The previous composite's render end, for the time a frame waited for a
+    # busy renderer (only the composite before it in the record can be it).
+    for prev, r in zip(records, records[1:]):
+        r["free_ns"] = max(r["delivered_ns"], prev["render_end_ns"])
+    records = records[max(args.skip, 1):]
     if len(records) < 2:
         sys.exit(f"{args.stats}: fewer than 2 composites after --skip {args.skip}")
     ms = lambda a, b: [(r[b] - r[a]) * 1e-6 for r in records]
     stages = {
         "camera": ms("capture_ns", "delivered_ns"),
-        "wait": ms("delivered_ns", "render_start_ns"),
+        "queued": ms("delivered_ns", "free_ns"),
+        "handoff": ms("free_ns", "render_start_ns"),
         "render": ms("render_start_ns", "render_end_ns"),
         "output": ms("render_end_ns", "output_ns"),
         "total": ms("capture_ns", "output_ns"),
     }
-    stages["overhead"] = [w + o for w, o in zip(stages["wait"], stages["output"])]
+    stages["overhead"] = [h + o for h, o in zip(stages["handoff"], stages["output"])]
     print(f"{len(records)} composites ({fillers} repeats/placeholders), executor: {records[0]['executor']}")
     print(f"{'stage':10s} {'median ms':>10s} {'p99 ms':>10s}")
     for name, values in stages.items():
