@@ -26,7 +26,7 @@
 
 #include "camera_session.h"
 #include "camhead/base/monotonic_clock.h"
-#include "sequence_gaps.h"
+#include "camhead/hal/camera/frame_sequence.h"
 #include "shared_manager.h"
 #include "stream_settings.h"
 
@@ -111,7 +111,7 @@ private:
   void stop_session(CameraSession &session);
   bool reconnect(std::int64_t deadline);
   void lose(const std::string &reason);
-  void fill(libcamera::Request &request, int index, const settings::SequenceGaps::Step &step,
+  void fill(libcamera::Request &request, int index, const FrameSequence::Step &step,
             CapturedFrame &out);
 
   // Declared first: destroyed last, after every camera it made.
@@ -123,7 +123,7 @@ private:
   std::atomic<std::int64_t> interval_ns_{0};
 
   // The capture thread's own.
-  settings::SequenceGaps sequence_;
+  FrameSequence sequence_;
   std::uint32_t last_generation_ = 0;
   std::int64_t next_try_ns_ = 0;
   bool stamp_noted_ = false;
@@ -350,7 +350,7 @@ CaptureResult LibcameraSource::wait_frame(std::chrono::milliseconds timeout, Cap
       }
       continue;
     }
-    const settings::SequenceGaps::Step step = sequence_.next(buffer->metadata().sequence);
+    const FrameSequence::Step step = sequence_.next(buffer->metadata().sequence);
     held_[static_cast<std::size_t>(index)] = {true, step.sequence};
     status_.dropped += step.dropped;
     ++status_.frames;
@@ -360,8 +360,8 @@ CaptureResult LibcameraSource::wait_frame(std::chrono::milliseconds timeout, Cap
 }
 
 // Under mutex_, for the Request at `index` that just completed.
-void LibcameraSource::fill(libcamera::Request &request, int index,
-                           const settings::SequenceGaps::Step &step, CapturedFrame &out) {
+void LibcameraSource::fill(libcamera::Request &request, int index, const FrameSequence::Step &step,
+                           CapturedFrame &out) {
   const libcamera::ControlList &metadata = request.metadata();
   const libcamera::FrameBuffer &buffer = *request.findBuffer(session_->stream());
   std::int64_t stamp = 0;

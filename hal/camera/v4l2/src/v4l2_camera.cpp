@@ -20,9 +20,9 @@
 
 #include "buffer_timestamp.h"
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/hal/camera/frame_sequence.h"
 #include "camhead/hal/v4l2/reconnect_schedule.h"
 #include "capture_stream.h"
-#include "sequence_tracker.h"
 
 namespace camhead::hal::camera {
 namespace {
@@ -88,7 +88,7 @@ private:
   const std::int64_t interval_ns_;
 
   // The capture thread's own.
-  SequenceTracker sequence_;
+  FrameSequence sequence_;
   v4l2::ReconnectSchedule schedule_;
   std::uint32_t generation_ = 0;
   std::int64_t exposure_ns_ = 0;
@@ -178,7 +178,7 @@ CaptureResult V4l2Camera::wait_frame(std::chrono::milliseconds timeout, Captured
                                            std::int64_t{buffer.timestamp.tv_sec} * 1'000'000'000 +
                                                std::int64_t{buffer.timestamp.tv_usec} * 1'000,
                                            now, realtime_ns());
-    const SequenceTracker::Step step = sequence_.next(buffer.sequence);
+    const FrameSequence::Step step = sequence_.next(buffer.sequence);
     stream.hold(index, step.sequence);
     status_.dropped += step.dropped;
     ++status_.frames;

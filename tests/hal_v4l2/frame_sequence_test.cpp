@@ -1,14 +1,14 @@
 // Driver sequence numbers to camhead frame numbers and drops
-// (hal/camera/v4l2/src/sequence_tracker.h).
-#include "sequence_tracker.h"
+// (hal/camera/include/camhead/hal/camera/frame_sequence.h).
+#include "camhead/hal/camera/frame_sequence.h"
 
 #include <gtest/gtest.h>
 
 namespace camhead::hal::camera {
 namespace {
 
-TEST(SequenceTracker, ConsecutiveNumbersDropNothing) {
-  SequenceTracker tracker;
+TEST(FrameSequence, ConsecutiveNumbersDropNothing) {
+  FrameSequence tracker;
   for (std::uint32_t s = 100; s < 110; ++s) {
     const auto step = tracker.next(s);
     EXPECT_EQ(step.sequence, s - 100u);
@@ -16,8 +16,8 @@ TEST(SequenceTracker, ConsecutiveNumbersDropNothing) {
   }
 }
 
-TEST(SequenceTracker, GapsAreDroppedFramesAndKeptInTheNumbers) {
-  SequenceTracker tracker;
+TEST(FrameSequence, GapsAreDroppedFramesAndKeptInTheNumbers) {
+  FrameSequence tracker;
   EXPECT_EQ(tracker.next(7).sequence, 0u);
   const auto step = tracker.next(10); // 8 and 9 were made and never dequeued
   EXPECT_EQ(step.dropped, 2u);
@@ -25,9 +25,9 @@ TEST(SequenceTracker, GapsAreDroppedFramesAndKeptInTheNumbers) {
   EXPECT_EQ(tracker.next(11).sequence, 4u);
 }
 
-TEST(SequenceTracker, ACounterThatNeverMovesIsNotADrop) {
+TEST(FrameSequence, ACounterThatNeverMovesIsNotADrop) {
   // v4l2loopback's mmap writers leave every number 0.
-  SequenceTracker tracker;
+  FrameSequence tracker;
   for (std::uint64_t i = 0; i < 5; ++i) {
     const auto step = tracker.next(0);
     EXPECT_EQ(step.sequence, i);
@@ -35,8 +35,8 @@ TEST(SequenceTracker, ACounterThatNeverMovesIsNotADrop) {
   }
 }
 
-TEST(SequenceTracker, WrappingAt32BitsIsOneStep) {
-  SequenceTracker tracker;
+TEST(FrameSequence, WrappingAt32BitsIsOneStep) {
+  FrameSequence tracker;
   (void)tracker.next(0xffff'fffeu);
   EXPECT_EQ(tracker.next(0xffff'ffffu).dropped, 0u);
   const auto step = tracker.next(0);
@@ -45,16 +45,16 @@ TEST(SequenceTracker, WrappingAt32BitsIsOneStep) {
   EXPECT_EQ(tracker.next(2).dropped, 1u);
 }
 
-TEST(SequenceTracker, GoingBackIsARestartNotFourBillionDrops) {
-  SequenceTracker tracker;
+TEST(FrameSequence, GoingBackIsARestartNotFourBillionDrops) {
+  FrameSequence tracker;
   (void)tracker.next(500);
   const auto step = tracker.next(3);
   EXPECT_EQ(step.dropped, 0u);
   EXPECT_EQ(step.sequence, 1u);
 }
 
-TEST(SequenceTracker, AReopenedStreamCountsOnWithoutAGap) {
-  SequenceTracker tracker;
+TEST(FrameSequence, AReopenedStreamCountsOnWithoutAGap) {
+  FrameSequence tracker;
   (void)tracker.next(40);
   (void)tracker.next(41);
   tracker.restart();
