@@ -153,9 +153,19 @@ private:
     }
     if (const auto format = d.find("format")) {
       const std::string name = format->string();
-      const std::optional<base::PixelFormat> pixels = base::parse_pixel_format(name);
+      auto *v4l2 = std::get_if<V4l2CameraConfig>(&camera.kind);
+      if (name == "mjpeg") {
+        // Decoded on the capture thread; the frames are rgb24 from there on.
+        if (v4l2 == nullptr)
+          format->fail("mjpeg comes from V4L2 webcams only (type v4l2)");
+        v4l2->mjpeg = true;
+        camera.format = base::PixelFormat::rgb24;
+      }
+      const std::optional<base::PixelFormat> pixels =
+          name == "mjpeg" ? camera.format : base::parse_pixel_format(name);
       if (!pixels || *pixels == base::PixelFormat::xrgb8888)
-        format->fail("unknown camera format \"" + name + "\" (yuyv, nv12, rgb24 or bgr24)");
+        format->fail("unknown camera format \"" + name +
+                     "\" (yuyv, nv12, rgb24, bgr24, or mjpeg for a v4l2 camera)");
       camera.format = *pixels;
     }
     if (d.has("width"))

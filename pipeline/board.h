@@ -133,6 +133,7 @@ struct V4l2CameraConfig {
   std::string device; // /dev/videoN or a /dev/v4l/by-id/... name
   double fps = 0.0;   // 0: the driver's rate
   int buffers = 4;
+  bool mjpeg = false; // "format": "mjpeg": decoded to rgb24 as it arrives
 };
 
 // A camera through libcamera (hal/camera/libcamera): CSI sensors behind an

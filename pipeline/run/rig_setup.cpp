@@ -119,7 +119,8 @@ std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Sc
                                           .width = c.width,
                                           .height = c.height,
                                           .fps = v4l2->fps,
-                                          .buffers = v4l2->buffers});
+                                          .buffers = v4l2->buffers,
+                                          .mjpeg = v4l2->mjpeg});
   if (const auto *libcamera = std::get_if<LibcameraCameraConfig>(&c.kind))
     return hal::camera::open_libcamera_camera({.camera_id = libcamera->camera_id,
                                                .format = c.format,

@@ -140,7 +140,10 @@ TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
   expect(live(R"({"type": "usb3"})"),
          "camera.type: unknown camera \"usb3\" (sim, file, v4l2 or libcamera)");
   expect(live(R"({"type": "sim", "format": "mjpeg"})"),
-         "camera.format: unknown camera format \"mjpeg\" (yuyv, nv12, rgb24 or bgr24)");
+         "camera.format: mjpeg comes from V4L2 webcams only (type v4l2)");
+  expect(live(R"({"type": "sim", "format": "h264"})"),
+         "camera.format: unknown camera format \"h264\" (yuyv, nv12, rgb24, bgr24, or mjpeg "
+         "for a v4l2 camera)");
   expect(live(R"({"type": "sim", "width": 721})"),
          "camera.width: width and height must be even (721x576)");
   expect(live(R"({"type": "sim", "fps": 0})"), "camera.fps: must be within 1 .. 240");

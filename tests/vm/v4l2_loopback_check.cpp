@@ -17,16 +17,26 @@
 //                             (v4l2loopback then takes a new format)
 //   v4l2_loopback_close       close() leaves a black frame for the reader and
 //                             the node open to the next writer
+//   v4l2_loopback_mjpeg       MJPEG frames (a webcam's, written raw) are read
+//                             with the camera's mjpeg option and come back
+//                             decoded to rgb24 within JPEG's loss
 //
 //   camhead_v4l2_loopback_check DEVICE
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
+#include <linux/videodev2.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
 #include "camhead/base/monotonic_clock.h"
 #include "camhead/hal/camera/v4l2/v4l2_camera.h"
+#include "camhead/hal/jpeg/jpeg_frame.h"
 #include "camhead/hal/output/v4l2/v4l2_loopback_sink.h"
 #include "vm_result.h"
 
@@ -141,6 +151,81 @@ std::string describe(const Pair &pair) {
   return pair.sink->status().detail + " | " + pair.camera->status().detail;
 }
 
+// A picture a webcam might send: smooth ramps, which JPEG keeps well.
+std::vector<std::uint8_t> ramps() {
+  std::vector<std::uint8_t> rgb(std::size_t(kWidth) * kHeight * 3);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      std::uint8_t *p = &rgb[(std::size_t(y) * kWidth + x) * 3];
+      p[0] = std::uint8_t(255 * x / (kWidth - 1));
+      p[1] = std::uint8_t(255 * y / (kHeight - 1));
+      p[2] = 96;
+    }
+  return rgb;
+}
+
+// MJPEG written to the loopback node as a webcam's driver would fill it
+// (raw V4L2: the sink writes only YUYV and NV12), read back through the
+// camera with mjpeg set; "" when every frame decodes to the picture.
+std::string mjpeg_round_trip(const std::string &device) {
+  const std::vector<std::uint8_t> picture = ramps();
+  const std::vector<std::uint8_t> jpeg = jpeg::encode_jpeg_rgb(picture, kWidth, kHeight, 90);
+  const int fd = ::open(device.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0)
+    return "open " + device + " for writing failed";
+  v4l2_format fmt{};
+  fmt.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+  fmt.fmt.pix.width = kWidth;
+  fmt.fmt.pix.height = kHeight;
+  fmt.fmt.pix.pixelformat = V4L2_PIX_FMT_MJPEG;
+  fmt.fmt.pix.field = V4L2_FIELD_NONE;
+  fmt.fmt.pix.sizeimage = std::uint32_t(jpeg.size());
+  int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+  std::string problem;
+  if (::ioctl(fd, VIDIOC_S_FMT, &fmt) != 0 || ::ioctl(fd, VIDIOC_STREAMON, &type) != 0 ||
+      ::write(fd, jpeg.data(), jpeg.size()) != ssize_t(jpeg.size()))
+    problem = "writing MJPEG to " + device + " failed";
+  std::unique_ptr<camera::CameraSource> reader;
+  if (problem.empty()) {
+    try {
+      reader = camera::open_v4l2_camera(
+          camera::V4l2CameraOptions{device, PixelFormat::rgb24, kWidth, kHeight, 0, 4, true});
+    } catch (const std::exception &e) {
+      problem = e.what();
+    }
+  }
+  int compared = 0;
+  for (int k = 0; problem.empty() && k < 5; ++k) {
+    if (::write(fd, jpeg.data(), jpeg.size()) != ssize_t(jpeg.size())) {
+      problem = "write of MJPEG frame " + std::to_string(k) + " failed";
+      break;
+    }
+    camera::CapturedFrame frame;
+    if (reader->wait_frame(2000ms, frame) != camera::CaptureResult::frame) {
+      problem = "no frame " + std::to_string(k) + ": " + reader->status().detail;
+      break;
+    }
+    double sum = 0.0;
+    for (std::size_t i = 0; i < picture.size() && i < frame.bytes.size(); ++i)
+      sum += std::abs(int(frame.bytes[i]) - int(picture[i]));
+    const double mean = sum / double(picture.size());
+    if (frame.format.pixel != PixelFormat::rgb24 || frame.bytes.size() != picture.size() ||
+        mean > 3.0)
+      problem = "frame " + std::to_string(k) + " is " + camhead::base::describe(frame.format) +
+                ", mean difference " + std::to_string(mean) + " codes";
+    reader->release(frame);
+    ++compared;
+  }
+  if (problem.empty() && reader->status().errors != 0)
+    problem = "errors counted: " + reader->status().detail;
+  reader.reset();
+  ::close(fd);
+  return problem.empty()
+             ? std::to_string(compared) + " MJPEG frames (" + std::to_string(jpeg.size()) +
+                   " bytes each) decoded within 3 codes of the picture"
+             : problem;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -153,7 +238,7 @@ int main(int argc, char **argv) {
   Pair pair = open_pair(device, PixelFormat::yuyv, error);
   if (!pair.camera) {
     for (const char *name : {"v4l2_loopback_open", "v4l2_loopback_round_trip", "v4l2_loopback_nv12",
-                             "v4l2_loopback_close"})
+                             "v4l2_loopback_close", "v4l2_loopback_mjpeg"})
       print_result(name, false, error);
     return 1;
   }
@@ -209,5 +294,8 @@ int main(int argc, char **argv) {
   problem = nv12.camera ? round_trip(nv12, 4) : error;
   print_result("v4l2_loopback_nv12", problem.empty(),
                problem + (problem.empty() ? "4 frames exact; " + describe(nv12) : ""));
+  nv12 = {};
+  const std::string mjpeg = mjpeg_round_trip(device);
+  print_result("v4l2_loopback_mjpeg", mjpeg.find("decoded within") != std::string::npos, mjpeg);
   return 0;
 }

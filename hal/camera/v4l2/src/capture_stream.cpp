@@ -1,11 +1,14 @@
 // See capture_stream.h.
 #include "capture_stream.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include <sys/mman.h>
 
+#include "camhead/hal/jpeg/jpeg_frame.h"
 #include "camhead/hal/v4l2/pixel_formats.h"
 
 namespace camhead::hal::camera {
@@ -93,7 +96,9 @@ std::unique_ptr<CaptureStream> CaptureStream::open(const StreamRequest &request,
 }
 
 bool CaptureStream::negotiate(const StreamRequest &request, std::string &error) {
-  const auto fourcc = v4l2::fourcc_of(request.format);
+  mjpeg_ = request.mjpeg;
+  const auto fourcc =
+      mjpeg_ ? std::optional<std::uint32_t>(V4L2_PIX_FMT_MJPEG) : v4l2::fourcc_of(request.format);
   if (!fourcc) {
     error = "format " + std::string(base::pixel_format_name(request.format)) +
             " is not a camera format (yuyv, nv12, rgb24 or bgr24)";
@@ -111,21 +116,29 @@ bool CaptureStream::negotiate(const StreamRequest &request, std::string &error) 
     return false;
   }
   const v4l2_pix_format &pix = fmt.fmt.pix;
-  if (pix.pixelformat != *fourcc || pix.width != asked.width || pix.height != asked.height ||
+  // Some webcams call their MJPEG "JPEG": the same frames.
+  const bool same_format = pix.pixelformat == *fourcc || (mjpeg_ && v4l2::is_jpeg(pix.pixelformat));
+  if (!same_format || pix.width != asked.width || pix.height != asked.height ||
       !v4l2::is_whole_frame(pix.field)) {
     bool offers_jpeg = false;
     const std::string offered = offered_formats(file_, offers_jpeg);
     error = "asked " + v4l2::describe(asked) + ", the driver answers " + v4l2::describe(pix);
     if (!offered.empty())
       error += " (it offers " + offered + ")";
-    if (v4l2::is_jpeg(pix.pixelformat) || offers_jpeg)
-      error += "; MJPEG cannot be decoded yet: choose a size the device gives as YUYV, NV12, "
-               "RGB3 or BGR3";
+    if (!mjpeg_ && (v4l2::is_jpeg(pix.pixelformat) || offers_jpeg))
+      error += "; for its MJPEG frames ask for the format mjpeg";
     return false;
   }
   format_.pixel = request.format;
   format_.width = request.width;
   format_.height = request.height;
+  if (mjpeg_) {
+    // Decoded by stb_image: full-range RGB, packed, whatever the driver's
+    // bytesperline and colorimetry fields say of the compressed stream.
+    format_.pixel = base::PixelFormat::rgb24;
+    format_.stride = 0;
+    return true;
+  }
   const std::size_t packed = base::packed_stride(format_.pixel, format_.width);
   if (pix.bytesperline != 0 && pix.bytesperline < packed) {
     error = v4l2::describe(pix) + ": bytesperline " + std::to_string(pix.bytesperline) +
@@ -206,8 +219,11 @@ bool CaptureStream::map_buffers(int count, std::string &error) {
     error = "VIDIOC_REQBUFS gave " + std::to_string(request.count) + " buffers (need 2 to 32)";
     return false;
   }
-  const std::size_t frame = base::frame_bytes(format_);
+  // A compressed frame is as long as it is; the decoded copies are frames.
+  const std::size_t frame = mjpeg_ ? 1 : base::frame_bytes(format_);
   buffers_.resize(request.count);
+  if (mjpeg_)
+    decoded_.assign(request.count, std::vector<std::uint8_t>(base::frame_bytes(format_)));
   for (std::uint32_t i = 0; i < request.count; ++i) {
     v4l2_buffer buffer{};
     buffer.index = i;
@@ -245,8 +261,18 @@ CaptureStream::~CaptureStream() {
 }
 
 std::span<const std::uint8_t> CaptureStream::bytes(int index) const {
+  if (mjpeg_)
+    return decoded_[static_cast<std::size_t>(index)];
   const Buffer &buffer = buffers_[static_cast<std::size_t>(index)];
   return {static_cast<const std::uint8_t *>(buffer.address), base::frame_bytes(format_)};
+}
+
+bool CaptureStream::decode(int index, std::uint32_t bytesused, std::string &error) {
+  const Buffer &buffer = buffers_[static_cast<std::size_t>(index)];
+  const std::span<const std::uint8_t> jpeg(static_cast<const std::uint8_t *>(buffer.address),
+                                           std::min<std::size_t>(bytesused, buffer.length));
+  return jpeg::decode_jpeg_rgb(jpeg, format_.width, format_.height,
+                               decoded_[static_cast<std::size_t>(index)], error);
 }
 
 CaptureStream::Dequeued CaptureStream::dequeue(v4l2_buffer &buffer) {

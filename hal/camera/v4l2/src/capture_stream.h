@@ -27,6 +27,7 @@ struct StreamRequest {
   int height = 0;
   double fps = 0;
   int buffers = 4;
+  bool mjpeg = false; // ask for MJPEG, deliver rgb24 (v4l2_camera.h)
 };
 
 class CaptureStream {
@@ -48,7 +49,14 @@ public:
   [[nodiscard]] int fd() const { return file_.fd(); }
   [[nodiscard]] bool is_open() const { return file_.is_open(); }
   [[nodiscard]] int buffer_count() const { return static_cast<int>(buffers_.size()); }
+  // The frame in buffer `index`: the mapped buffer, or its decoded copy for
+  // a compressed stream.
   [[nodiscard]] std::span<const std::uint8_t> bytes(int index) const;
+  // MJPEG: frames arrive compressed and decode() makes them rgb24.
+  [[nodiscard]] bool compressed() const { return mjpeg_; }
+  // Decodes buffer `index` (bytesused of it) into its rgb24 copy; false with
+  // the reason.
+  [[nodiscard]] bool decode(int index, std::uint32_t bytesused, std::string &error);
 
   enum class Dequeued { buffer, nothing, failed };
   // VIDIOC_DQBUF, non-blocking; `failed` leaves errno set.
@@ -89,6 +97,8 @@ private:
   std::string summary_;
   std::vector<Buffer> buffers_;
   bool streaming_ = false;
+  bool mjpeg_ = false;
+  std::vector<std::vector<std::uint8_t>> decoded_; // one rgb24 frame per buffer (MJPEG)
 };
 
 } // namespace camhead::hal::camera

@@ -156,7 +156,8 @@ CaptureResult V4l2Camera::wait_frame(std::chrono::milliseconds timeout, Captured
       return CaptureResult::disconnected;
     }
     const int index = static_cast<int>(buffer.index);
-    const std::size_t frame_bytes = base::frame_bytes(format_);
+    // A compressed frame's size is its own; it is checked by decoding it.
+    const std::size_t frame_bytes = stream.compressed() ? 1 : base::frame_bytes(format_);
     if ((buffer.flags & V4L2_BUF_FLAG_ERROR) != 0 || buffer.bytesused < frame_bytes) {
       // Corrupt (a USB packet lost) or short: never shown, the buffer goes back.
       ++status_.errors;
@@ -181,6 +182,25 @@ CaptureResult V4l2Camera::wait_frame(std::chrono::milliseconds timeout, Captured
     const FrameSequence::Step step = sequence_.next(buffer.sequence);
     stream.hold(index, step.sequence);
     status_.dropped += step.dropped;
+    lock.unlock();
+
+    // Decoded outside the lock (it takes milliseconds): nobody else touches
+    // a buffer that has not been delivered.
+    std::string undecodable;
+    if (stream.compressed() && !stream.decode(index, buffer.bytesused, undecodable)) {
+      lock.lock();
+      ++status_.errors;
+      status_.detail = name_ + ": dropped a frame: " + undecodable;
+      stream.unhold(index);
+      if (!stream.queue(index)) {
+        const int err = errno;
+        lock.unlock();
+        lose("VIDIOC_QBUF: " + errno_text(err));
+        return CaptureResult::disconnected;
+      }
+      continue;
+    }
+    lock.lock();
     ++status_.frames;
     lock.unlock();
 
@@ -297,6 +317,9 @@ std::unique_ptr<CameraSource> open_v4l2_camera(const V4l2CameraOptions &options)
   if (options.format == base::PixelFormat::xrgb8888)
     throw V4l2CameraError(device + ": format: xrgb8888 is a display format; a camera gives "
                                    "yuyv, nv12, rgb24 or bgr24");
+  if (options.mjpeg && options.format != base::PixelFormat::rgb24)
+    throw V4l2CameraError(device + ": format: MJPEG frames are delivered decoded as rgb24, not " +
+                          std::string(base::pixel_format_name(options.format)));
   base::VideoFormat wanted{options.format, options.width, options.height};
   if (const std::string reason = base::check_video_format(wanted); !reason.empty())
     throw V4l2CameraError(device + ": format: " + reason);
@@ -307,8 +330,8 @@ std::unique_ptr<CameraSource> open_v4l2_camera(const V4l2CameraOptions &options)
   if (options.buffers < 2 || options.buffers > 8)
     throw V4l2CameraError(device + ": buffers: " + std::to_string(options.buffers) +
                           " is not 2 to 8");
-  StreamRequest request{device,         options.format, options.width,
-                        options.height, options.fps,    options.buffers};
+  StreamRequest request{device,      options.format,  options.width, options.height,
+                        options.fps, options.buffers, options.mjpeg};
   std::string error;
   std::unique_ptr<CaptureStream> stream = CaptureStream::open(request, error);
   if (!stream)

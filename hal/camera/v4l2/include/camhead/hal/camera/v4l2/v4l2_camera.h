@@ -51,8 +51,7 @@ namespace camhead::hal::camera {
 struct V4l2CameraOptions {
   // /dev/videoN, or a udev link such as /dev/v4l/by-id/usb-...-video-index0.
   std::string device;
-  // yuyv, nv12, rgb24 or bgr24. A device that offers only MJPEG at this size
-  // is refused with a message saying so: camhead does not decode it yet.
+  // yuyv, nv12, rgb24 or bgr24; with `mjpeg`, rgb24 (the decoded frames).
   base::PixelFormat format = base::PixelFormat::yuyv;
   int width = 0;
   int height = 0;
@@ -62,6 +61,10 @@ struct V4l2CameraOptions {
   // Buffers to ask for, 2 to 8; the driver may give more. 4 keeps one with
   // the caller, one with the renderer and two filling.
   int buffers = 4;
+  // Ask the device for MJPEG (what most USB webcams give at 720p and above)
+  // and deliver each frame decoded to rgb24 on the capture thread. A frame
+  // that does not decode is counted as an error and not delivered.
+  bool mjpeg = false;
 };
 
 // "DEVICE: REASON", thrown by open_v4l2_camera only.
