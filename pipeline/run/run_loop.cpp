@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include <unistd.h>
 
@@ -398,9 +399,10 @@ RunSummary Pipeline::finish() {
         std::fprintf(options_.status, "camhead run: %s: %s\n", sink->name().c_str(),
                      sink->status().detail.c_str());
     }
-  if (stats_ != nullptr && std::fclose(stats_) != 0)
+  // Closed once, here or (after a failed run) by the destructor.
+  if (std::FILE *stats = std::exchange(stats_, nullptr);
+      stats != nullptr && std::fclose(stats) != 0)
     throw std::runtime_error(options_.stats_file->string() + ": write failed");
-  stats_ = nullptr;
   const hal::camera::CameraStatus cam = camera_->status();
   summary.frames_in = counters_.frames_in;
   summary.frames_out = counters_.frames_out;

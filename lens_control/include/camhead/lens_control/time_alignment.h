@@ -36,9 +36,13 @@ struct TimelineParams {
   // Two neighbouring samples further apart than this have a dropout between
   // them: interpolating across it is a guess, marked not fresh.
   std::int64_t stale_after_ns = 50'000'000;
-  // History length; at 100-1000 Hz, 256 samples cover 0.25-2.5 s, far more
-  // than any frame latency.
-  std::size_t capacity = 256;
+  // History length. A frame asks for its mid-exposure, which is as old as
+  // the pipeline's latency when it asks: 650 ms for a 720x576 frame on the
+  // CPU reference of a 2-core machine, seconds in a sanitizer build or behind
+  // a slow simulated camera. 8192 samples hold 8 s at 1 kHz and 80 s at
+  // 100 Hz (128 KiB an axis); a frame older than that gets the oldest
+  // sample, flagged not fresh.
+  std::size_t capacity = 8192;
 };
 
 class AxisTimeline {
