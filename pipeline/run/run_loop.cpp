@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <thread>
 #include <utility>
+#include <variant>
 
 #include <unistd.h>
 
@@ -99,6 +100,9 @@ private:
   base::BoundedQueue<Delivered> captured_{1};
   Counters counters_;
   std::atomic<bool> stopping_{false};
+  // A camera that waits for its consumer (a file not played in real time):
+  // the capture thread waits for the renderer instead of replacing frames.
+  bool lossless_ = false;
   std::int64_t start_ns_ = 0;
   std::int64_t last_output_ns_ = 0; // output thread only
 };
@@ -145,6 +149,8 @@ Pipeline::Pipeline(const RunOptions &options)
     last_frames_.emplace_back(base::frame_bytes(sink->format()));
   for (int i = 0; i < kSlots; ++i)
     (void)free_slots_.push(i);
+  if (const auto *file = std::get_if<FileCameraConfig>(&board_.camera->kind))
+    lossless_ = !file->realtime;
 }
 
 Pipeline::~Pipeline() {
@@ -173,7 +179,11 @@ void Pipeline::capture_loop() {
     if (result != CaptureResult::frame)
       continue;
     ++counters_.frames_in;
-    if (std::optional<Delivered> replaced = captured_.push({frame, base::monotonic_ns()})) {
+    if (lossless_) {
+      // A file played as fast as it is taken: every frame is rendered.
+      if (std::optional<Delivered> refused = captured_.push_waiting({frame, base::monotonic_ns()}))
+        camera_->release(refused->frame);
+    } else if (std::optional<Delivered> replaced = captured_.push({frame, base::monotonic_ns()})) {
       ++counters_.render_busy;
       camera_->release(replaced->frame);
     }
@@ -199,7 +209,9 @@ void Pipeline::render_loop() {
       continue;
     }
     const CapturedFrame &frame = delivered->frame;
-    const std::optional<int> slot_index = free_slots_.pop(200ms);
+    std::optional<int> slot_index = free_slots_.pop(200ms);
+    while (lossless_ && !slot_index && !free_slots_.closed())
+      slot_index = free_slots_.pop(200ms);
     if (!slot_index) {
       ++counters_.output_busy;
       camera_->release(frame);

@@ -39,6 +39,21 @@ public:
     return dropped;
   }
 
+  // Adds `item` once there is room, waiting for it: for a producer that
+  // must lose nothing (a file played as fast as it is taken). After close()
+  // the item itself comes back.
+  std::optional<T> push_waiting(T item) {
+    {
+      std::unique_lock lock(mutex_);
+      room_.wait(lock, [&] { return closed_ || items_.size() < capacity_; });
+      if (closed_)
+        return std::optional<T>(std::move(item));
+      items_.push_back(std::move(item));
+    }
+    ready_.notify_one();
+    return std::nullopt;
+  }
+
   // The oldest item, waiting at most `timeout`; empty on time-out, or once
   // the queue is closed and drained.
   std::optional<T> pop(std::chrono::nanoseconds timeout) {
@@ -49,6 +64,7 @@ public:
       return std::nullopt;
     std::optional<T> item(std::move(items_.front()));
     items_.pop_front();
+    room_.notify_one();
     return item;
   }
 
@@ -60,6 +76,7 @@ public:
       closed_ = true;
     }
     ready_.notify_all();
+    room_.notify_all();
   }
 
   [[nodiscard]] bool closed() const {
@@ -71,6 +88,7 @@ private:
   const std::size_t capacity_;
   mutable std::mutex mutex_;
   std::condition_variable ready_;
+  std::condition_variable room_;
   std::deque<T> items_;
   bool closed_ = false;
 };
