@@ -2,13 +2,11 @@
 #include "camhead/hal/v4l2/device_file.h"
 
 #include <array>
-#include <cstring>
+#include <cerrno>
 #include <utility>
 
 #include <fcntl.h>
 #include <linux/videodev2.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace camhead::hal::v4l2 {
 namespace {
@@ -22,46 +20,14 @@ std::string c_string(const unsigned char *text, std::size_t size) {
 
 } // namespace
 
-std::string errno_text(int err) {
-  std::array<char, 128> buffer{};
-  // The GNU strerror_r returns the text, which need not be in `buffer`.
-  return ::strerror_r(err, buffer.data(), buffer.size());
-}
-
-DeviceFile &DeviceFile::operator=(DeviceFile &&other) noexcept {
-  if (this != &other) {
-    close();
-    fd_ = std::exchange(other.fd_, -1);
-  }
-  return *this;
-}
-
-void DeviceFile::close() {
-  // Not retried on EINTR: Linux has released the descriptor whatever close returns.
-  if (fd_ >= 0)
-    ::close(std::exchange(fd_, -1));
-}
-
 DeviceFile open_device(const std::string &path, std::string &error) {
   if (path.empty()) {
     error = "no device named";
     return {};
   }
-  const int fd = ::open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    error = "cannot open: " + errno_text(errno);
-    return {};
-  }
-  DeviceFile file(fd);
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    error = "cannot check it: " + errno_text(errno);
-    return {};
-  }
-  if (!S_ISCHR(st.st_mode)) {
-    error = "is not a device node (not a V4L2 device)";
-    return {};
-  }
+  DeviceFile file = open_device_node(path, O_RDWR | O_NONBLOCK, error);
+  if (!file.is_open() && error == "is not a device node")
+    error += " (not a V4L2 device)";
   return file;
 }
 

@@ -22,41 +22,10 @@ template <class T> std::uint64_t user_pointer(T *pointer) {
 
 } // namespace
 
-std::string errno_text(int err) {
-  std::array<char, 128> buffer{};
-  // The GNU strerror_r returns the text, which need not be in `buffer`.
-  return ::strerror_r(err, buffer.data(), buffer.size());
-}
-
-CardFile &CardFile::operator=(CardFile &&other) noexcept {
-  if (this != &other) {
-    close();
-    fd_ = std::exchange(other.fd_, -1);
-  }
-  return *this;
-}
-
-void CardFile::close() {
-  // Not retried on EINTR: Linux has released the descriptor whatever close returns.
-  if (fd_ >= 0)
-    ::close(std::exchange(fd_, -1));
-}
-
 CardFile open_card(const std::string &path, std::string &error) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    const int err = errno;
-    error = "cannot open: " + errno_text(err);
-    if (err == ENOENT)
-      error += " (is the display driver loaded? ls /dev/dri)";
-    return CardFile{};
-  }
-  CardFile card(fd);
-  struct stat info {};
-  if (::fstat(fd, &info) != 0 || !S_ISCHR(info.st_mode)) {
-    error = "not a device node";
-    return CardFile{};
-  }
+  CardFile card = hal::open_device_node(path, O_RDWR | O_NONBLOCK, error);
+  if (!card.is_open() && errno == ENOENT)
+    error += " (is the display driver loaded? ls /dev/dri)";
   return card;
 }
 
@@ -65,7 +34,7 @@ std::string driver_name(const CardFile &card) {
   drm_version version{};
   version.name = name.data();
   version.name_len = name.size() - 1;
-  if (!card.ioctl(DRM_IOCTL_VERSION, version))
+  if (!card.ioctl(DRM_IOCTL_VERSION, version, true))
     return {};
   return std::string(name.data(), std::min<std::size_t>(version.name_len, name.size() - 1));
 }
@@ -92,7 +61,7 @@ std::vector<std::string> list_cards() {
 std::optional<Resources> get_resources(const CardFile &card, std::string &error) {
   for (;;) {
     drm_mode_card_res counts{};
-    if (!card.ioctl(DRM_IOCTL_MODE_GETRESOURCES, counts)) {
+    if (!card.ioctl(DRM_IOCTL_MODE_GETRESOURCES, counts, true)) {
       error = "DRM_IOCTL_MODE_GETRESOURCES: " + errno_text(errno) +
               (errno == EOPNOTSUPP || errno == EINVAL ? " (not a mode-setting card)" : "");
       return std::nullopt;
@@ -107,7 +76,7 @@ std::optional<Resources> get_resources(const CardFile &card, std::string &error)
     res.crtc_id_ptr = user_pointer(resources.crtcs.data());
     res.connector_id_ptr = user_pointer(resources.connectors.data());
     res.encoder_id_ptr = user_pointer(resources.encoders.data());
-    if (!card.ioctl(DRM_IOCTL_MODE_GETRESOURCES, res)) {
+    if (!card.ioctl(DRM_IOCTL_MODE_GETRESOURCES, res, true)) {
       error = "DRM_IOCTL_MODE_GETRESOURCES: " + errno_text(errno);
       return std::nullopt;
     }
@@ -135,7 +104,7 @@ std::optional<Connector> get_connector(const CardFile &card, std::uint32_t id, b
     counts.count_modes = 1;
     counts.modes_ptr = user_pointer(&spare);
   }
-  if (!card.ioctl(DRM_IOCTL_MODE_GETCONNECTOR, counts)) {
+  if (!card.ioctl(DRM_IOCTL_MODE_GETCONNECTOR, counts, true)) {
     error = "DRM_IOCTL_MODE_GETCONNECTOR " + std::to_string(id) + ": " + errno_text(errno);
     return std::nullopt;
   }
@@ -155,7 +124,7 @@ std::optional<Connector> get_connector(const CardFile &card, std::uint32_t id, b
     conn.count_props = counts.count_props;
     conn.props_ptr = user_pointer(props.data());
     conn.prop_values_ptr = user_pointer(values.data());
-    if (!card.ioctl(DRM_IOCTL_MODE_GETCONNECTOR, conn)) {
+    if (!card.ioctl(DRM_IOCTL_MODE_GETCONNECTOR, conn, true)) {
       error = "DRM_IOCTL_MODE_GETCONNECTOR " + std::to_string(id) + ": " + errno_text(errno);
       return std::nullopt;
     }
@@ -179,7 +148,7 @@ std::optional<drm_mode_get_encoder> get_encoder(const CardFile &card, std::uint3
                                                 std::string &error) {
   drm_mode_get_encoder encoder{};
   encoder.encoder_id = id;
-  if (!card.ioctl(DRM_IOCTL_MODE_GETENCODER, encoder)) {
+  if (!card.ioctl(DRM_IOCTL_MODE_GETENCODER, encoder, true)) {
     error = "DRM_IOCTL_MODE_GETENCODER " + std::to_string(id) + ": " + errno_text(errno);
     return std::nullopt;
   }
@@ -189,7 +158,7 @@ std::optional<drm_mode_get_encoder> get_encoder(const CardFile &card, std::uint3
 std::optional<drm_mode_crtc> get_crtc(const CardFile &card, std::uint32_t id, std::string &error) {
   drm_mode_crtc crtc{};
   crtc.crtc_id = id;
-  if (!card.ioctl(DRM_IOCTL_MODE_GETCRTC, crtc)) {
+  if (!card.ioctl(DRM_IOCTL_MODE_GETCRTC, crtc, true)) {
     error = "DRM_IOCTL_MODE_GETCRTC " + std::to_string(id) + ": " + errno_text(errno);
     return std::nullopt;
   }
@@ -210,7 +179,7 @@ bool set_crtc(const CardFile &card, std::uint32_t crtc, std::uint32_t fb, std::u
     request.mode = *mode;
     request.mode_valid = 1;
   }
-  if (!card.ioctl(DRM_IOCTL_MODE_SETCRTC, request)) {
+  if (!card.ioctl(DRM_IOCTL_MODE_SETCRTC, request, true)) {
     error = "DRM_IOCTL_MODE_SETCRTC: " + errno_text(errno);
     return false;
   }
@@ -249,7 +218,7 @@ std::optional<DumbBuffer> DumbBuffer::create(const CardFile &card, int width, in
   create.width = static_cast<std::uint32_t>(width);
   create.height = static_cast<std::uint32_t>(height);
   create.bpp = 32;
-  if (!card.ioctl(DRM_IOCTL_MODE_CREATE_DUMB, create)) {
+  if (!card.ioctl(DRM_IOCTL_MODE_CREATE_DUMB, create, true)) {
     error = "DRM_IOCTL_MODE_CREATE_DUMB " + std::to_string(width) + "x" + std::to_string(height) +
             ": " + errno_text(errno);
     return std::nullopt;
@@ -269,7 +238,7 @@ std::optional<DumbBuffer> DumbBuffer::create(const CardFile &card, int width, in
   fb.pixel_format = DRM_FORMAT_XRGB8888;
   fb.handles[0] = create.handle;
   fb.pitches[0] = create.pitch;
-  if (card.ioctl(DRM_IOCTL_MODE_ADDFB2, fb)) {
+  if (card.ioctl(DRM_IOCTL_MODE_ADDFB2, fb, true)) {
     buffer.fb_id_ = fb.fb_id;
   } else {
     // Drivers from before ADDFB2 take the depth/bpp form, which means XRGB8888.
@@ -281,7 +250,7 @@ std::optional<DumbBuffer> DumbBuffer::create(const CardFile &card, int width, in
     legacy.bpp = 32;
     legacy.depth = 24;
     legacy.handle = create.handle;
-    if (!card.ioctl(DRM_IOCTL_MODE_ADDFB, legacy))
+    if (!card.ioctl(DRM_IOCTL_MODE_ADDFB, legacy, true))
       return fail("DRM_IOCTL_MODE_ADDFB2 XRGB8888: " + errno_text(err2) +
                   "; DRM_IOCTL_MODE_ADDFB: " + errno_text(errno));
     buffer.fb_id_ = legacy.fb_id;
@@ -289,7 +258,7 @@ std::optional<DumbBuffer> DumbBuffer::create(const CardFile &card, int width, in
 
   drm_mode_map_dumb map{};
   map.handle = create.handle;
-  if (!card.ioctl(DRM_IOCTL_MODE_MAP_DUMB, map))
+  if (!card.ioctl(DRM_IOCTL_MODE_MAP_DUMB, map, true))
     return fail("DRM_IOCTL_MODE_MAP_DUMB: " + errno_text(errno));
   void *bytes = ::mmap(nullptr, buffer.size_, PROT_READ | PROT_WRITE, MAP_SHARED, card.fd(),
                        static_cast<off_t>(map.offset));
@@ -304,12 +273,12 @@ void DumbBuffer::release(const CardFile &card) {
     ::munmap(std::exchange(map_, nullptr), size_);
   if (fb_id_ != 0) {
     std::uint32_t fb = std::exchange(fb_id_, 0);
-    (void)card.ioctl(DRM_IOCTL_MODE_RMFB, fb);
+    (void)card.ioctl(DRM_IOCTL_MODE_RMFB, fb, true);
   }
   if (handle_ != 0) {
     drm_mode_destroy_dumb destroy{};
     destroy.handle = std::exchange(handle_, 0);
-    (void)card.ioctl(DRM_IOCTL_MODE_DESTROY_DUMB, destroy);
+    (void)card.ioctl(DRM_IOCTL_MODE_DESTROY_DUMB, destroy, true);
   }
   size_ = 0;
 }

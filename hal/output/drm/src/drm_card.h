@@ -17,40 +17,16 @@
 
 #include <drm.h>
 #include <drm_mode.h>
-#include <sys/ioctl.h>
+
+#include "camhead/hal/device_file.h"
 
 namespace camhead::hal::output::drm {
 
-// strerror(err), thread-safe.
-[[nodiscard]] std::string errno_text(int err);
-
-class CardFile {
-public:
-  CardFile() = default;
-  explicit CardFile(int fd) : fd_(fd) {}
-  ~CardFile() { close(); }
-  CardFile(CardFile &&other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
-  CardFile &operator=(CardFile &&other) noexcept;
-  CardFile(const CardFile &) = delete;
-  CardFile &operator=(const CardFile &) = delete;
-
-  [[nodiscard]] int fd() const { return fd_; }
-  [[nodiscard]] bool is_open() const { return fd_ >= 0; }
-  void close();
-
-  // ioctl(fd, request, &arg), again while EINTR or EAGAIN (the kernel asks
-  // for a retry when a mode-setting lock was contended); false with errno.
-  template <class Arg> [[nodiscard]] bool ioctl(unsigned long request, Arg &arg) const {
-    int result = 0;
-    do {
-      result = ::ioctl(fd_, request, &arg);
-    } while (result < 0 && (errno == EINTR || errno == EAGAIN));
-    return result == 0;
-  }
-
-private:
-  int fd_ = -1;
-};
+using hal::errno_text;
+// The card's descriptor; its ioctls are asked with retry_again set: DRM
+// answers EAGAIN when a mode-setting lock was contended (libdrm's drmIoctl
+// retries it too).
+using CardFile = hal::DeviceFile;
 
 // Opens a /dev/dri node read-write, non-blocking (events are polled),
 // close-on-exec. Refuses what is not a character device.

@@ -143,7 +143,7 @@ struct Display {
       buffer.release(card);
     if (master) {
       int unused = 0;
-      (void)card.ioctl(DRM_IOCTL_DROP_MASTER, unused);
+      (void)card.ioctl(DRM_IOCTL_DROP_MASTER, unused, true);
       master = false;
     }
     card.close();
@@ -190,7 +190,7 @@ void open_named_card(const std::string &spec, Display &display) {
 
 void become_master(Display &display) {
   int unused = 0;
-  if (display.card.ioctl(DRM_IOCTL_SET_MASTER, unused)) {
+  if (display.card.ioctl(DRM_IOCTL_SET_MASTER, unused, true)) {
     display.master = true;
     return;
   }
@@ -391,7 +391,7 @@ private:
       flip.fb_id = d.buffers[static_cast<std::size_t>(index)].fb_id();
       flip.flags = DRM_MODE_PAGE_FLIP_EVENT;
       flip.user_data = ++d.flip_serial;
-      if (d.card.ioctl(DRM_IOCTL_MODE_PAGE_FLIP, flip)) {
+      if (d.card.ioctl(DRM_IOCTL_MODE_PAGE_FLIP, flip, true)) {
         d.flip_pending = true;
         d.front = index;
         return true;
@@ -464,7 +464,7 @@ private:
     std::string error;
     if (!d.master) {
       int unused = 0;
-      if (!d.card.ioctl(DRM_IOCTL_SET_MASTER, unused))
+      if (!d.card.ioctl(DRM_IOCTL_SET_MASTER, unused, true))
         return still_dark("DRM master is still held by another program (" + errno_text(errno) +
                           ")");
       d.master = true;
@@ -538,7 +538,7 @@ std::unique_ptr<FrameSink> open_drm_sink(const DrmSinkOptions &options) {
   become_master(d);
   drm_get_cap dumb{};
   dumb.capability = DRM_CAP_DUMB_BUFFER;
-  if (!d.card.ioctl(DRM_IOCTL_GET_CAP, dumb) || dumb.value == 0)
+  if (!d.card.ioctl(DRM_IOCTL_GET_CAP, dumb, true) || dumb.value == 0)
     fail_open(d.label, "the driver offers no dumb buffers (DRM_CAP_DUMB_BUFFER)");
   const std::optional<Resources> resources = get_resources(d.card, error);
   if (!resources)

@@ -9,44 +9,16 @@
 // them), close() only while no other thread uses the descriptor.
 #pragma once
 
-#include <cerrno>
 #include <cstdint>
 #include <optional>
 #include <string>
 
-#include <sys/ioctl.h>
+#include "camhead/hal/device_file.h"
 
 namespace camhead::hal::v4l2 {
 
-// strerror(err), thread-safe.
-[[nodiscard]] std::string errno_text(int err);
-
-class DeviceFile {
-public:
-  DeviceFile() = default;
-  explicit DeviceFile(int fd) : fd_(fd) {}
-  ~DeviceFile() { close(); }
-  DeviceFile(DeviceFile &&other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
-  DeviceFile &operator=(DeviceFile &&other) noexcept;
-  DeviceFile(const DeviceFile &) = delete;
-  DeviceFile &operator=(const DeviceFile &) = delete;
-
-  [[nodiscard]] int fd() const { return fd_; }
-  [[nodiscard]] bool is_open() const { return fd_ >= 0; }
-  void close();
-
-  // ioctl(fd, request, &arg), again while EINTR; false with errno set.
-  template <class Arg> [[nodiscard]] bool ioctl(unsigned long request, Arg &arg) const {
-    int result = 0;
-    do {
-      result = ::ioctl(fd_, request, &arg);
-    } while (result < 0 && errno == EINTR);
-    return result == 0;
-  }
-
-private:
-  int fd_ = -1;
-};
+using hal::DeviceFile;
+using hal::errno_text;
 
 // Opens `path` (a /dev node or a udev link to one, followed) read-write,
 // non-blocking, close-on-exec. Refuses what is not a character device, so a
