@@ -28,6 +28,9 @@ packages=(
   # driver's source, which the lab builds against the same headers as
   # gpio-sim (build_v4l2loopback.sh). Installing it also runs DKMS once.
   v4l2loopback-dkms
+  # The lab's independent V4L2 client: v4l2-ctl reads what the loopback
+  # sink writes (tests/vm/v4l2_loopback.sh).
+  v4l-utils
   # hal/camera/libcamera: the headers and library its module links
   # (camhead itself opens the module at run time), and the vimc IPA module
   # the lab's libcamera check packs (tests/vm/libcamera_vimc.sh).

@@ -5,7 +5,7 @@
 # options Chrome needs (exclusive_caps=1) and unloaded at the end. Where the
 # build machine had no v4l2loopback source the module is not in the lab and
 # the results skip.
-results="v4l2_loopback_open v4l2_loopback_round_trip v4l2_loopback_close v4l2_loopback_nv12 v4l2_loopback_mjpeg"
+results="v4l2_loopback_open v4l2_loopback_round_trip v4l2_loopback_close v4l2_loopback_nv12 v4l2_loopback_mjpeg v4l2_loopback_v4l2ctl"
 say() {
   for name in $results; do
     echo "RESULT $name: $1"
@@ -27,5 +27,19 @@ fi
 
 status=0
 camhead_v4l2_loopback_check /dev/video10 || status=$?
+
+# An independent client reads what camhead's sink writes: v4l2-ctl (Debian's
+# v4l-utils), as a webcam consumer would, frames stored raw and checked.
+if command -v v4l2-ctl >/dev/null; then
+  camhead_v4l2_loopback_check --write /dev/video10 3 &
+  writer=$!
+  sleep 0.5
+  v4l2-ctl -d /dev/video10 --stream-mmap --stream-count=8 --stream-to=/tmp/v4l2ctl.raw \
+    >/tmp/v4l2ctl.log 2>&1 || echo "LAB v4l2_loopback: v4l2-ctl: $(tail -1 /tmp/v4l2ctl.log)"
+  wait "$writer" || echo "LAB v4l2_loopback: the writer failed"
+  camhead_v4l2_loopback_check --verify /tmp/v4l2ctl.raw || status=$?
+else
+  echo "RESULT v4l2_loopback_v4l2ctl: SKIP v4l2-ctl is not in the lab (install v4l-utils: cmake/bootstrap.sh)"
+fi
 rmmod v4l2loopback || echo "LAB v4l2_loopback: rmmod v4l2loopback failed (still in use?)"
 exit "$status"

@@ -22,11 +22,18 @@
 //                             decoded to rgb24 within JPEG's loss
 //
 //   camhead_v4l2_loopback_check DEVICE
+//   camhead_v4l2_loopback_check --write DEVICE SECONDS
+//       writes numbered YUYV frames at 25 fps (for another client to read)
+//   camhead_v4l2_loopback_check --verify FILE
+//       checks frames a client stored raw, one after another: each must be
+//       one of the numbered frames, whole, the numbers increasing; prints
+//       the RESULT line v4l2_loopback_v4l2ctl
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fcntl.h>
@@ -228,7 +235,70 @@ std::string mjpeg_round_trip(const std::string &device) {
 
 } // namespace
 
+// --write: what camhead run does to a webcam consumer, with frames a reader
+// can check.
+int write_for(const std::string &device, double seconds) {
+  try {
+    auto sink = output::open_v4l2_loopback_sink(
+        device, VideoFormat{PixelFormat::yuyv, kWidth, kHeight}, 25);
+    const std::int64_t end = camhead::base::monotonic_ns() + std::int64_t(seconds * 1e9);
+    for (std::uint32_t k = 0; camhead::base::monotonic_ns() < end; ++k) {
+      if (!write_frame(*sink, k)) {
+        std::fprintf(stderr, "write: %s\n", sink->status().detail.c_str());
+        return 1;
+      }
+      std::this_thread::sleep_for(40ms);
+    }
+    return sink->close() ? 0 : 1;
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "write: %s\n", e.what());
+    return 1;
+  }
+}
+
+// --verify: the frames another client (v4l2-ctl) read.
+int verify(const char *path) {
+  std::FILE *in = std::fopen(path, "rb");
+  const std::size_t frame_bytes = std::size_t(kWidth) * kHeight * 2;
+  std::vector<std::uint8_t> frame(frame_bytes);
+  std::string problem = in == nullptr ? std::string("no file ") + path : "";
+  int frames = 0;
+  std::uint32_t last = 0;
+  while (problem.empty()) {
+    const std::size_t got = std::fread(frame.data(), 1, frame_bytes, in);
+    if (got == 0)
+      break;
+    if (got != frame_bytes) {
+      problem = "frame " + std::to_string(frames) + " is " + std::to_string(got) + " bytes, not " +
+                std::to_string(frame_bytes);
+      break;
+    }
+    const std::uint32_t k = number_of(frame);
+    const std::string difference = first_difference(frame, k);
+    if (!difference.empty())
+      problem =
+          "frame " + std::to_string(frames) + " (number " + std::to_string(k) + "): " + difference;
+    else if (frames > 0 && k <= last)
+      problem = "frame numbers go " + std::to_string(last) + " then " + std::to_string(k);
+    last = k;
+    ++frames;
+  }
+  if (in != nullptr)
+    std::fclose(in);
+  if (problem.empty() && frames < 3)
+    problem = "only " + std::to_string(frames) + " frames read";
+  print_result("v4l2_loopback_v4l2ctl", problem.empty(),
+               problem.empty() ? std::to_string(frames) +
+                                     " frames read by v4l2-ctl, each whole and exact, in order"
+                               : problem);
+  return problem.empty() ? 0 : 1;
+}
+
 int main(int argc, char **argv) {
+  if (argc == 4 && std::string(argv[1]) == "--write")
+    return write_for(argv[2], std::atof(argv[3]));
+  if (argc == 3 && std::string(argv[1]) == "--verify")
+    return verify(argv[2]);
   if (argc != 2) {
     std::fprintf(stderr, "usage: camhead_v4l2_loopback_check DEVICE\n");
     return 2;
