@@ -13,46 +13,14 @@
 #include "camhead/hal/lens/trace/trace_replay.h"
 #include "camhead/hal/lens/usb/simulated_usb_lens.h"
 #include "camhead/hal/lens/usb/usb_lens.h"
+#include "trace_curve.h"
 
 namespace camhead::pipeline {
 
 namespace {
 
 namespace hl = hal::lens;
-using Axis = std::optional<std::int32_t> hl::EncoderReading::*;
-
-// Counts of one axis of a trace at trace time t (seconds from its first row),
-// linear between rows, looping over the trace's span; the last known value
-// where the axis has a gap.
-class TraceCurve {
-public:
-  TraceCurve(const hl::LensTrace &trace, Axis axis) {
-    for (const hl::EncoderReading &r : trace.readings)
-      if (r.*axis)
-        points_.push_back(
-            {double(r.t_ns - trace.readings.front().t_ns) * 1e-9, double(*(r.*axis))});
-  }
-  [[nodiscard]] bool empty() const { return points_.empty(); }
-  [[nodiscard]] double span_s() const { return points_.empty() ? 0.0 : points_.back().t; }
-
-  [[nodiscard]] double at(double t) const {
-    if (points_.size() == 1 || span_s() <= 0.0)
-      return points_.front().counts;
-    t = std::fmod(std::max(t, 0.0), span_s());
-    auto hi = std::upper_bound(points_.begin(), points_.end(), t,
-                               [](double v, const Point &p) { return v < p.t; });
-    if (hi == points_.end())
-      return points_.back().counts;
-    const Point &b = *hi, &a = *(hi - 1);
-    return a.counts + (b.counts - a.counts) * (t - a.t) / (b.t - a.t);
-  }
-
-private:
-  struct Point {
-    double t, counts;
-  };
-  std::vector<Point> points_;
-};
+using Axis = TraceCurve::Axis;
 
 std::unique_ptr<hl::LensEncoder> open_trace(const TraceSourceConfig &c) {
   hl::TraceReplayOptions options;
@@ -69,9 +37,11 @@ std::unique_ptr<hl::LensEncoder> open_usb(const UsbSourceConfig &c) {
     return hl::open_usb_lens(config);
   // The simulated board latches its counts from the trace, looping.
   const hl::LensTrace trace = hl::read_lens_trace(*c.simulate);
-  auto focus = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::focus);
-  auto iris = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::iris);
-  auto zoom = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::zoom);
+  // Looping as the trace's own replay does, so that both play one lens.
+  const double period_s = double(hl::loop_period_ns(trace)) * 1e-9;
+  auto focus = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::focus, period_s);
+  auto iris = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::iris, period_s);
+  auto zoom = std::make_shared<TraceCurve>(trace, &hl::EncoderReading::zoom, period_s);
   hl::SimulatedUsbLensOptions options;
   options.rate_hz = 200.0;
   options.serial = c.serial.value_or("SIM0001");
@@ -101,8 +71,8 @@ constexpr int kSimulatedGpioRepeats = 10;
 
 std::optional<hl::gpio::SimulatedQuadratureAxis>
 simulated_axis(const hl::LensTrace &trace, Axis axis, const GpioAxisConfig &a) {
-  const TraceCurve curve(trace, axis);
-  if (curve.empty())
+  if (std::none_of(trace.readings.begin(), trace.readings.end(),
+                   [axis](const hl::EncoderReading &r) { return bool(r.*axis); }))
     return std::nullopt;
   hl::gpio::SimulatedQuadratureAxis sim;
   sim.decoder.reverse = a.reverse;
@@ -111,11 +81,11 @@ simulated_axis(const hl::LensTrace &trace, Axis axis, const GpioAxisConfig &a) {
   sim.decoder.counts_at_index = a.counts_at_index;
   sim.index_count = a.counts_at_index;
   const std::int64_t first = trace.readings.front().t_ns;
-  const std::int64_t span = trace.readings.back().t_ns - first;
+  const std::int64_t period = hl::loop_period_ns(trace); // as the trace's replay loops
   for (int k = 0; k < kSimulatedGpioRepeats; ++k)
     for (const hl::EncoderReading &r : trace.readings)
       if (r.*axis)
-        sim.trajectory.push_back({r.t_ns - first + k * (span + 10'000'000), double(*(r.*axis))});
+        sim.trajectory.push_back({r.t_ns - first + k * period, double(*(r.*axis))});
   return sim;
 }
 

@@ -15,9 +15,9 @@
 #include <optional>
 
 #include "board.h"
-#include "camhead/hal/lens/trace/lens_trace.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/lens_control/lens_state.h"
+#include "trace_curve.h"
 
 namespace camhead::pipeline {
 
@@ -33,17 +33,12 @@ public:
   [[nodiscard]] lens_control::LensState state_at(std::int64_t t_ns) const;
 
 private:
-  TraceLens(hal::lens::LensTrace trace, lens_control::LensProfile profile,
+  TraceLens(const hal::lens::LensTrace &trace, lens_control::LensProfile profile,
             const TraceSourceConfig &config);
-  [[nodiscard]] std::optional<double>
-  counts_at(std::optional<std::int32_t> hal::lens::EncoderReading::*axis,
-            std::int64_t trace_ns) const;
 
-  hal::lens::LensTrace trace_;
   lens_control::LensProfile profile_;
   double speed_;
-  bool loop_;
-  std::int64_t period_ns_ = 0; // as TraceReplay: the span plus one mean interval
+  TraceCurve focus_, iris_, zoom_;
 };
 
 } // namespace camhead::pipeline

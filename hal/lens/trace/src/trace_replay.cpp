@@ -32,6 +32,14 @@ ReplayClock &monotonic_replay_clock() {
   return clock;
 }
 
+std::int64_t loop_period_ns(const LensTrace &trace) {
+  if (trace.readings.size() < 2)
+    return 0;
+  const std::int64_t span = trace.readings.back().t_ns - trace.readings.front().t_ns;
+  const auto intervals = static_cast<std::int64_t>(trace.readings.size() - 1);
+  return span > 0 ? span + span / intervals : 0;
+}
+
 TraceReplay::TraceReplay(LensTrace trace, TraceReplayOptions options)
     : trace_(std::move(trace)), loop_enabled_(options.loop), speed_(options.speed),
       clock_(options.clock != nullptr ? options.clock : &monotonic_replay_clock()),
@@ -43,12 +51,10 @@ TraceReplay::TraceReplay(LensTrace trace, TraceReplayOptions options)
     throw TraceError(trace_.source, 0, "", "replay speed must be > 0 and finite");
   }
   if (loop_enabled_) {
-    const std::int64_t span = trace_.readings.back().t_ns - trace_.readings.front().t_ns;
-    const auto intervals = static_cast<std::int64_t>(trace_.readings.size() - 1);
-    if (intervals == 0 || span <= 0) {
+    period_ns_ = loop_period_ns(trace_);
+    if (period_ns_ == 0) {
       throw TraceError(trace_.source, 0, "", "cannot loop a trace that spans no time");
     }
-    period_ns_ = span + span / intervals;
   }
 }
 

@@ -31,6 +31,12 @@
 
 namespace camhead::hal::lens {
 
+// The period a looping replay repeats with: the trace's span plus one mean
+// sample interval, so that the next loop's first reading follows the last as
+// the samples follow each other. 0 for a trace with no time span (fewer
+// than two readings, or all at one instant): it cannot loop.
+[[nodiscard]] std::int64_t loop_period_ns(const LensTrace &trace);
+
 // The replay's time base. The default is CLOCK_MONOTONIC; tests inject one
 // whose sleep_until just moves its own time forward, so they run instantly.
 class ReplayClock {
