@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -110,7 +111,11 @@ inline double json_number(const std::string &line, const std::string &field) {
   const std::string key = "\"" + field + "\":";
   const std::size_t at = line.find(key);
   EXPECT_NE(at, std::string::npos) << field << " missing in " << line;
-  return at == std::string::npos ? 0.0 : std::stod(line.substr(at + key.size()));
+  if (at == std::string::npos)
+    return 0.0;
+  // The record writes a focus at infinity as null (JSON has no infinity).
+  const std::string value = line.substr(at + key.size());
+  return value.rfind("null", 0) == 0 ? std::numeric_limits<double>::infinity() : std::stod(value);
 }
 
 // The composites of a --record-stats file, with every field checked there;
