@@ -18,6 +18,7 @@
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/scene_loader.h"
 #include "chart_command.h"
 #include "commands.h"
@@ -38,6 +39,7 @@ struct BenchArgs {
   bool adaptive = false;
   bool skip_empty = false;
   double frame_ms = 0.0; // > 0: follow this frame-time target instead of --rpp
+  bool region = false;   // compare the influence region with every pixel
 };
 
 double paper_fps(int rpp) {
@@ -127,10 +129,65 @@ int run_frame_target(const BenchArgs &args, renderer::GpuTracer &tracer,
   return 0;
 }
 
+// --influence-region: each rpp traced over every pixel and over the
+// influence region only (the same composite), on the GPU tracer and, with
+// --cpu-peer, the CPU reference, in one process.
+int run_region_bench(const BenchArgs &args, renderer::GpuTracer &tracer,
+                     const renderer::Scene &scene, const renderer::CompiledScene &compiled) {
+  using namespace camhead::renderer;
+  const LayerSelection layers =
+      args.all_layers ? LayerSelection::all() : LayerSelection::display_only();
+  std::printf("median of %d frames after %d warm-up frames; sampling: %s\n\n", args.frames,
+              args.warmup, args.adaptive ? "adaptive (rpp = mean rays per pixel)" : "uniform");
+  std::printf("| rpp | pixels traced | GPU every pixel ms | GPU region ms | GPU speed-up |%s\n",
+              args.cpu_peer ? " CPU every pixel ms | CPU region ms | CPU speed-up |" : "");
+  std::printf("|-----|---------------|--------------------|---------------|--------------|%s\n",
+              args.cpu_peer ? "--------------------|---------------|--------------|" : "");
+  for (const int rpp : args.rpp) {
+    const gpu::FrameParams frame = make_frame_params(scene, rpp);
+    const InfluenceRegion region = influence_region(compiled, frame);
+    const auto gpu = [&](const InfluenceRegion *r) {
+      return median_frame(args,
+                          [&] {
+                            return args.adaptive ? tracer.render_adaptive(frame, {}, {}, layers, r)
+                                                 : tracer.render(frame, {}, layers, r);
+                          })
+          .total_s;
+    };
+    const double gpu_full = gpu(nullptr), gpu_region = gpu(&region);
+    std::printf("| %3d | %12.1f%% | %18.2f | %13.2f | %11.2fx |", rpp, 100.0 * region.fraction(),
+                gpu_full * 1e3, gpu_region * 1e3, gpu_full / gpu_region);
+    if (args.cpu_peer) {
+      const auto cpu = [&](const InfluenceRegion *r) {
+        return median_frame(args,
+                            [&] {
+                              return args.adaptive
+                                         ? render_cpu_adaptive(compiled, frame, {}, {}, 0, r)
+                                         : render_cpu(compiled, frame, {}, 0, r);
+                            })
+            .total_s;
+      };
+      const double cpu_full = cpu(nullptr), cpu_region = cpu(&region);
+      std::printf(" %18.2f | %13.2f | %11.2fx |", cpu_full * 1e3, cpu_region * 1e3,
+                  cpu_full / cpu_region);
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 int run_bench(const BenchArgs &args) {
   using namespace camhead::renderer;
   try {
     Scene scene = load_scene(args.scene);
+    if (args.region &&
+        (!scene.plate || scene.plate->width != args.width || scene.plate->height != args.height)) {
+      // The region needs a plate (without one the composite is I_m, every
+      // pixel); what it holds costs nothing.
+      scene.plate = Image(args.width, args.height, 3);
+      std::fill(scene.plate->data.begin(), scene.plate->data.end(), 0.18f);
+    }
     if (scene.plate && (scene.plate->width != args.width || scene.plate->height != args.height)) {
       scene.plate.reset(); // the plate only costs one read per pixel
     }
@@ -143,6 +200,8 @@ int run_bench(const BenchArgs &args) {
                 tracer.device_name().c_str());
     if (args.frame_ms > 0.0)
       return run_frame_target(args, tracer, scene);
+    if (args.region)
+      return run_region_bench(args, tracer, scene, compiled);
     std::printf("median of %d frames after %d warm-up frames; read back: %s; sampling: %s\n\n",
                 args.frames, args.warmup, args.all_layers ? "all layers" : "8-bit display image",
                 args.adaptive ? "adaptive (rpp = mean rays per pixel)" : "uniform");
@@ -240,6 +299,9 @@ void add_bench_command(CLI::App &app) {
                 "Trace one sample where no ray of a pixel can meet the scene (always on in\n"
                 "the CPU reference; on the GPU a measurement, see bench/RESULTS.md)");
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
+  cmd->add_flag("--influence-region", args->region,
+                "Time each rpp over every pixel and over the influence region alone (where\n"
+                "the virtual objects, their shadows and reflections can change the frame)");
   cmd->add_flag("--cpu-peer", args->cpu_peer,
                 "Also time the CPU reference on the same frames and print the ratio");
   add_bench_chart_command(*cmd);

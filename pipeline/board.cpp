@@ -109,13 +109,15 @@ private:
       return own;
     };
     if (type == "sim") {
-      d.object({"type"},
-               with_common({"fps", "samples", "disconnect_after_frames", "disconnect_s"}));
+      d.object({"type"}, with_common({"fps", "samples", "cache_mb", "disconnect_after_frames",
+                                      "disconnect_s"}));
       SimCameraConfig sim;
       if (d.has("fps"))
         sim.fps = d.at("fps").number(Range::within(1.0, 240.0));
       if (d.has("samples"))
         sim.samples = std::uint32_t(d.at("samples").integer(1, 4096));
+      if (d.has("cache_mb"))
+        sim.cache_mb = std::uint32_t(d.at("cache_mb").integer(0, 65536));
       if (d.has("disconnect_after_frames"))
         sim.disconnect_after_frames =
             std::uint64_t(d.at("disconnect_after_frames").integer(0, 1 << 30));

@@ -114,6 +114,8 @@ struct LensConfig {
 struct SimCameraConfig {
   double fps = 25.0;
   std::uint32_t samples = 2; // rays per pixel of the simulated world
+  // Memory for pictures already rendered, MiB; 0 renders every frame.
+  std::uint32_t cache_mb = 256;
   // Fault option: the camera goes away after this many frames, for
   // disconnect_s, and comes back.
   std::optional<std::uint64_t> disconnect_after_frames;

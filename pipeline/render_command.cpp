@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/image_io.h"
+#include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/mesh_io.h"
 #include "camhead/renderer/scene_loader.h"
 #include "commands.h"
@@ -28,6 +30,7 @@ struct RenderArgs {
   int threads = 0;
   std::string layer = "composite";
   std::string device;
+  bool no_influence_region = false;
 };
 
 const renderer::Image &pick_layer(const renderer::RenderResult &r, const std::string &layer) {
@@ -44,6 +47,20 @@ const renderer::Image &pick_layer(const renderer::RenderResult &r, const std::st
     return r.depth;
   }
   return r.composite;
+}
+
+// The composite with the pixels outside the influence region at a quarter
+// of their brightness: what --layer region shows.
+void dim_outside(renderer::Image &image, const renderer::InfluenceRegion &region) {
+  std::vector<bool> inside(std::size_t(image.width) * image.height, false);
+  for (const renderer::PixelRect &r : region.rects)
+    for (std::uint32_t y = r.y0; y < r.y1; ++y)
+      for (std::uint32_t x = r.x0; x < r.x1; ++x)
+        inside[std::size_t(y) * image.width + x] = true;
+  for (std::size_t i = 0; i < inside.size(); ++i)
+    if (!inside[i])
+      for (int c = 0; c < image.channels; ++c)
+        image.data[i * image.channels + c] *= 0.25f;
 }
 
 // Refuses an output that could not be written before spending a long render
@@ -77,9 +94,20 @@ int run_render(const RenderArgs &args) {
     const CompiledScene compiled = compile_scene(scene);
     const gpu::FrameParams frame = make_frame_params(scene, args.rpp);
     const int rpp = int(frame.sampling.z);
-    std::fprintf(stderr, "%s: %dx%d, %d rpp, %zu primitives, %zu lights\n", args.scene.c_str(),
-                 scene.render.width, scene.render.height, rpp, compiled.primitives.size(),
-                 compiled.lights.size());
+    // The region leaves the layers other than the composite unmade outside it.
+    const bool use_region =
+        !args.no_influence_region && (args.layer == "composite" || args.layer == "region");
+    const InfluenceRegion region = use_region ? influence_region(compiled, frame)
+                                              : whole_frame_region(frame.image.x, frame.image.y);
+    std::fprintf(stderr,
+                 "%s: %dx%d, %d rpp, %zu primitives, %zu lights, %.1f %% of the pixels "
+                 "traced%s\n",
+                 args.scene.c_str(), scene.render.width, scene.render.height, rpp,
+                 compiled.primitives.size(), compiled.lights.size(), 100.0 * region.fraction(),
+                 !use_region            ? ""
+                 : !scene.plate         ? " (no plate: the composite is the render)"
+                 : region.whole_frame() ? " (the virtual objects reach everywhere)"
+                                        : " (the influence region)");
 
     RenderResult result;
     std::string executor;
@@ -87,8 +115,9 @@ int run_render(const RenderArgs &args) {
       executor = "CPU reference";
       ProgressLine progress("render (CPU)");
       const ProgressFn report = [&](int done, int total) { progress.update(done, total); };
-      result = args.adaptive ? render_cpu_adaptive(compiled, frame, {}, report, args.threads)
-                             : render_cpu(compiled, frame, report, args.threads);
+      result = args.adaptive
+                   ? render_cpu_adaptive(compiled, frame, {}, report, args.threads, &region)
+                   : render_cpu(compiled, frame, report, args.threads, &region);
       progress.finish();
     } else {
       GpuTracer tracer(args.device);
@@ -96,10 +125,12 @@ int run_render(const RenderArgs &args) {
       ProgressLine progress("render (" + executor + ")");
       tracer.load(compiled);
       const ProgressFn report = [&](int done, int total) { progress.update(done, total); };
-      result =
-          args.adaptive ? tracer.render_adaptive(frame, {}, report) : tracer.render(frame, report);
+      result = args.adaptive ? tracer.render_adaptive(frame, {}, report, {}, &region)
+                             : tracer.render(frame, report, {}, &region);
       progress.finish();
     }
+    if (args.layer == "region")
+      dim_outside(result.composite, region);
     write_image(args.output, pick_layer(result, args.layer));
     const double rays_per_second = double(result.camera_rays) / result.seconds;
     std::fprintf(stderr, "%s: %s written; %.3f s on %s, %.1f M camera rays/s (%.1f fps)\n",
@@ -141,13 +172,19 @@ void add_render_command(CLI::App &app) {
   cmd->add_option("--layer", args->layer,
                   "composite: I_f, the camera image with the virtual objects;\n"
                   "mixed: I_m, real proxy + virtual; real: I_r, real proxy alone;\n"
-                  "mask: M, virtual coverage; depth: mean camera-axis depth (m)")
-      ->check(CLI::IsMember({"composite", "mixed", "real", "mask", "depth"}));
+                  "mask: M, virtual coverage; depth: mean camera-axis depth (m);\n"
+                  "region: the composite, darkened outside the influence region (the pixels\n"
+                  "the virtual objects, their shadows and reflections can change)")
+      ->check(CLI::IsMember({"composite", "mixed", "real", "mask", "depth", "region"}));
   cmd->add_flag("--cpu", args->cpu, "Use the CPU reference tracer instead of Vulkan");
   cmd->add_flag("--adaptive", args->adaptive,
                 "Adaptive ray budget: --rpp on average, shared out per pixel by a pilot's\n"
                 "variance and circle of confusion (renderer adaptive.h)");
   cmd->add_option("--threads", args->threads, "CPU threads for --cpu (default: all)");
+  cmd->add_flag("--no-influence-region", args->no_influence_region,
+                "Trace every pixel. By default a composite traces only where the virtual\n"
+                "objects, their shadows and their reflections can change it (the same image,\n"
+                "bit for bit); the other layers always trace every pixel");
   cmd->add_option("--device", args->device,
                   "Vulkan device by index or name substring (see camhead devices);\n"
                   "default: the first GPU, else lavapipe");

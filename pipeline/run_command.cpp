@@ -26,6 +26,7 @@ struct RunArgs {
   std::string stats;
   std::string executor;
   int threads = 0;
+  bool no_influence_region = false;
 };
 
 std::atomic<bool> stop_requested{false};
@@ -54,6 +55,7 @@ int run(const RunArgs &args) {
   else if (args.executor == "auto")
     options.executor = pipeline::Executor::automatic;
   options.threads = args.threads;
+  options.influence_region = !args.no_influence_region;
   options.stop = &stop_requested;
 
   stop_requested = false;
@@ -129,6 +131,10 @@ void add_run_command(CLI::App &app) {
       ->check(CLI::IsMember({"auto", "cpu", "gpu"}));
   cmd->add_option("--threads", args->threads, "CPU executor threads (0: one per core)")
       ->check(CLI::Range(0, 256));
+  cmd->add_flag("--no-influence-region", args->no_influence_region,
+                "Trace every pixel, not only where the virtual objects, their shadows and\n"
+                "their reflections can change the frame (the same video, bit for bit; for\n"
+                "comparing the cost)");
   cmd->callback([args] { set_exit_code(run(*args)); });
 }
 

@@ -20,13 +20,13 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"render_start_ns\":%" PRId64 ",\"render_end_ns\":%" PRId64 ",\"output_ns\":%" PRId64
       ",\"focus_m\":%s,\"f_number\":%.6g"
       ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"rpp\":%u,\"camera_rays\":%" PRIu64
-      ",\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
+      ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
       ",\"encode_ms\":%.3f,\"executor\":\"%s\"}\n",
       output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns, r.render_start_ns,
       r.render_end_ns, output_ns,
       std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
-      r.focal_length_mm, r.lens_fresh ? "true" : "false", r.rpp, r.camera_rays, r.dropped_before,
-      1e3 * r.decode_s, 1e3 * r.trace_s, 1e3 * r.encode_s, executor.c_str());
+      r.focal_length_mm, r.lens_fresh ? "true" : "false", r.rpp, r.camera_rays, r.traced,
+      r.dropped_before, 1e3 * r.decode_s, 1e3 * r.trace_s, 1e3 * r.encode_s, executor.c_str());
 }
 
 } // namespace camhead::pipeline

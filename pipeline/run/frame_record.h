@@ -20,6 +20,7 @@ struct FrameRecord {
   bool lens_fresh = false;
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;
+  double traced = 1.0;              // the fraction of the pixels traced (the influence region)
   std::uint64_t dropped_before = 0; // camera, render-busy and output-busy drops since the last
   double decode_s = 0.0, trace_s = 0.0, encode_s = 0.0;
 };

@@ -1,8 +1,16 @@
 #include "rig_setup.h"
 
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/camera/libcamera/libcamera_camera.h"
@@ -24,6 +32,65 @@ renderer::Scene real_world_of(renderer::Scene scene) {
   return scene;
 }
 
+// The simulated world's pictures already rendered, by the exact camera they
+// were rendered for. Rendering the world costs as much as a frame of the
+// pipeline (more: every pixel is traced); a looped trace on the camera's
+// frame clock repeats its lens states exactly, so from its second loop on
+// the simulated camera costs a copy and the pipeline has the machine to
+// itself. Filled until `capacity` bytes, then only read.
+class WorldPictures {
+public:
+  explicit WorldPictures(std::size_t capacity) : capacity_(capacity) {}
+
+  bool copy(const renderer::FrameCamera &camera, std::span<std::uint8_t> out) {
+    const std::lock_guard lock(mutex_);
+    const auto it = pictures_.find(key_of(camera));
+    if (it == pictures_.end() || it->second.size() != out.size())
+      return false;
+    std::copy(it->second.begin(), it->second.end(), out.begin());
+    return true;
+  }
+
+  void keep(const renderer::FrameCamera &camera, std::span<const std::uint8_t> picture) {
+    const std::lock_guard lock(mutex_);
+    if (used_ + picture.size() > capacity_)
+      return;
+    if (pictures_.try_emplace(key_of(camera), picture.begin(), picture.end()).second)
+      used_ += picture.size();
+  }
+
+private:
+  using Key = std::array<std::uint32_t, 15>;
+
+  // Every field's bits: two cameras share a picture only if they are equal.
+  static Key key_of(const renderer::FrameCamera &c) {
+    static_assert(sizeof(renderer::FrameCamera) == sizeof(Key), "a FrameCamera field is not keyed");
+    const float fields[15] = {c.position.x,
+                              c.position.y,
+                              c.position.z,
+                              c.look_at.x,
+                              c.look_at.y,
+                              c.look_at.z,
+                              c.up.x,
+                              c.up.y,
+                              c.up.z,
+                              c.focus_distance_m,
+                              c.f_number,
+                              c.focal_length_mm,
+                              c.projection_focal_length_mm,
+                              c.sensor_width_mm,
+                              c.entrance_pupil_offset_m};
+    Key key;
+    std::memcpy(key.data(), fields, sizeof fields);
+    return key;
+  }
+
+  std::mutex mutex_;
+  std::map<Key, std::vector<std::uint8_t>> pictures_;
+  std::size_t capacity_;
+  std::size_t used_ = 0;
+};
+
 // The simulated camera's picture: the scene's real objects through the lens
 // at each exposure's middle, rendered by its own frame renderer, with a new
 // noise pattern every frame as a sensor has. The lens is the physical truth
@@ -43,16 +110,21 @@ std::unique_ptr<CameraSource> open_sim_camera(const SimCameraConfig &sim,
   options.disconnect_after_frames = sim.disconnect_after_frames;
   options.disconnect_s = sim.disconnect_s;
   const std::uint32_t samples = sim.samples;
-  auto generator = [world, format, pose, samples, &lens,
+  auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
+  auto generator = [world, cache, format, pose, samples, &lens,
                     truth = std::move(truth)](std::int64_t start_ns, std::int64_t exposure_ns,
                                               std::span<std::uint8_t> out) {
     const std::int64_t mid = start_ns + exposure_ns / 2;
     renderer::FrameRequest request;
     request.camera = lens_camera(pose, truth ? truth->state_at(mid) : lens.state_at(mid).state);
+    if (cache->copy(request.camera, out))
+      return;
     request.rays_per_pixel = samples;
     request.seed = std::uint32_t(start_ns / 1000) | 1u;
     const renderer::VideoBuffer target{format, out};
-    (void)world->render(request, {format, {}}, std::span(&target, 1));
+    if (world->render(request, {format, {}}, std::span(&target, 1)).status ==
+        renderer::FrameStatus::ok)
+      cache->keep(request.camera, out);
   };
   return hal::camera::open_simulated_camera(options, std::move(generator));
 }

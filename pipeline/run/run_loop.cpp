@@ -51,7 +51,8 @@ struct Counters {
   std::atomic<std::uint64_t> frames_in{0}, frames_out{0}, render_busy{0}, output_busy{0},
       render_failed{0}, placeholders{0}, repeats{0}, sink_errors{0};
   std::atomic<std::uint32_t> rpp{0};
-  std::atomic<std::int64_t> latency_ns{0}; // capture to output, last frame
+  std::atomic<std::uint32_t> traced_permille{1000}; // of the last frame's pixels
+  std::atomic<std::int64_t> latency_ns{0};          // capture to output, last frame
   std::atomic<bool> camera_lost{false};
   std::atomic<bool> renderer_lost{false}; // the GPU is gone: placeholders from now on
 };
@@ -240,6 +241,7 @@ void Pipeline::render_loop() {
     request.rays_per_pixel = board_.render.rays_per_pixel.value_or(budget.rpp());
     request.adaptive = board_.render.adaptive;
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
+    request.influence_region = options_.influence_region;
     r.rpp = request.rays_per_pixel;
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
@@ -257,6 +259,8 @@ void Pipeline::render_loop() {
       continue;
     }
     r.camera_rays = report.camera_rays;
+    r.traced = report.frame_pixels > 0 ? double(report.traced_pixels) / report.frame_pixels : 1.0;
+    counters_.traced_permille = std::uint32_t(std::lround(1000.0 * r.traced));
     r.decode_s = report.decode_s;
     r.trace_s = report.trace_s;
     r.encode_s = report.encode_s;
@@ -347,9 +351,11 @@ void Pipeline::print_status(std::int64_t now, double dt, std::uint64_t in, std::
                       : counters_.camera_lost ? "  CAMERA LOST: placeholder"
                                               : "";
   std::fprintf(options_.status,
-               "%sin %5.1f fps  out %5.1f fps  rpp %u  dropped %" PRIu64 " (camera %" PRIu64
-               ", render busy %" PRIu64 ")  focus %s f/%.1f %.0f mm%s  latency %.0f ms%s%s",
+               "%sin %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
+               " (camera %" PRIu64 ", render busy %" PRIu64
+               ")  focus %s f/%.1f %.0f mm%s  latency %.0f ms%s%s",
                tty ? "\r\033[K" : "", double(in) / dt, double(out) / dt, counters_.rpp.load(),
+               0.1 * counters_.traced_permille.load(),
                cam.dropped + counters_.render_busy + counters_.output_busy, cam.dropped,
                counters_.render_busy.load(), focus, lens.state.f_number.value,
                lens.state.focal_length_mm.value, lens.fresh ? "" : " (stale)",

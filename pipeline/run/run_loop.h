@@ -37,7 +37,10 @@ struct RunOptions {
   std::optional<std::filesystem::path> stats_file;
   std::optional<Executor> executor; // overrides the board's
   int threads = 0;                  // CPU executor; <= 0: one per hardware thread
-  std::FILE *status = stderr;       // the status line; null: none
+  // Trace only where the virtual objects can change the composite
+  // (renderer influence_region.h); false traces every pixel, for comparison.
+  bool influence_region = true;
+  std::FILE *status = stderr; // the status line; null: none
   const std::atomic<bool> *stop = nullptr;
 };
 

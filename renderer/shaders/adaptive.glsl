@@ -36,6 +36,12 @@
 #define ADAPTIVE_LOG2_LAMBDA_RANGE 126.0f
 #define ADAPTIVE_BISECTION_STEPS 40
 
+// The pixels that share the frame's budget: the influence region's
+// (frame.adaptive.z), or all of them.
+float adaptive_pixels() {
+  return frame.adaptive.z > 0.0f ? frame.adaptive.z : float(frame.image.x) * float(frame.image.y);
+}
+
 // The pilot's per-sample mean and unbiased variance of one pixel's composite
 // luminance, from its aux accumulator of n samples.
 vec2 adaptive_moments(vec4 aux, float n) {

@@ -37,7 +37,7 @@ void main() {
   for (uint g = t; g < tiles; g += ADAPTIVE_SOLVE_THREADS) {
     luminance += adaptive_groups[g];
   }
-  float pixels = float(frame.image.x) * float(frame.image.y);
+  float pixels = adaptive_pixels();
   float floor_weight =
       ADAPTIVE_FLOOR_FRACTION * workgroup_sum(luminance) / pixels + ADAPTIVE_FLOOR_ABSOLUTE;
 

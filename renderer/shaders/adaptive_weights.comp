@@ -34,6 +34,8 @@ void main() {
     barrier();
   }
   if (t == 0u) {
-    adaptive_groups[gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x] = tile_luminance[0];
+    // By the tile's place in the image: a region's dispatches cover part of it.
+    uint tiles_x = (frame.image.x + CAMHEAD_TILE_X - 1u) / CAMHEAD_TILE_X;
+    adaptive_groups[gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x] = tile_luminance[0];
   }
 }

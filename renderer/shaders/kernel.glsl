@@ -402,10 +402,12 @@ struct Resolved {
 // evaluated as I_c + (I_m - I_r) - M (I_c - I_r), which returns I_c bit for
 // bit where nothing virtual is seen (M = 0 and I_m == I_r). Without a plate
 // the real render stands in for the camera image, so I_f = I_m.
-// `samples`: the pixel's sample count (frame.sampling.z, or its adaptive n_i).
+// `samples`: the pixel's sample count (frame.sampling.z, or its adaptive n_i;
+// 0 outside the influence region, whose accumulators are zero: the camera
+// image).
 Resolved resolve_pixel(vec4 acc_mixed, vec4 acc_real, vec4 acc_aux, vec4 plate, bool has_plate,
                        uint samples) {
-  float inv = 1.0f / float(samples);
+  float inv = samples > 0u ? 1.0f / float(samples) : 0.0f;
   Resolved r;
   r.mixed = vec3(acc_mixed) * inv;
   r.real = vec3(acc_real) * inv;

@@ -81,7 +81,8 @@ struct FrameParams {
   uvec4 sampling; // x: first sample, y: end sample (exclusive), z: total samples per pixel, w: seed
   uvec4 tracing;  // x: max_bounces; y: adaptive pilot samples (0 = uniform); z: camera
                   // sampler (SAMPLER_*); w: TRACING_* flags
-  vec4 adaptive;  // adaptive allocation: x coc_weight, y cap (samples per pixel); z, w: reserved
+  vec4 adaptive;  // adaptive allocation: x coc_weight, y cap (samples per pixel), z pixels
+                  // sharing the budget (the influence region's; 0 = all); w reserved
 };
 
 // Camera-ray samplers (FrameParams.tracing.z, sampling.glsl).

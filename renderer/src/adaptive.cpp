@@ -62,7 +62,8 @@ gpu::vec4 adaptive_parameters(const AdaptiveSampling &settings, std::uint32_t pi
 
 std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux,
                                             const gpu::FrameParams &frame, std::uint32_t pilot,
-                                            const AdaptiveSampling &settings) {
+                                            const AdaptiveSampling &settings,
+                                            const InfluenceRegion *region) {
   using cpu::kSolveThreads;
   using cpu::kTileX;
   using cpu::kTileY;
@@ -75,40 +76,45 @@ std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux
   const std::uint32_t width = frame.image.x;
   const std::uint32_t height = frame.image.y;
   const std::size_t pixels = std::size_t(width) * height;
+  const InfluenceRegion everything = whole_frame_region(width, height);
+  const InfluenceRegion &shared = region != nullptr ? *region : everything;
+  if (region != nullptr)
+    k.frame.adaptive.z = float(region->pixels());
 
   // 1. adaptive_weights.comp: weights, histogram, tile luminance, a tile
-  //    (workgroup) at a time.
-  std::vector<float> weights(pixels);
+  //    (workgroup) at a time, over the region's tiles (the others stay 0).
+  std::vector<float> weights(pixels, 0.0f);
   std::vector<std::uint32_t> histogram(2 * ADAPTIVE_BINS, 0u);
   const std::uint32_t tiles_x = (width + kTileX - 1) / kTileX;
   const std::uint32_t tiles_y = (height + kTileY - 1) / kTileY;
-  std::vector<float> tiles(std::size_t(tiles_x) * tiles_y);
-  for (std::uint32_t ty = 0; ty < tiles_y; ++ty)
-    for (std::uint32_t tx = 0; tx < tiles_x; ++tx) {
-      // By local invocation index, as the kernel's shared array.
-      std::array<float, kTileX * kTileY> luminance{};
-      for (std::uint32_t t = 0; t < kTileX * kTileY; ++t) {
-        const std::uint32_t x = tx * kTileX + t % kTileX, y = ty * kTileY + t / kTileX;
-        if (x >= width || y >= height)
-          continue;
-        const std::size_t i = std::size_t(y) * width + x;
-        const float w = k.adaptive_weight(int(x), int(y));
-        weights[i] = w;
-        const std::uint32_t bin = k.adaptive_bin(w);
-        histogram[2 * bin] += 1u;
-        histogram[2 * bin + 1] += k.adaptive_bin_offset(w);
-        luminance[t] = std::abs(k.adaptive_moments(pilot_aux[i], float(pilot)).x);
+  std::vector<float> tiles(std::size_t(tiles_x) * tiles_y, 0.0f);
+  for (const PixelRect &rect : shared.rects)
+    for (std::uint32_t ty = rect.y0 / kTileY; ty * kTileY < rect.y1; ++ty)
+      for (std::uint32_t tx = rect.x0 / kTileX; tx * kTileX < rect.x1; ++tx) {
+        // By local invocation index, as the kernel's shared array.
+        std::array<float, kTileX * kTileY> luminance{};
+        for (std::uint32_t t = 0; t < kTileX * kTileY; ++t) {
+          const std::uint32_t x = tx * kTileX + t % kTileX, y = ty * kTileY + t / kTileX;
+          if (x >= width || y >= height)
+            continue;
+          const std::size_t i = std::size_t(y) * width + x;
+          const float w = k.adaptive_weight(int(x), int(y));
+          weights[i] = w;
+          const std::uint32_t bin = k.adaptive_bin(w);
+          histogram[2 * bin] += 1u;
+          histogram[2 * bin + 1] += k.adaptive_bin_offset(w);
+          luminance[t] = std::abs(k.adaptive_moments(pilot_aux[i], float(pilot)).x);
+        }
+        tiles[std::size_t(ty) * tiles_x + tx] = cpu::tree_sum(luminance);
       }
-      tiles[std::size_t(ty) * tiles_x + tx] = cpu::tree_sum(luminance);
-    }
 
   // 2. adaptive_solve.comp: floor weight and water level.
   std::array<float, kSolveThreads> partial{};
   for (std::size_t g = 0; g < tiles.size(); ++g)
     partial[g % kSolveThreads] += tiles[g];
+  const float sharing = k.adaptive_pixels();
   const float floor_weight =
-      ADAPTIVE_FLOOR_FRACTION * cpu::tree_sum(partial) / (float(width) * float(height)) +
-      ADAPTIVE_FLOOR_ABSOLUTE;
+      ADAPTIVE_FLOOR_FRACTION * cpu::tree_sum(partial) / sharing + ADAPTIVE_FLOOR_ABSOLUTE;
   std::vector<float> mean_weight(ADAPTIVE_BINS, 0.0f);
   for (std::uint32_t bin = 0; bin < ADAPTIVE_BINS; ++bin)
     if (histogram[2 * bin] > 0)
@@ -122,7 +128,7 @@ std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux
                                                         lambda, floor_weight, pilot_f, cap);
     return cpu::tree_sum(sums);
   };
-  const float budget = float(width) * float(height) * float(k.frame.sampling.z);
+  const float budget = sharing * float(k.frame.sampling.z);
   float low = -ADAPTIVE_LOG2_LAMBDA_RANGE, high = ADAPTIVE_LOG2_LAMBDA_RANGE;
   for (int step = 0; step < ADAPTIVE_BISECTION_STEPS; ++step) {
     const float middle = 0.5f * (low + high);
@@ -130,10 +136,15 @@ std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux
   }
   const float lambda = glm::exp2(high);
 
-  // 3. adaptive_shares.comp.
-  std::vector<std::uint32_t> counts(pixels);
-  for (std::size_t i = 0; i < pixels; ++i)
-    counts[i] = k.adaptive_share(weights[i], std::uint32_t(i), lambda, floor_weight, pilot_f, cap);
+  // 3. adaptive_shares.comp, over the region's pixels.
+  std::vector<std::uint32_t> counts(pixels, 0u);
+  for (const PixelRect &rect : shared.rects)
+    for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+      for (std::uint32_t x = rect.x0; x < rect.x1; ++x) {
+        const std::size_t i = std::size_t(y) * width + x;
+        counts[i] =
+            k.adaptive_share(weights[i], std::uint32_t(i), lambda, floor_weight, pilot_f, cap);
+      }
   return counts;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -189,6 +190,29 @@ gpu::Light compile_light(const Light &l, const glm::vec3 &origin) {
   return g;
 }
 
+// The bounds of primitives [first, end) of `prims`, false when empty.
+bool primitive_bounds(const std::vector<gpu::Primitive> &prims, std::size_t first,
+                      ObjectBounds &b) {
+  if (first == prims.size())
+    return false;
+  b.lo = glm::vec3(std::numeric_limits<float>::infinity());
+  b.hi = -b.lo;
+  for (std::size_t i = first; i < prims.size(); ++i) {
+    const gpu::Primitive &p = prims[i];
+    const glm::vec3 p0(p.p0);
+    if ((glm::floatBitsToUint(p.p0.w) >> 24) == PRIM_SPHERE) {
+      b.lo = glm::min(b.lo, p0 - glm::vec3(p.p1.x));
+      b.hi = glm::max(b.hi, p0 + glm::vec3(p.p1.x));
+      continue;
+    }
+    for (const glm::vec3 &v : {p0, p0 + glm::vec3(p.p1), p0 + glm::vec3(p.p2)}) {
+      b.lo = glm::min(b.lo, v);
+      b.hi = glm::max(b.hi, v);
+    }
+  }
+  return true;
+}
+
 std::vector<glm::vec4> compile_plate(const Scene &scene) {
   const Image &img = *scene.plate;
   if (img.width != scene.render.width || img.height != scene.render.height ||
@@ -216,8 +240,22 @@ CompiledScene compile_scene(const Scene &scene) {
   constexpr float kOriginGridM = 64.0f;
   out.origin = glm::round(scene.camera.position / kOriginGridM) * kOriginGridM;
   std::vector<gpu::Primitive> prims;
-  for (const Object &o : scene.objects)
+  for (const Object &o : scene.objects) {
+    const std::size_t first = prims.size();
     add_object(prims, o, out.origin);
+    ObjectBounds bounds;
+    if (!primitive_bounds(prims, first, bounds))
+      continue;
+    // An index past the materials is the scene loader's error to report; the
+    // kernel reads such primitives as diffuse.
+    const MaterialType type = std::size_t(o.material) < scene.materials.size()
+                                  ? scene.materials[std::size_t(o.material)].type
+                                  : MaterialType::diffuse;
+    bounds.real = o.real;
+    bounds.specular = type == MaterialType::mirror || type == MaterialType::glass;
+    bounds.shaded = type == MaterialType::diffuse;
+    out.objects.push_back(bounds);
+  }
   Bvh bvh = build_bvh(std::move(prims));
   out.primitives = std::move(bvh.primitives);
   out.nodes = std::move(bvh.nodes);

@@ -70,33 +70,48 @@ struct Accumulators {
   std::vector<glm::vec4> mixed, real, aux;
 };
 
-// Runs kernel.trace_pixel over every pixel on `threads` threads; `report`
-// gets the fraction of rows done.
-void trace_all(cpu::CpuKernel &kernel, const CompiledScene &scene, Accumulators &acc, int threads,
+// A row's stretch of the pixels to trace.
+struct RowSpan {
+  std::uint32_t y, x0, x1;
+};
+
+// The region's rows, or every row of the frame.
+std::vector<RowSpan> row_spans(const cpu::CpuKernel &kernel, const InfluenceRegion *region) {
+  const InfluenceRegion whole = whole_frame_region(kernel.frame.image.x, kernel.frame.image.y);
+  std::vector<RowSpan> spans;
+  for (const PixelRect &rect : (region != nullptr ? *region : whole).rects)
+    for (std::uint32_t y = rect.y0; y < rect.y1; ++y)
+      spans.push_back({y, rect.x0, rect.x1});
+  return spans;
+}
+
+// Runs kernel.trace_pixel over the pixels of `spans` on `threads` threads;
+// `report` gets the fraction of spans done.
+void trace_all(cpu::CpuKernel &kernel, const CompiledScene &scene, Accumulators &acc,
+               const std::vector<RowSpan> &spans, int threads,
                const std::function<void(double)> &report) {
   const int width = int(kernel.frame.image.x);
-  const int height = int(kernel.frame.image.y);
-  const std::size_t pixels = std::size_t(width) * height;
+  const std::size_t pixels = std::size_t(width) * kernel.frame.image.y;
   const bool has_plate = kernel.frame.image.z != 0;
   if (threads <= 0) {
     threads = int(std::max(1u, std::thread::hardware_concurrency()));
   }
-  RowQueue queue(height);
+  RowQueue queue(int(spans.size()));
   std::atomic<int> rows_done{0};
   std::mutex progress_mutex;
   auto worker = [&] {
-    for (int y = queue.next(); y >= 0; y = queue.next()) {
-      for (int x = 0; x < width; ++x) {
-        const std::size_t i = std::size_t(y) * width + x;
+    for (int next = queue.next(); next >= 0; next = queue.next()) {
+      const RowSpan &span = spans[std::size_t(next)];
+      for (std::uint32_t x = span.x0; x < span.x1; ++x) {
+        const std::size_t i = std::size_t(span.y) * width + x;
         const glm::vec4 plate =
             has_plate && scene.plate.size() == pixels ? scene.plate[i] : glm::vec4(0.0f);
-        kernel.trace_pixel(uint32_t(x), uint32_t(y), plate, has_plate, acc.mixed[i], acc.real[i],
-                           acc.aux[i]);
+        kernel.trace_pixel(x, span.y, plate, has_plate, acc.mixed[i], acc.real[i], acc.aux[i]);
       }
       const int done = rows_done.fetch_add(1) + 1;
       if (report) {
         std::lock_guard lock(progress_mutex);
-        report(double(done) / height);
+        report(double(done) / double(spans.size()));
       }
     }
   };
@@ -143,7 +158,7 @@ RenderResult resolve_all(cpu::CpuKernel &kernel, const CompiledScene &scene,
 } // namespace
 
 RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &frame,
-                        const ProgressFn &progress, int threads) {
+                        const ProgressFn &progress, int threads, const InfluenceRegion *region) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t pixels = std::size_t(frame.image.x) * frame.image.y;
   const uint32_t total = frame.sampling.z;
@@ -152,20 +167,21 @@ RenderResult render_cpu(const CompiledScene &scene, const gpu::FrameParams &fram
   kernel.frame.sampling.x = 0;
   kernel.frame.sampling.y = total;
   Accumulators acc(pixels);
+  const std::vector<RowSpan> spans = row_spans(kernel, region);
   // Report in samples per pixel, as the GPU tracer does.
-  trace_all(kernel, scene, acc, threads, [&](double done) {
+  trace_all(kernel, scene, acc, spans, threads, [&](double done) {
     if (progress)
       progress(int(double(total) * done), int(total));
   });
   RenderResult result = resolve_all(kernel, scene, acc, {});
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  result.camera_rays = std::uint64_t(pixels) * total;
+  result.camera_rays = (region != nullptr ? region->pixels() : pixels) * total;
   return result;
 }
 
 RenderResult render_cpu_adaptive(const CompiledScene &scene, const gpu::FrameParams &frame,
                                  const AdaptiveSampling &settings, const ProgressFn &progress,
-                                 int threads) {
+                                 int threads, const InfluenceRegion *region) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t pixels = std::size_t(frame.image.x) * frame.image.y;
   const uint32_t total = frame.sampling.z;
@@ -179,15 +195,17 @@ RenderResult render_cpu_adaptive(const CompiledScene &scene, const gpu::FramePar
   };
   // 1. The pilot, a uniform frame of `pilot` samples.
   kernel.frame.sampling = gpu::uvec4(0u, pilot, pilot, frame.sampling.w);
-  trace_all(kernel, scene, acc, threads, [&](double done) { report(done * pilot / total); });
+  const std::vector<RowSpan> spans = row_spans(kernel, region);
+  trace_all(kernel, scene, acc, spans, threads, [&](double done) { report(done * pilot / total); });
   // 2. The budget.
-  const std::vector<std::uint32_t> counts = allocate_samples(acc.aux, frame, pilot, settings);
+  const std::vector<std::uint32_t> counts =
+      allocate_samples(acc.aux, frame, pilot, settings, region);
   // 3. Each pixel's share.
   const std::uint32_t most = *std::max_element(counts.begin(), counts.end());
   kernel.sample_counts = counts.data();
   kernel.frame.tracing.y = pilot;
   kernel.frame.sampling = gpu::uvec4(0u, most - pilot, total, frame.sampling.w);
-  trace_all(kernel, scene, acc, threads,
+  trace_all(kernel, scene, acc, spans, threads,
             [&](double done) { report((pilot + done * (total - pilot)) / total); });
   RenderResult result = resolve_all(kernel, scene, acc, counts);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

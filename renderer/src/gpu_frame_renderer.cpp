@@ -7,6 +7,7 @@
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/influence_region.h"
 #include "frame_checks.h"
 #include "vulkan_context.h"
 
@@ -16,7 +17,7 @@ namespace {
 class GpuFrameRenderer final : public FrameRenderer {
 public:
   GpuFrameRenderer(const Scene &scene, const std::string &device)
-      : scene_(without_plate(scene)), tracer_(device) {
+      : scene_(without_plate(scene)), compiled_(compile_scene(scene_)), tracer_(device) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 4 != 0 || h % 2 != 0)
@@ -24,7 +25,7 @@ public:
                                   "x" + std::to_string(h) +
                                   " is not one the GPU video kernels take (width a multiple of "
                                   "4, even height)");
-    tracer_.load(compile_scene(scene_));
+    tracer_.load(compiled_);
   }
 
   std::string executor() const override { return "gpu " + tracer_.device_name(); }
@@ -45,10 +46,15 @@ public:
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
     if (request.seed != 0)
       frame.sampling.w = request.seed;
+    frame.image.z = plate.bytes.empty() ? 0u : 1u; // the camera frame is the plate
     FrameReport report;
     try {
+      region_ = request.influence_region ? influence_region(compiled_, frame)
+                                         : whole_frame_region(frame.image.x, frame.image.y);
+      report.traced_pixels = region_.pixels();
+      report.frame_pixels = std::uint64_t(frame.image.x) * frame.image.y;
       const RenderResult result = tracer_.render_video(
-          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr);
+          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, &region_);
       report.camera_rays = result.camera_rays;
       // The conversions run on the device inside the frame's one
       // submission: their time is part of the trace time here.
@@ -80,7 +86,9 @@ private:
   }
 
   Scene scene_;
+  CompiledScene compiled_; // for each frame's influence region
   GpuTracer tracer_;
+  InfluenceRegion region_;
   bool lost_ = false;
 };
 

@@ -109,12 +109,13 @@ std::uint8_t code(float value) {
 } // namespace
 
 void decode_row(const base::VideoFormat &f, std::span<const std::uint8_t> frame, int y,
-                glm::vec4 *out) {
+                glm::vec4 *out, int x0, int x1) {
+  const int end = x1 < 0 ? f.width : x1;
   const std::size_t stride = base::row_bytes(f);
   const std::uint8_t *row = frame.data() + stride * std::size_t(y);
   switch (f.pixel) {
   case PixelFormat::yuyv:
-    for (int x = 0; x < f.width; x += 2) {
+    for (int x = x0; x < end; x += 2) {
       const std::uint8_t *p = row + 2 * std::size_t(x);
       out[x] = glm::vec4(ycbcr_to_linear(f, p[0], p[1], p[3]), 0.0f);
       out[x + 1] = glm::vec4(ycbcr_to_linear(f, p[2], p[1], p[3]), 0.0f);
@@ -123,7 +124,7 @@ void decode_row(const base::VideoFormat &f, std::span<const std::uint8_t> frame,
   case PixelFormat::nv12: {
     const std::uint8_t *chroma =
         frame.data() + stride * std::size_t(f.height) + stride * std::size_t(y / 2);
-    for (int x = 0; x < f.width; ++x) {
+    for (int x = x0; x < end; ++x) {
       const std::size_t c = 2 * std::size_t(x / 2);
       out[x] = glm::vec4(ycbcr_to_linear(f, row[x], chroma[c], chroma[c + 1]), 0.0f);
     }
@@ -132,7 +133,7 @@ void decode_row(const base::VideoFormat &f, std::span<const std::uint8_t> frame,
   case PixelFormat::rgb24:
   case PixelFormat::bgr24: {
     const bool bgr = f.pixel == PixelFormat::bgr24;
-    for (int x = 0; x < f.width; ++x) {
+    for (int x = x0; x < end; ++x) {
       const std::uint8_t *p = row + 3 * std::size_t(x);
       const glm::vec3 codes = bgr ? glm::vec3(p[2], p[1], p[0]) : glm::vec3(p[0], p[1], p[2]);
       out[x] = glm::vec4(glsl::video_rgb_codes_to_linear(codes), 0.0f);
@@ -140,7 +141,7 @@ void decode_row(const base::VideoFormat &f, std::span<const std::uint8_t> frame,
     break;
   }
   case PixelFormat::xrgb8888:
-    for (int x = 0; x < f.width; ++x) {
+    for (int x = x0; x < end; ++x) {
       const std::uint8_t *p = row + 4 * std::size_t(x); // B G R X in memory
       out[x] = glm::vec4(glsl::video_rgb_codes_to_linear(glm::vec3(p[2], p[1], p[0])), 0.0f);
     }
@@ -149,7 +150,8 @@ void decode_row(const base::VideoFormat &f, std::span<const std::uint8_t> frame,
 }
 
 void encode_rows(const base::VideoFormat &f, std::span<std::uint8_t> frame, const glm::vec4 *image,
-                 int y0, int y1) {
+                 int y0, int y1, int x0, int x1) {
+  const int end = x1 < 0 ? f.width : x1;
   const std::size_t stride = base::row_bytes(f);
   const std::size_t width = std::size_t(f.width);
   const auto pixel = [&](int x, int y) { return glm::vec3(image[std::size_t(y) * width + x]); };
@@ -161,7 +163,7 @@ void encode_rows(const base::VideoFormat &f, std::span<std::uint8_t> frame, cons
   case PixelFormat::yuyv:
     for (int y = y0; y < y1; ++y) {
       std::uint8_t *row = frame.data() + stride * std::size_t(y);
-      for (int x = 0; x < f.width; x += 2) {
+      for (int x = x0; x < end; x += 2) {
         const glm::vec3 a = ypbpr(x, y);
         const glm::vec3 b = ypbpr(x + 1, y);
         const glm::vec3 ca = codes(a);
@@ -181,7 +183,7 @@ void encode_rows(const base::VideoFormat &f, std::span<std::uint8_t> frame, cons
       std::uint8_t *luma1 = luma0 + stride;
       std::uint8_t *chroma =
           frame.data() + stride * std::size_t(f.height) + stride * std::size_t(y / 2);
-      for (int x = 0; x < f.width; x += 2) {
+      for (int x = x0; x < end; x += 2) {
         glm::vec3 sum(0.0f);
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
@@ -200,7 +202,7 @@ void encode_rows(const base::VideoFormat &f, std::span<std::uint8_t> frame, cons
     const bool bgr = f.pixel == PixelFormat::bgr24;
     for (int y = y0; y < y1; ++y) {
       std::uint8_t *row = frame.data() + stride * std::size_t(y);
-      for (int x = 0; x < f.width; ++x) {
+      for (int x = x0; x < end; ++x) {
         const glm::vec3 c = glsl::video_linear_to_rgb_codes(pixel(x, y));
         std::uint8_t *p = row + 3 * std::size_t(x);
         p[bgr ? 2 : 0] = code(c.x);
@@ -213,7 +215,7 @@ void encode_rows(const base::VideoFormat &f, std::span<std::uint8_t> frame, cons
   case PixelFormat::xrgb8888:
     for (int y = y0; y < y1; ++y) {
       std::uint8_t *row = frame.data() + stride * std::size_t(y);
-      for (int x = 0; x < f.width; ++x) {
+      for (int x = x0; x < end; ++x) {
         const glm::vec3 c = glsl::video_linear_to_rgb_codes(pixel(x, y));
         std::uint8_t *p = row + 4 * std::size_t(x);
         p[0] = code(c.z);

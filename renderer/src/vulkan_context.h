@@ -287,6 +287,8 @@ struct ComputePipelineCreateInfo {
   std::span<const std::uint32_t> spirv;
   const char *entry = "main";
   const char *name = "kernel"; // for error messages
+  // Dispatched with vkCmdDispatchBase (a part of the grid).
+  bool dispatch_base = false;
 };
 
 [[nodiscard]] UniquePipeline make_compute_pipeline(const Device &device,

@@ -273,6 +273,7 @@ UniquePipeline make_compute_pipeline(const Device &device, const ComputePipeline
   create.stage.module = module;
   create.stage.pName = info.entry;
   create.layout = info.layout;
+  create.flags = info.dispatch_base ? VK_PIPELINE_CREATE_DISPATCH_BASE_BIT : 0;
   VkPipeline pipeline = VK_NULL_HANDLE;
   device.check(
       vkCreateComputePipelines(device.get(), VK_NULL_HANDLE, 1, &create, nullptr, &pipeline),

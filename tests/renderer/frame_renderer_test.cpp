@@ -200,6 +200,58 @@ TEST_P(FramePassThrough, OnlyWhatTheVirtualObjectTouchesChanges) {
   EXPECT_GT(changed_inside, 20u) << "the ball must show";
 }
 
+// The influence region (influence_region.h) changes the cost, not the
+// video: every byte of every output as when every pixel is traced, for an
+// output in the camera's format (which takes the camera's bytes outside the
+// region) and outputs in others (converted everywhere), with a shadow and a
+// mirror in the scene.
+TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
+  const int w = 96, h = 64;
+  Scene scene = scene_with_ball(w, h, {-0.6f, 0.1f, -2.5f});
+  Light light;
+  light.type = LightType::area;
+  light.position = {-1.0f, 2.0f, -1.5f};
+  light.normal = glm::normalize(glm::vec3(0.3f, -1.0f, -0.3f));
+  light.power_W = 300.0f;
+  scene.lights.push_back(light);
+  scene.materials.push_back({"mirror", MaterialType::mirror, glm::vec3(0.9f), 1.5f});
+  scene.objects.push_back(test::box("mirror", {0.9f, 0.2f, -3.5f}, {0.5f, 0.8f, 0.05f},
+                                    int(scene.materials.size()) - 1, true, {0.0f, -30.0f, 0.0f}));
+  auto renderer = make_renderer(GetParam(), scene);
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
+  const VideoFormat in = format(PixelFormat::yuyv, w, h);
+  const std::vector<std::uint8_t> plate = noise_frame(in, 11);
+  for (const PixelFormat pixel : {PixelFormat::yuyv, PixelFormat::nv12, PixelFormat::xrgb8888}) {
+    const auto frame = [&](bool region, bool alone) {
+      // Alone: the output in the camera's format is the only one.
+      std::vector<VideoFormat> formats = {format(pixel, w, h)};
+      if (!alone)
+        formats.push_back(format(PixelFormat::yuyv, w, h));
+      std::vector<std::vector<std::uint8_t>> bytes;
+      std::vector<VideoBuffer> targets;
+      for (const VideoFormat &f : formats)
+        bytes.emplace_back(base::frame_bytes(f), 0xAB);
+      for (std::size_t i = 0; i < formats.size(); ++i)
+        targets.push_back({formats[i], bytes[i]});
+      FrameRequest request;
+      request.camera = scene_camera(scene);
+      request.rays_per_pixel = 4;
+      request.influence_region = region;
+      const FrameReport report = renderer->render(request, {in, plate}, targets);
+      EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
+      if (region)
+        EXPECT_LT(report.traced_pixels, report.frame_pixels);
+      else
+        EXPECT_EQ(report.traced_pixels, report.frame_pixels);
+      return bytes;
+    };
+    for (const bool alone : {true, false})
+      EXPECT_TRUE(frame(true, alone) == frame(false, alone))
+          << base::pixel_format_name(pixel) << (alone ? " alone" : " beside yuyv");
+  }
+}
+
 TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
   auto renderer = make_renderer(GetParam(), real_only(32, 16));
   if (!renderer)

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "camhead/renderer/gpu_layout.h"
+#include "camhead/renderer/influence_region.h"
 
 namespace camhead::renderer {
 
@@ -34,7 +35,8 @@ struct AdaptiveSampling {
 [[nodiscard]] std::uint32_t adaptive_pilot(const AdaptiveSampling &settings,
                                            std::uint32_t mean_samples);
 
-// FrameParams::adaptive for these settings: the CoC weight and the cap.
+// FrameParams::adaptive for these settings: the CoC weight and the cap;
+// the region's pixel count (z) is the caller's.
 [[nodiscard]] gpu::vec4 adaptive_parameters(const AdaptiveSampling &settings, std::uint32_t pilot,
                                             std::uint32_t mean_samples);
 
@@ -45,9 +47,14 @@ struct AdaptiveSampling {
 // frame.sampling.z in expectation (shares are rounded at random; unless the
 // cap forbids it). A pure function of its inputs, and the same steps as the
 // GPU tracer's kernels.
+//
+// With a `region` (influence_region.h) only its pixels take part: the
+// budget is its pixels x frame.sampling.z, and the pixels outside get 0
+// (their pilot accumulators must be zero, as a pixel not traced has them).
 [[nodiscard]] std::vector<std::uint32_t> allocate_samples(std::span<const glm::vec4> pilot_aux,
                                                           const gpu::FrameParams &frame,
                                                           std::uint32_t pilot,
-                                                          const AdaptiveSampling &settings);
+                                                          const AdaptiveSampling &settings,
+                                                          const InfluenceRegion *region = nullptr);
 
 } // namespace camhead::renderer

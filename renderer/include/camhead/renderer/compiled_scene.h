@@ -14,6 +14,16 @@
 
 namespace camhead::renderer {
 
+// The bounds of one scene object's primitives, in the compiled frame, and
+// what the influence region (influence_region.h) needs to know of it.
+struct ObjectBounds {
+  glm::vec3 lo{0.0f};
+  glm::vec3 hi{0.0f};
+  bool real = false;     // part of the real proxy
+  bool specular = false; // mirror or glass: shows what lies elsewhere
+  bool shaded = false;   // diffuse: receives light, and so shadows
+};
+
 struct CompiledScene {
   std::vector<gpu::Primitive> primitives; // ordered as the BVH leaves use them
   std::vector<gpu::BvhNode> nodes;        // nodes[0] is the root
@@ -28,6 +38,8 @@ struct CompiledScene {
   // camera, and a scene near it compiles exactly as given. FrameParams stay in
   // world coordinates; the tracers subtract this from cam_position.
   glm::vec3 origin{0.0f};
+  // One entry per object that kept a primitive, in the scene's order.
+  std::vector<ObjectBounds> objects;
 };
 
 // Flattens the objects (planes and boxes into triangles, meshes transformed

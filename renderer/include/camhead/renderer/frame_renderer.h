@@ -38,6 +38,10 @@ struct FrameRequest {
   AdaptiveSampling adaptive_settings;
   // The frame's own noise pattern; 0 takes the scene's render.seed.
   std::uint32_t seed = 0;
+  // Trace only where the virtual objects can change the composite
+  // (influence_region.h); the outputs are the same bit for bit. False
+  // traces every pixel, for comparison.
+  bool influence_region = true;
 };
 
 enum class FrameStatus {
@@ -50,6 +54,9 @@ struct FrameReport {
   FrameStatus status = FrameStatus::ok;
   std::string detail;
   std::uint64_t camera_rays = 0;
+  // Pixels traced (the influence region's) of the frame's.
+  std::uint64_t traced_pixels = 0;
+  std::uint64_t frame_pixels = 0;
   // Where the frame's time went, seconds: converting the plate in, tracing
   // (and compositing), converting the composite out.
   double decode_s = 0.0;

@@ -9,6 +9,7 @@
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/render_result.h"
 
 namespace camhead::renderer {
@@ -47,9 +48,13 @@ public:
 
   // Traces frame.sampling.z samples per pixel in batches, calling `progress`
   // after each, resolves the layers and the composite on the GPU and reads
-  // them back.
+  // them back. Every call takes an optional influence `region`
+  // (influence_region.h, for this frame and the loaded scene): only its
+  // pixels are traced, and the layers other than the composite are zero
+  // outside it.
   [[nodiscard]] RenderResult render(const gpu::FrameParams &frame, const ProgressFn &progress = {},
-                                    LayerSelection layers = LayerSelection::all());
+                                    LayerSelection layers = LayerSelection::all(),
+                                    const InfluenceRegion *region = nullptr);
 
   // Adaptive sampling (adaptive.h): frame.sampling.z samples per pixel on
   // average, shared out by what a pilot saw; result.sample_counts holds the
@@ -57,7 +62,8 @@ public:
   [[nodiscard]] RenderResult render_adaptive(const gpu::FrameParams &frame,
                                              const AdaptiveSampling &settings = {},
                                              const ProgressFn &progress = {},
-                                             LayerSelection layers = LayerSelection::all());
+                                             LayerSelection layers = LayerSelection::all(),
+                                             const InfluenceRegion *region = nullptr);
 
   // A live frame (frame_renderer.h): `plate` in its own pixel format is
   // converted into the linear plate on the device, and the composite into
@@ -66,7 +72,8 @@ public:
   // work on 4 x 2 blocks); the caller checks. A plate without bytes is none.
   [[nodiscard]] RenderResult render_video(const gpu::FrameParams &frame, const VideoFrame &plate,
                                           std::span<const VideoBuffer> outputs,
-                                          const AdaptiveSampling *adaptive = nullptr);
+                                          const AdaptiveSampling *adaptive = nullptr,
+                                          const InfluenceRegion *region = nullptr);
 
 private:
   struct VideoJob {

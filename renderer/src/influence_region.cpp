@@ -1,0 +1,436 @@
+// The influence region (influence_region.h), in three steps:
+//
+// 1. World space. The points where a virtual object can change what a camera
+//    ray brings back, as convex polyhedra:
+//    - each virtual object's bounds: a ray that meets it;
+//    - each real mirror's or glass's bounds: a ray that meets one may go on
+//      to a virtual object or its shadow (however many bounces follow);
+//    - for each light, virtual object and real diffuse object: the points of
+//      that real object whose shadow ray to the light can meet the virtual
+//      object. Those points are v + t (v - l) with v in the object's box B,
+//      l on the light (a point, the rectangle of an area light, or a sun's
+//      direction at infinity) and t >= 0, a subset of B + cone(D) with D
+//      the differences of their corners; that set is cut out of the real
+//      object's box by the supporting planes of B + cone(D) (normals across
+//      pairs of generators, each kept only if the whole set lies behind it).
+//    Everything is grown by a margin above the kernel's ray offsets and
+//    float rounding.
+// 2. The thin lens. A point at depth z is seen by the pixels within
+//    f A |1/F - 1/z| pixels of its pinhole projection (aperture radius A,
+//    focal-plane depth F, focal length f in pixels); for a given aperture
+//    point a lens ray is a perspective projection, so a polyhedron's image
+//    is bounded by its vertices' images, each grown by its own blur. Points
+//    behind the lens are cut off; a piece within a millimetre of it, where
+//    the projection diverges, takes the whole frame if a camera ray can
+//    get there.
+// 3. Pixels and tiles. Each pixel rectangle, widened by the pixel filter and
+//    a pixel of margin, marks the tiles it touches; runs of tiles are merged
+//    into rectangles.
+#include "camhead/renderer/influence_region.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+namespace camhead::renderer {
+namespace {
+
+using glm::dvec3;
+
+// n . x <= h
+struct Halfspace {
+  dvec3 n;
+  double h;
+};
+
+// A closed convex polyhedron as its faces (convex polygons, vertices in
+// order), cut down one half-space at a time.
+class ConvexPolyhedron {
+public:
+  static ConvexPolyhedron box(const dvec3 &lo, const dvec3 &hi) {
+    std::array<dvec3, 8> c;
+    for (int i = 0; i < 8; ++i)
+      c[i] = dvec3(i & 4 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 1 ? hi.z : lo.z);
+    constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                  {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+    ConvexPolyhedron p;
+    for (const auto &f : kFaces)
+      p.faces_.push_back({c[f[0]], c[f[1]], c[f[2]], c[f[3]]});
+    return p;
+  }
+
+  [[nodiscard]] bool empty() const { return faces_.empty(); }
+
+  // Keeps the part with n . x <= h, closed by a new face on the plane.
+  void clip(const Halfspace &plane) {
+    std::vector<std::vector<dvec3>> kept;
+    std::vector<dvec3> cap;
+    for (const std::vector<dvec3> &face : faces_) {
+      std::vector<dvec3> out;
+      for (std::size_t i = 0; i < face.size(); ++i) {
+        const dvec3 &a = face[i];
+        const dvec3 &b = face[(i + 1) % face.size()];
+        const double da = glm::dot(plane.n, a) - plane.h;
+        const double db = glm::dot(plane.n, b) - plane.h;
+        if (da <= 0.0) {
+          out.push_back(a);
+          if (da == 0.0)
+            cap.push_back(a);
+        }
+        if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
+          const dvec3 p = a + (b - a) * (da / (da - db));
+          out.push_back(p);
+          cap.push_back(p);
+        }
+      }
+      if (out.size() >= 3)
+        kept.push_back(std::move(out));
+    }
+    if (cap.size() >= 3)
+      kept.push_back(order_around(std::move(cap), plane.n));
+    faces_ = std::move(kept);
+  }
+
+  template <typename Visit> void for_each_vertex(Visit visit) const {
+    for (const std::vector<dvec3> &face : faces_)
+      for (const dvec3 &v : face)
+        visit(v);
+  }
+
+private:
+  // The points of a convex polygon on a plane of normal n, in order.
+  static std::vector<dvec3> order_around(std::vector<dvec3> points, const dvec3 &n) {
+    dvec3 centre(0.0);
+    for (const dvec3 &p : points)
+      centre += p;
+    centre /= double(points.size());
+    const dvec3 u = glm::normalize(std::abs(n.x) < 0.9 ? glm::cross(n, dvec3(1, 0, 0))
+                                                       : glm::cross(n, dvec3(0, 1, 0)));
+    const dvec3 v = glm::cross(n, u);
+    const auto angle = [&](const dvec3 &p) {
+      return std::atan2(glm::dot(p - centre, v), glm::dot(p - centre, u));
+    };
+    std::sort(points.begin(), points.end(),
+              [&](const dvec3 &a, const dvec3 &b) { return angle(a) < angle(b); });
+    return points;
+  }
+
+  std::vector<std::vector<dvec3>> faces_;
+};
+
+struct Box {
+  dvec3 lo, hi;
+};
+
+std::array<dvec3, 8> corners(const Box &b) {
+  std::array<dvec3, 8> c;
+  for (int i = 0; i < 8; ++i)
+    c[i] = dvec3(i & 4 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 1 ? b.hi.z : b.lo.z);
+  return c;
+}
+
+// Supporting half-spaces of B + cone(dirs) (B a box): candidate normals
+// across the pairs of generators (the box's edges and the directions), each
+// kept if no generator leaves it. Every half-space kept contains the set, so
+// the cut is safe whether or not the list is complete; it is complete (the
+// facets of a Minkowski sum lie across pairs of generators), so it is tight.
+std::vector<Halfspace> cone_halfspaces(const Box &box, std::span<const dvec3> dirs, double margin) {
+  std::vector<dvec3> unit;
+  for (const dvec3 &d : dirs)
+    if (const double len = glm::length(d); len > 0.0)
+      unit.push_back(d / len);
+  std::vector<dvec3> candidates = {dvec3(1, 0, 0), dvec3(0, 1, 0), dvec3(0, 0, 1)};
+  for (std::size_t i = 0; i < unit.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis)
+      candidates.push_back(glm::cross(candidates[std::size_t(axis)], unit[i]));
+    for (std::size_t j = i + 1; j < unit.size(); ++j)
+      candidates.push_back(glm::cross(unit[i], unit[j]));
+  }
+  const std::array<dvec3, 8> box_corners = corners(box);
+  std::vector<Halfspace> planes;
+  for (const dvec3 &c : candidates) {
+    const double len = glm::length(c);
+    if (!(len > 1e-9))
+      continue; // (nearly) parallel generators span no plane
+    for (const double sign : {1.0, -1.0}) {
+      const dvec3 n = sign * c / len;
+      // A generator in the plane may lean out of it by rounding; margin
+      // covers what that leans out over the scene.
+      if (std::any_of(unit.begin(), unit.end(),
+                      [&](const dvec3 &d) { return glm::dot(n, d) > 1e-9; }))
+        continue;
+      if (std::any_of(planes.begin(), planes.end(),
+                      [&](const Halfspace &p) { return glm::dot(p.n, n) > 1.0 - 1e-12; }))
+        continue;
+      double h = -std::numeric_limits<double>::infinity();
+      for (const dvec3 &v : box_corners)
+        h = std::max(h, glm::dot(n, v));
+      planes.push_back({n, h + margin});
+    }
+  }
+  return planes;
+}
+
+// The frame's thin lens in the compiled scene's frame, and the tiles marked
+// so far.
+class RegionBuilder {
+public:
+  RegionBuilder(const gpu::FrameParams &frame, const dvec3 &origin)
+      : centre_(dvec3(frame.cam_position) - origin), right_(dvec3(frame.cam_right)),
+        up_(dvec3(frame.cam_up)), forward_(dvec3(frame.cam_forward)), aperture_(frame.lens.x),
+        focus_(frame.lens.y), focal_px_(frame.lens.z), filter_px_(frame.lens.w),
+        width_(frame.image.x), height_(frame.image.y),
+        tiles_x_((width_ + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X),
+        tiles_y_((height_ + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y),
+        marked_(std::size_t(tiles_x_) * tiles_y_, 0) {}
+
+  // Marks the pixels that may see a point of `poly` (consumed).
+  void add(ConvexPolyhedron poly) {
+    poly.clip({-forward_, -glm::dot(forward_, centre_)}); // behind the lens: no camera ray
+    if (poly.empty())
+      return;
+    // Within kNearM of the lens a ray is still within the aperture plus a
+    // sliver of the field of view; a piece there that a ray may reach is
+    // seen across the whole frame.
+    constexpr double kNearM = 1e-3;
+    ConvexPolyhedron near = poly;
+    near.clip({forward_, glm::dot(forward_, centre_) + kNearM});
+    if (!near.empty()) {
+      const double reach_aperture = aperture_ * std::max(1.0, std::abs(1.0 - kNearM / focus_));
+      const double reach_x =
+          reach_aperture + (0.5 * width_ + filter_px_ + 2.0) * kNearM / focal_px_;
+      const double reach_y =
+          reach_aperture + (0.5 * height_ + filter_px_ + 2.0) * kNearM / focal_px_;
+      double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+      near.for_each_vertex([&](const dvec3 &v) {
+        x_lo = std::min(x_lo, glm::dot(right_, v - centre_));
+        x_hi = std::max(x_hi, glm::dot(right_, v - centre_));
+        y_lo = std::min(y_lo, glm::dot(up_, v - centre_));
+        y_hi = std::max(y_hi, glm::dot(up_, v - centre_));
+      });
+      const bool reachable =
+          x_lo <= reach_x && x_hi >= -reach_x && y_lo <= reach_y && y_hi >= -reach_y;
+      if (reachable) {
+        mark(0.0, double(width_), 0.0, double(height_));
+        return;
+      }
+    }
+    poly.clip({-forward_, -glm::dot(forward_, centre_) - kNearM});
+    if (poly.empty())
+      return;
+    double u_lo = INFINITY, u_hi = -INFINITY, v_lo = INFINITY, v_hi = -INFINITY;
+    poly.for_each_vertex([&](const dvec3 &p) {
+      const dvec3 d = p - centre_;
+      const double z = glm::dot(forward_, d);
+      const double u = 0.5 * width_ + focal_px_ * glm::dot(right_, d) / z;
+      const double v = 0.5 * height_ - focal_px_ * glm::dot(up_, d) / z;
+      const double blur = focal_px_ * aperture_ * std::abs(1.0 / focus_ - 1.0 / z);
+      u_lo = std::min(u_lo, u - blur);
+      u_hi = std::max(u_hi, u + blur);
+      v_lo = std::min(v_lo, v - blur);
+      v_hi = std::max(v_hi, v + blur);
+    });
+    mark(u_lo, u_hi, v_lo, v_hi);
+  }
+
+  [[nodiscard]] InfluenceRegion region() const;
+
+private:
+  // Marks the tiles of the pixels whose samples (the pixel's centre within
+  // half the filter width) can fall in [u_lo, u_hi] x [v_lo, v_hi], image
+  // coordinates; one pixel more on each side for the rays' rounding.
+  void mark(double u_lo, double u_hi, double v_lo, double v_hi) {
+    const double reach = 0.5 * filter_px_ + 1.0;
+    const auto first = [&](double lo) { return std::floor(lo - 0.5 - reach); };
+    const auto last = [&](double hi) { return std::ceil(hi - 0.5 + reach); };
+    const double x0 = std::max(0.0, first(u_lo)), x1 = std::min(double(width_) - 1, last(u_hi));
+    const double y0 = std::max(0.0, first(v_lo)), y1 = std::min(double(height_) - 1, last(v_hi));
+    if (std::isnan(u_lo) || std::isnan(u_hi) || std::isnan(v_lo) || std::isnan(v_hi)) {
+      mark(0.0, double(width_), 0.0, double(height_)); // unknown: everywhere
+      return;
+    }
+    if (!(x0 <= x1) || !(y0 <= y1))
+      return; // off the frame
+    for (auto ty = std::uint32_t(y0) / CAMHEAD_TILE_Y; ty <= std::uint32_t(y1) / CAMHEAD_TILE_Y;
+         ++ty)
+      for (auto tx = std::uint32_t(x0) / CAMHEAD_TILE_X; tx <= std::uint32_t(x1) / CAMHEAD_TILE_X;
+           ++tx)
+        marked_[std::size_t(ty) * tiles_x_ + tx] = 1;
+  }
+
+  dvec3 centre_, right_, up_, forward_;
+  double aperture_, focus_, focal_px_, filter_px_;
+  std::uint32_t width_, height_, tiles_x_, tiles_y_;
+  std::vector<std::uint8_t> marked_;
+};
+
+InfluenceRegion RegionBuilder::region() const {
+  InfluenceRegion region;
+  region.width = width_;
+  region.height = height_;
+  const auto pixel_rect = [&](std::uint32_t tx0, std::uint32_t tx1, std::uint32_t ty0,
+                              std::uint32_t ty1) {
+    return PixelRect{tx0 * CAMHEAD_TILE_X, ty0 * CAMHEAD_TILE_Y,
+                     std::min(tx1 * CAMHEAD_TILE_X, width_),
+                     std::min(ty1 * CAMHEAD_TILE_Y, height_)};
+  };
+  // Runs of tiles, a row at a time; a run that repeats the one above
+  // extends its rectangle.
+  struct Open {
+    std::uint32_t tx0, tx1, ty0;
+  };
+  std::vector<Open> open, next;
+  for (std::uint32_t ty = 0; ty <= tiles_y_; ++ty) {
+    next.clear();
+    std::uint32_t tx = 0;
+    while (ty < tiles_y_ && tx < tiles_x_) {
+      if (!marked_[std::size_t(ty) * tiles_x_ + tx]) {
+        ++tx;
+        continue;
+      }
+      const std::uint32_t start = tx;
+      while (tx < tiles_x_ && marked_[std::size_t(ty) * tiles_x_ + tx])
+        ++tx;
+      const auto above = std::find_if(open.begin(), open.end(),
+                                      [&](const Open &o) { return o.tx0 == start && o.tx1 == tx; });
+      next.push_back({start, tx, above != open.end() ? above->ty0 : ty});
+      if (above != open.end())
+        open.erase(above);
+    }
+    for (const Open &o : open) // not continued in this row
+      region.rects.push_back(pixel_rect(o.tx0, o.tx1, o.ty0, ty));
+    std::swap(open, next);
+  }
+  std::sort(region.rects.begin(), region.rects.end(), [](const PixelRect &a, const PixelRect &b) {
+    return a.y0 != b.y0 ? a.y0 < b.y0 : a.x0 < b.x0;
+  });
+  return region;
+}
+
+Box bounds_of(const ObjectBounds &o, double margin) {
+  return {dvec3(o.lo) - margin, dvec3(o.hi) + margin};
+}
+
+// Where the shadow rays toward a light end: the light's corners, or a sun's
+// direction of travel; and the side an area light shines on.
+struct LightShape {
+  std::vector<dvec3> points;
+  std::optional<dvec3> travel;
+  std::optional<Halfspace> lit;
+  bool anywhere = false; // no cut: the whole receiver
+};
+
+std::optional<LightShape> light_shape(const gpu::Light &light, double margin) {
+  const glm::vec3 emission(light.emission);
+  if (!(emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f))
+    return std::nullopt; // direct_light() skips it
+  LightShape shape;
+  const dvec3 position(light.position);
+  switch (glm::floatBitsToUint(light.position.w)) {
+  case LIGHT_POINT:
+    shape.points = {position};
+    break;
+  case LIGHT_AREA: {
+    const dvec3 u = 0.5 * dvec3(light.axis_u), v = 0.5 * dvec3(light.axis_v);
+    shape.points = {position - u - v, position + u - v, position + u + v, position - u + v};
+    const dvec3 n(light.normal);
+    shape.lit = Halfspace{-n, -glm::dot(n, position) + margin};
+    break;
+  }
+  case LIGHT_SUN:
+    shape.travel = dvec3(light.normal);
+    break;
+  default:
+    // Not a kind compile_light() makes: were one added and forgotten here,
+    // its shadows could fall anywhere on a receiver.
+    shape.anywhere = true;
+    break;
+  }
+  return shape;
+}
+
+} // namespace
+
+std::uint64_t InfluenceRegion::pixels() const {
+  std::uint64_t sum = 0;
+  for (const PixelRect &r : rects)
+    sum += r.pixels();
+  return sum;
+}
+
+InfluenceRegion whole_frame_region(std::uint32_t width, std::uint32_t height) {
+  InfluenceRegion region;
+  region.width = width;
+  region.height = height;
+  if (width > 0 && height > 0)
+    region.rects.push_back({0, 0, width, height});
+  return region;
+}
+
+InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FrameParams &frame) {
+  if (frame.image.z == 0)
+    return whole_frame_region(frame.image.x, frame.image.y);
+  // Above the kernel's ray offsets (CAMHEAD_RAY_EPSILON x (1 + |p|)) and the
+  // float rounding of hits, at the scale of the scene.
+  double scale = glm::length(dvec3(frame.cam_position) - dvec3(scene.origin));
+  for (const ObjectBounds &o : scene.objects)
+    scale = std::max({scale, glm::length(dvec3(o.lo)), glm::length(dvec3(o.hi))});
+  const double margin = 1e-3 * (1.0 + scale);
+
+  RegionBuilder builder(frame, dvec3(scene.origin));
+  std::vector<Box> virtuals;
+  for (const ObjectBounds &o : scene.objects)
+    if (!o.real)
+      virtuals.push_back(bounds_of(o, margin));
+  if (virtuals.empty())
+    return builder.region();
+  for (const Box &v : virtuals)
+    builder.add(ConvexPolyhedron::box(v.lo, v.hi));
+  for (const ObjectBounds &o : scene.objects)
+    if (o.real && o.specular)
+      builder.add(ConvexPolyhedron::box(bounds_of(o, margin).lo, bounds_of(o, margin).hi));
+
+  const std::size_t lights = std::min<std::size_t>(frame.image.w, scene.lights.size());
+  for (std::size_t li = 0; li < lights; ++li) {
+    const std::optional<LightShape> shape = light_shape(scene.lights[li], margin);
+    if (!shape)
+      continue;
+    for (const Box &v : virtuals) {
+      std::vector<dvec3> dirs;
+      if (shape->travel)
+        dirs.push_back(*shape->travel);
+      for (const dvec3 &l : shape->points)
+        for (const dvec3 &c : corners(v))
+          dirs.push_back(c - l);
+      std::vector<Halfspace> cut;
+      if (!shape->anywhere)
+        cut = cone_halfspaces(v, dirs, margin);
+      if (shape->lit)
+        cut.push_back(*shape->lit);
+      for (const ObjectBounds &o : scene.objects) {
+        if (!o.real || !o.shaded)
+          continue;
+        const Box receiver = bounds_of(o, margin);
+        ConvexPolyhedron poly = ConvexPolyhedron::box(receiver.lo, receiver.hi);
+        for (const Halfspace &h : cut) {
+          poly.clip(h);
+          if (poly.empty())
+            break;
+        }
+        if (!poly.empty())
+          builder.add(std::move(poly));
+      }
+    }
+  }
+  return builder.region();
+}
+
+} // namespace camhead::renderer
