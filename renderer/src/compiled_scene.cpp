@@ -254,6 +254,11 @@ CompiledScene compile_scene(const Scene &scene) {
     bounds.real = o.real;
     bounds.specular = type == MaterialType::mirror || type == MaterialType::glass;
     bounds.shaded = type == MaterialType::diffuse;
+    if (o.type == ShapeType::sphere) {
+      bounds.sphere = true;
+      bounds.centre = glm::vec3(prims.back().p0);
+      bounds.radius = prims.back().p1.x;
+    }
     out.objects.push_back(bounds);
   }
   Bvh bvh = build_bvh(std::move(prims));

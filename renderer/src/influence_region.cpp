@@ -13,6 +13,9 @@
 //      the differences of their corners; that set is cut out of the real
 //      object's box by the supporting planes of B + cone(D) (normals across
 //      pairs of generators, each kept only if the whole set lies behind it).
+//      A sphere counts as its box with edges and corners cut off, and its
+//      shadow from a point light or a sun as the planes tangent to its
+//      round shadow cone or cylinder.
 //    Everything is grown by a margin above the kernel's ray offsets and
 //    float rounding.
 // 2. The thin lens. A point at depth z is seen by the pixels within
@@ -315,6 +318,37 @@ InfluenceRegion RegionBuilder::region() const {
   return region;
 }
 
+// Tangent planes around a sphere of `radius` (margin included) at `centre`,
+// along 12 edge and 8 corner directions: its box with the corners and edges
+// cut off, a third of the box's volume beyond the sphere instead of half.
+std::vector<Halfspace> sphere_cuts(const dvec3 &centre, double radius) {
+  std::vector<Halfspace> cuts;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        const int nonzero = (x != 0) + (y != 0) + (z != 0);
+        if (nonzero < 2)
+          continue; // the box's own faces, and the centre
+        const dvec3 n = glm::normalize(dvec3(x, y, z));
+        cuts.push_back({n, glm::dot(n, centre) + radius});
+      }
+  return cuts;
+}
+
+// Two unit vectors orthogonal to unit `a` and to each other.
+std::pair<dvec3, dvec3> orthogonal_pair(const dvec3 &a) {
+  const dvec3 u = glm::normalize(std::abs(a.x) < 0.9 ? glm::cross(a, dvec3(1, 0, 0))
+                                                     : glm::cross(a, dvec3(0, 1, 0)));
+  return {u, glm::cross(a, u)};
+}
+
+// The shadow of a sphere from a point light or a sun, bounded by 16 planes
+// tangent to its circular shadow cone or cylinder (1.3 % more area than the
+// circle) and by where it starts; none for a light inside the sphere (the
+// whole receiver) or an area light (cone_halfspaces() over its box).
+std::optional<std::vector<Halfspace>> sphere_shadow_cuts(const dvec3 &centre, double radius,
+                                                         const struct LightShape &light);
+
 Box bounds_of(const ObjectBounds &o, double margin) {
   return {dvec3(o.lo) - margin, dvec3(o.hi) + margin};
 }
@@ -327,6 +361,46 @@ struct LightShape {
   std::optional<Halfspace> lit;
   bool anywhere = false; // no cut: the whole receiver
 };
+
+std::optional<std::vector<Halfspace>> sphere_shadow_cuts(const dvec3 &centre, double radius,
+                                                         const LightShape &light) {
+  constexpr int kSides = 16;
+  std::vector<Halfspace> cuts;
+  if (light.travel) { // a cylinder along the sun's direction of travel
+    const dvec3 t = glm::normalize(*light.travel);
+    const auto [u, v] = orthogonal_pair(t);
+    for (int k = 0; k < kSides; ++k) {
+      const double phi = 2.0 * 3.14159265358979323846 * k / kSides;
+      const dvec3 n = std::cos(phi) * u + std::sin(phi) * v;
+      cuts.push_back({n, glm::dot(n, centre) + radius});
+    }
+    cuts.push_back({-t, -glm::dot(t, centre) + radius}); // not before the sphere
+    return cuts;
+  }
+  if (light.points.size() != 1)
+    return std::nullopt;
+  const dvec3 &l = light.points.front();
+  const double distance = glm::length(centre - l);
+  if (!(distance > radius))
+    return std::nullopt;
+  // Planes through the light, each tangent to the cone of half-angle alpha
+  // along one generator: n = u_k cos(alpha) - a sin(alpha) leaves every
+  // direction within alpha of the axis a behind it.
+  // Each half-space contains the whole cone (a direction at beta <= alpha
+  // from the axis, toward w, has n . d = cos(alpha) sin(beta) (u_k . w) -
+  // sin(alpha) cos(beta) <= sin(beta - alpha) <= 0), so their intersection,
+  // the circumscribed 16-gon's cone, does too.
+  const dvec3 a = (centre - l) / distance;
+  const double sine = radius / distance, cosine = std::sqrt(1.0 - sine * sine);
+  const auto [u, v] = orthogonal_pair(a);
+  for (int k = 0; k < kSides; ++k) {
+    const double phi = 2.0 * 3.14159265358979323846 * k / kSides;
+    const dvec3 n = (std::cos(phi) * u + std::sin(phi) * v) * cosine - a * sine;
+    cuts.push_back({n, glm::dot(n, l)});
+  }
+  cuts.push_back({-a, -glm::dot(a, l) - (distance - radius)}); // beyond the sphere's near side
+  return cuts;
+}
 
 std::optional<LightShape> light_shape(const gpu::Light &light, double margin) {
   const glm::vec3 emission(light.emission);
@@ -386,14 +460,19 @@ InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FramePar
   const double margin = 1e-3 * (1.0 + scale);
 
   RegionBuilder builder(frame, dvec3(scene.origin));
-  std::vector<Box> virtuals;
-  for (const ObjectBounds &o : scene.objects)
-    if (!o.real)
-      virtuals.push_back(bounds_of(o, margin));
-  if (virtuals.empty())
+  if (std::none_of(scene.objects.begin(), scene.objects.end(),
+                   [](const ObjectBounds &o) { return !o.real; }))
     return builder.region();
-  for (const Box &v : virtuals)
-    builder.add(ConvexPolyhedron::box(v.lo, v.hi));
+  for (const ObjectBounds &o : scene.objects) {
+    if (o.real)
+      continue;
+    const Box v = bounds_of(o, margin);
+    ConvexPolyhedron poly = ConvexPolyhedron::box(v.lo, v.hi);
+    if (o.sphere)
+      for (const Halfspace &h : sphere_cuts(dvec3(o.centre), double(o.radius) + margin))
+        poly.clip(h);
+    builder.add(std::move(poly));
+  }
   for (const ObjectBounds &o : scene.objects)
     if (o.real && o.specular)
       builder.add(ConvexPolyhedron::box(bounds_of(o, margin).lo, bounds_of(o, margin).hi));
@@ -403,16 +482,25 @@ InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FramePar
     const std::optional<LightShape> shape = light_shape(scene.lights[li], margin);
     if (!shape)
       continue;
-    for (const Box &v : virtuals) {
-      std::vector<dvec3> dirs;
-      if (shape->travel)
-        dirs.push_back(*shape->travel);
-      for (const dvec3 &l : shape->points)
-        for (const dvec3 &c : corners(v))
-          dirs.push_back(c - l);
+    for (const ObjectBounds &caster : scene.objects) {
+      if (caster.real)
+        continue;
+      const Box v = bounds_of(caster, margin);
       std::vector<Halfspace> cut;
-      if (!shape->anywhere)
+      std::optional<std::vector<Halfspace>> round;
+      if (caster.sphere && !shape->anywhere)
+        round = sphere_shadow_cuts(dvec3(caster.centre), double(caster.radius) + margin, *shape);
+      if (round) {
+        cut = std::move(*round);
+      } else if (!shape->anywhere) {
+        std::vector<dvec3> dirs;
+        if (shape->travel)
+          dirs.push_back(*shape->travel);
+        for (const dvec3 &l : shape->points)
+          for (const dvec3 &c : corners(v))
+            dirs.push_back(c - l);
         cut = cone_halfspaces(v, dirs, margin);
+      }
       if (shape->lit)
         cut.push_back(*shape->lit);
       for (const ObjectBounds &o : scene.objects) {

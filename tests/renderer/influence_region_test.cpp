@@ -241,6 +241,48 @@ TEST(InfluenceRegion, BlurAndFilterReachBitForBit) {
   }
 }
 
+// A sphere counts by its own round shape and its shadow by the planes
+// tangent to its shadow cone or cylinder, tighter than its box: many
+// spheres over a real floor, unlit, lit low by a point light or by a sun, seen
+// through a pinhole, so that some rim or shadow edge lies just past a
+// tile's edge.
+TEST(InfluenceRegion, SphereAndShadowBoundsBitForBit) {
+  enum Lighting { none, point, sun };
+  for (const Lighting kind : {none, point, sun}) {
+    const char *name = kind == none ? "no light" : kind == point ? "point light" : "sun";
+    Scene scene = test::empty_scene("spheres", 0.0f, 1.0f, 320, 240);
+    scene.camera.position = glm::vec3(0.0f, 1.2f, 0.0f);
+    scene.camera.look_at = glm::vec3(0.0f, 0.0f, -4.0f);
+    scene.materials = {{"grey", renderer::MaterialType::diffuse, glm::vec3(0.6f), 1.5f}};
+    scene.objects.push_back(test::plane("floor", glm::vec3(0.0f, 0.0f, -4.0f), 12.0f, 0, true));
+    for (int i = 0; i < 15; ++i) {
+      const glm::vec3 centre((float(i % 5) - 2.13f) * 0.71f, 0.15f + 0.07f * float(i % 4),
+                             -2.4f - 0.63f * float(i / 5));
+      scene.objects.push_back(test::sphere("ball", centre, 0.05f + 0.06f * float(i % 3), 0, false));
+    }
+    renderer::Light light;
+    if (kind == none) {
+      // The balls' own bounds alone.
+    } else if (kind == sun) {
+      light.type = renderer::LightType::sun;
+      light.direction = glm::normalize(glm::vec3(1.0f, -0.4f, 0.3f)); // long shadows
+      light.irradiance_W_m2 = 3.0f;
+    } else {
+      light.type = renderer::LightType::point;
+      light.position = glm::vec3(-2.5f, 0.6f, -3.0f);
+      light.power_W = 200.0f;
+    }
+    if (kind != none)
+      scene.lights.push_back(light);
+    scene = with_noise_plate(std::move(scene), 13);
+    const Comparison c = compare_cpu(scene, 8);
+    std::printf("15 balls over a floor, %s: %.1f %% traced\n", name, 100.0 * c.fraction);
+    EXPECT_LT(c.fraction, 0.75) << name;
+    EXPECT_EQ(c.differing_pixel, -1) << name << ": pixel (" << c.differing_pixel % 320 << ", "
+                                     << c.differing_pixel / 320 << ") differs";
+  }
+}
+
 // What it saves: a small virtual sphere alone over the plate is a small
 // region around its blurred image, and more blur is a larger one.
 TEST(InfluenceRegion, SmallObjectSmallRegionGrowingWithBlur) {

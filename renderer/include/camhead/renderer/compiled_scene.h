@@ -22,6 +22,10 @@ struct ObjectBounds {
   bool real = false;     // part of the real proxy
   bool specular = false; // mirror or glass: shows what lies elsewhere
   bool shaded = false;   // diffuse: receives light, and so shadows
+  // A sphere's own shape, tighter than its box.
+  bool sphere = false;
+  glm::vec3 centre{0.0f};
+  float radius = 0.0f;
 };
 
 struct CompiledScene {
