@@ -7,13 +7,15 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <system_error>
 
 #include <unistd.h>
 
+#include "camhead/base/partial_file.h"
 #include "camhead/lens_control/calibration.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "commands.h"
@@ -54,25 +56,6 @@ written; 1 any other error.
 )";
 
 // Removes the temporary file unless the run got as far as renaming it.
-class TempFile {
-public:
-  explicit TempFile(fs::path p) : path_(std::move(p)) {}
-  ~TempFile() {
-    if (!path_.empty()) {
-      std::error_code ignored;
-      fs::remove(path_, ignored);
-    }
-  }
-  TempFile(const TempFile &) = delete;
-  TempFile &operator=(const TempFile &) = delete;
-
-  [[nodiscard]] const fs::path &path() const { return path_; }
-  void release() { path_.clear(); }
-
-private:
-  fs::path path_;
-};
-
 int run_calibrate(const CalibrateArgs &args) {
   using namespace camhead::lens_control;
   const fs::path output(args.output);
@@ -95,30 +78,23 @@ int run_calibrate(const CalibrateArgs &args) {
     // what a profile is, not the writer.
     (void)LensProfile::parse(json, output);
 
-    // Next to the output, so that the rename stays on one file system and
-    // replaces the output in one step.
-    TempFile temp(fs::path(output.string() + ".partial-" + std::to_string(::getpid())));
-    {
-      std::ofstream out(temp.path(), std::ios::binary | std::ios::trunc);
-      out << json;
-      out.close();
-      if (!out) {
-        std::fprintf(stderr, "output %s: cannot write %s\n", args.output.c_str(),
-                     temp.path().string().c_str());
-        return 4;
-      }
+    // Beside the output and renamed over it in one step (base/partial_file.h).
+    std::string error;
+    std::optional<base::PartialFile> file = base::PartialFile::create(output, error);
+    if (!file ||
+        !file->write(std::span(reinterpret_cast<const std::uint8_t *>(json.data()), json.size()),
+                     error)) {
+      std::fprintf(stderr, "output %s: %s\n", args.output.c_str(), error.c_str());
+      return 4;
     }
     // The residuals use the profile as loaded from the bytes on disk: the
     // profile a rig will use.
-    const LensProfile profile = LensProfile::load(temp.path());
+    const LensProfile profile = LensProfile::load(file->partial_path());
     const std::vector<Residuals> residuals = compute_residuals(measurements, profile);
-    std::error_code ec;
-    fs::rename(temp.path(), output, ec);
-    if (ec) {
-      std::fprintf(stderr, "output %s: %s\n", args.output.c_str(), ec.message().c_str());
+    if (!file->commit(true, error)) {
+      std::fprintf(stderr, "output %s: %s\n", args.output.c_str(), error.c_str());
       return 4;
     }
-    temp.release();
     std::fputs(format_report(fit, residuals).c_str(), stdout);
     const std::string zoom =
         fit.prime ? "prime" : std::to_string(fit.zoom.points.size()) + " zoom points";

@@ -163,8 +163,13 @@ void monitor(const LensArgs &args) {
     return;
   std::vector<LensChannel> channels;
   std::unique_ptr<hal::lens::OpenTrackIoSender> sender;
+  std::string profile;
   try {
-    channels = pipeline::open_lens_channels(*board);
+    // Loaded once: a second load could see another file (or fail) outside
+    // this error handling.
+    const lens_control::LensProfile loaded = pipeline::load_board_profile(*board);
+    profile = loaded.name();
+    channels = pipeline::open_lens_channels(*board, loaded);
     if (!args.send_opentrackio.empty())
       sender = open_sender(args.send_opentrackio);
   } catch (const std::exception &e) {
@@ -176,7 +181,6 @@ void monitor(const LensArgs &args) {
   const auto interval = std::chrono::milliseconds(args.interval_ms > 0 ? args.interval_ms
                                                   : terminal           ? 100
                                                                        : 1000);
-  const std::string profile = pipeline::load_board_profile(*board).name();
   auto next_draw = std::chrono::steady_clock::now();
   auto next_send = next_draw;
   run_until_stopped(args.duration_s, [&](double elapsed) {
@@ -227,12 +231,16 @@ void record(const LensArgs &args) {
     return;
   }
   try {
+    // Every input first: nothing is opened for writing before the profile
+    // and the source have been checked.
+    auto profile = pipeline::load_board_profile(*board);
+    auto source = pipeline::open_lens_source(*chosen);
     auto recorder = std::make_unique<hal::lens::TraceRecorder>(
-        pipeline::open_lens_source(*chosen), args.output,
+        std::move(source), args.output,
         hal::lens::TraceRecorderOptions{.comment = "recorded by camhead lens record from board " +
                                                    board->name + ", source " + chosen->name});
     hal::lens::TraceRecorder &file = *recorder;
-    LensChannel channel(*chosen, std::move(recorder), pipeline::load_board_profile(*board));
+    LensChannel channel(*chosen, std::move(recorder), std::move(profile));
     std::fprintf(stderr, "recording %s into %s%s\n", file.name().c_str(), args.output.c_str(),
                  args.duration_s > 0 ? "" : " (Ctrl-C stops)");
     double next_report = 1.0;

@@ -68,6 +68,10 @@ hl::gpio::GpioQuadratureAxis gpio_axis(const GpioAxisConfig &a) {
 // The simulated chip has no loop of its own: its edges are computed ahead,
 // so the trace is repeated this many times (a minute of the bundled trace).
 constexpr int kSimulatedGpioRepeats = 10;
+// Edges the simulated chip computes ahead, at most: 4 M, a hundred MB. The
+// bundled trace needs 0.4 M; a trace that jumps by 2^32 counts in 61 bytes
+// would need every one of those edges.
+constexpr double kMaxSimulatedEdges = double(1 << 22);
 
 std::optional<hl::gpio::SimulatedQuadratureAxis>
 simulated_axis(const hl::LensTrace &trace, Axis axis, const GpioAxisConfig &a) {
@@ -80,6 +84,21 @@ simulated_axis(const hl::LensTrace &trace, Axis axis, const GpioAxisConfig &a) {
   // counts_at_index, so the axis homes as a real one does, on passing it.
   sim.decoder.counts_at_index = a.counts_at_index;
   sim.index_count = a.counts_at_index;
+  double edges = 0.0;
+  std::optional<std::int32_t> last;
+  for (const hl::EncoderReading &r : trace.readings)
+    if (r.*axis) {
+      if (last)
+        edges += std::abs(double(*(r.*axis)) - double(*last));
+      last = r.*axis;
+    }
+  if (edges * kSimulatedGpioRepeats > kMaxSimulatedEdges)
+    throw hl::TraceError(
+        trace.source, 0, "",
+        "its counts move " + std::to_string(std::llround(edges)) +
+            " in all, more than the simulated GPIO chip follows (" +
+            std::to_string(std::llround(kMaxSimulatedEdges / kSimulatedGpioRepeats)) +
+            "); a lens moves a few ten thousand");
   const std::int64_t first = trace.readings.front().t_ns;
   const std::int64_t period = hl::loop_period_ns(trace); // as the trace's replay loops
   for (int k = 0; k < kSimulatedGpioRepeats; ++k)
@@ -210,7 +229,11 @@ void LensChannel::feed() {
 }
 
 std::vector<LensChannel> open_lens_channels(const Board &board) {
-  const lens_control::LensProfile profile = load_board_profile(board);
+  return open_lens_channels(board, load_board_profile(board));
+}
+
+std::vector<LensChannel> open_lens_channels(const Board &board,
+                                            const lens_control::LensProfile &profile) {
   std::vector<LensChannel> channels;
   for (const LensSourceConfig &source : board.lens.sources)
     channels.emplace_back(source, open_lens_source(source), profile);

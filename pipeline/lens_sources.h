@@ -70,5 +70,8 @@ private:
 
 // Every source of the board, each on the board's profile.
 [[nodiscard]] std::vector<LensChannel> open_lens_channels(const Board &board);
+// The same with the board's profile already loaded (load_board_profile()).
+[[nodiscard]] std::vector<LensChannel> open_lens_channels(const Board &board,
+                                                          const lens_control::LensProfile &profile);
 
 } // namespace camhead::pipeline

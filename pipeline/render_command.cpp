@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
+#include "camhead/base/partial_file.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/gpu_tracer.h"
@@ -77,6 +80,13 @@ std::optional<std::string> output_problem(const std::filesystem::path &output) {
   if (!dir.empty() && !std::filesystem::is_directory(dir)) {
     return "folder " + dir.string() + " does not exist";
   }
+  // What writing it will meet (base/partial_file.h), found now rather than
+  // after the render: a folder, a device node, a place this user cannot
+  // write to.
+  if (std::string reason = base::check_replaceable(output); !reason.empty())
+    return reason;
+  if (::access(dir.empty() ? "." : dir.c_str(), W_OK) != 0)
+    return "folder " + (dir.empty() ? std::string(".") : dir.string()) + " is not writable";
   return std::nullopt;
 }
 
@@ -180,7 +190,8 @@ void add_render_command(CLI::App &app) {
   cmd->add_flag("--adaptive", args->adaptive,
                 "Adaptive ray budget: --rpp on average, shared out per pixel by a pilot's\n"
                 "variance and circle of confusion (renderer adaptive.h)");
-  cmd->add_option("--threads", args->threads, "CPU threads for --cpu (default: all)");
+  cmd->add_option("--threads", args->threads, "CPU threads for --cpu (default: all)")
+      ->check(CLI::Range(0, 1024));
   cmd->add_flag("--no-influence-region", args->no_influence_region,
                 "Trace every pixel. By default a composite traces only where the virtual\n"
                 "objects, their shadows and their reflections can change it (the same image,\n"

@@ -74,7 +74,9 @@ Measurement row(const CsvReader &csv, const CsvRow &cells) {
                          : "missing from the header (" + std::string(axis) + " rows need it)");
   switch (m.axis) {
   case CalibrationAxis::focus:
-    m.value = csv.number(v, "distance_m", Range::above(0.0, 1e5), /*infinity_allowed=*/true);
+    // Nothing focuses closer than a millimetre, and 1/d of a smaller
+    // positive number (1e-310) would overflow the curve fitted through it.
+    m.value = csv.number(v, "distance_m", Range::within(1e-3, 1e5), /*infinity_allowed=*/true);
     break;
   case CalibrationAxis::iris:
     m.value = csv.number(v, "f_number", Range::within(0.5, 128.0));

@@ -56,7 +56,9 @@ double diopters(const JsonValue &v) {
   }
   if (!v.json().is_number())
     v.fail("must be a distance in metres or \"infinity\"");
-  return 1.0 / v.number(Range::above(0.0, 1e5));
+  // Nothing focuses closer than a millimetre; 1/d of a smaller positive
+  // number (1e-310) overflows to infinity, which no curve can hold.
+  return 1.0 / v.number(Range::within(1e-3, 1e5));
 }
 
 // A calibration table: an array of at least 2 points.

@@ -6,6 +6,9 @@
 #include <functional>
 #include <mutex>
 #include <numeric>
+#include <stdexcept>
+#include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -25,6 +28,8 @@ public:
     int row = next_.fetch_add(1);
     return row < rows_ ? row : -1;
   }
+  // No more rows for anyone.
+  void cancel() { next_ = rows_; }
 
 private:
   int rows_;
@@ -116,8 +121,20 @@ void trace_all(cpu::CpuKernel &kernel, const CompiledScene &scene, Accumulators 
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) {
-    pool.emplace_back(worker);
+  try {
+    for (int t = 1; t < threads; ++t) {
+      pool.emplace_back(worker);
+    }
+  } catch (const std::system_error &e) {
+    // A machine out of threads (or memory for their stacks): the threads
+    // that started stop, and the caller hears why rather than the program
+    // aborting on a joinable thread.
+    queue.cancel();
+    for (auto &thread : pool) {
+      thread.join();
+    }
+    throw std::runtime_error("cannot start thread " + std::to_string(pool.size() + 2) + " of " +
+                             std::to_string(threads) + ": " + e.what());
   }
   worker();
   for (auto &thread : pool) {

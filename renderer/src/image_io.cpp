@@ -15,10 +15,14 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <zlib.h>
+
+#include "camhead/base/partial_file.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
@@ -53,7 +57,9 @@ namespace {
 
 // Far beyond any render (65536 x 2048) yet small enough that a corrupt header
 // cannot make us allocate tens of gigabytes.
-constexpr std::size_t kMaxPixels = std::size_t(1) << 27;
+// 8K UHD (7680 x 4320) fits; a 16-bit RGBA decode of this many pixels is
+// 256 MiB, the most a file of any size can make stb or tinyexr allocate.
+constexpr std::size_t kMaxPixels = std::size_t(1) << 25;
 
 [[noreturn]] void fail(const std::filesystem::path &path, const std::string &reason) {
   throw ImageError(path.string() + ": " + reason);
@@ -70,14 +76,13 @@ std::vector<unsigned char> read_file(const std::filesystem::path &path) {
   return bytes;
 }
 
+// Beside `path` and renamed over it when whole (base/partial_file.h): a
+// write that fails half-way leaves the previous file as it was.
 void write_file(const std::filesystem::path &path, const unsigned char *data, std::size_t size) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out)
-    fail(path, std::string("cannot create: ") + std::strerror(errno));
-  out.write(reinterpret_cast<const char *>(data), std::streamsize(size));
-  out.close();
-  if (!out)
-    fail(path, "write error");
+  std::string error;
+  std::optional<base::PartialFile> file = base::PartialFile::create(path, error);
+  if (!file || !file->write(std::span(data, size), error) || !file->commit(true, error))
+    fail(path, error);
 }
 
 std::string lower_extension(const std::filesystem::path &path) {
@@ -190,7 +195,16 @@ void check_tiles(const std::filesystem::path &path, const std::vector<unsigned c
   }
 }
 
-Image read_exr(const std::filesystem::path &path) {
+// Refuses an image whose header says another size than the caller needs.
+void check_size(const std::filesystem::path &path, long long w, long long h,
+                const std::optional<ImageSize> &expected) {
+  if (expected && (w != expected->width || h != expected->height))
+    fail(path, "is " + std::to_string(w) + "x" + std::to_string(h) + ", not the " +
+                   std::to_string(expected->width) + "x" + std::to_string(expected->height) +
+                   " needed");
+}
+
+Image read_exr(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
   const std::vector<unsigned char> bytes = read_file(path);
   EXRVersion version;
   if (ParseEXRVersionFromMemory(&version, bytes.data(), bytes.size()) != TINYEXR_SUCCESS)
@@ -212,6 +226,7 @@ Image read_exr(const std::filesystem::path &path) {
       fail(path, "data window out of range");
   const long long w = (long long)dw.max_x - dw.min_x + 1;
   const long long h = (long long)dw.max_y - dw.min_y + 1;
+  check_size(path, w, h, expected);
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported data window size");
   int idx[3] = {-1, -1, -1};
@@ -318,14 +333,36 @@ void write_exr(const std::filesystem::path &path, const Image &image) {
   write_file(path, mem.get(), size);
 }
 
-Image read_png(const std::filesystem::path &path) {
-  const std::vector<unsigned char> bytes = read_file(path);
+// A copy of a PNG without its empty IDAT chunks: stb_image copies each
+// IDAT's bytes with memcpy, from a null buffer for an empty first one
+// (undefined behaviour, UBSan says); the image is the same without them.
+std::vector<unsigned char> without_empty_idat(std::vector<unsigned char> bytes) {
+  constexpr std::size_t kSignature = 8;
+  std::size_t at = kSignature;
+  while (at + 12 <= bytes.size()) {
+    const std::size_t length = std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
+                               std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    const bool empty_idat = length == 0 && std::memcmp(&bytes[at + 4], "IDAT", 4) == 0;
+    if (empty_idat) {
+      bytes.erase(bytes.begin() + std::ptrdiff_t(at), bytes.begin() + std::ptrdiff_t(at + 12));
+      continue;
+    }
+    if (length > bytes.size() - at - 12)
+      break; // truncated: stb says so
+    at += 12 + length;
+  }
+  return bytes;
+}
+
+Image read_png(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
+  const std::vector<unsigned char> bytes = without_empty_idat(read_file(path));
   if (bytes.size() > std::size_t(INT_MAX))
     fail(path, "file too large");
   const int len = int(bytes.size());
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp))
     fail(path, std::string("not a readable PNG: ") + stbi_failure_reason());
+  check_size(path, w, h, expected);
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported image size");
   const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
@@ -375,12 +412,12 @@ float linear_to_srgb(float v) {
   return float(linear_to_srgb_d(v));
 }
 
-Image read_image(const std::filesystem::path &path) {
+Image read_image(const std::filesystem::path &path, std::optional<ImageSize> expected) {
   const std::string ext = lower_extension(path);
   if (ext == ".exr")
-    return read_exr(path);
+    return read_exr(path, expected);
   if (ext == ".png")
-    return read_png(path);
+    return read_png(path, expected);
   fail(path, "unsupported image type (expected .exr or .png)");
 }
 

@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 
 #pragma GCC diagnostic push
@@ -76,10 +79,81 @@ void check_exponents(const Path &path, const std::string &text) {
   }
 }
 
+// Corners (face vertex references) an OBJ may have: 16 M, about 5.6 M
+// triangles, a few hundred MB inside tinyobjloader.
+constexpr std::size_t kMaxObjCorners = std::size_t(1) << 24;
+
+// The lines of an OBJ that make a triangle mesh, as tinyobjloader is given
+// them: positions, and faces with their vertex indices alone. The rest
+// (normals, texture coordinates, vertex weights, whose `vw c 1e60` makes
+// tinyobjloader convert an out-of-range float to int, materials, groups) is
+// left out; every face index is checked against the positions, and the
+// corners against kMaxObjCorners, so that a garbage face is refused at its
+// line before anything is stored for it.
+std::string mesh_lines(const Path &path, const std::string &text) {
+  std::size_t positions = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    if (end - at > 2 && text[at] == 'v' && (text[at + 1] == ' ' || text[at + 1] == '\t'))
+      ++positions;
+    at = end + 1;
+  }
+  std::string out;
+  std::size_t corners = 0, seen = 0;
+  int line = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    ++line;
+    std::string_view row(text.data() + at, end - at);
+    at = end + 1;
+    while (!row.empty() && std::isspace((unsigned char)row.front()))
+      row.remove_prefix(1);
+    const bool blank_after = row.size() > 1 && (row[1] == ' ' || row[1] == '\t');
+    if (row.size() < 2 || !blank_after || (row[0] != 'v' && row[0] != 'f'))
+      continue;
+    const std::string where = "line " + std::to_string(line) + ": ";
+    if (row[0] == 'v') {
+      ++seen;
+      out.append(row);
+      out += '\n';
+      continue;
+    }
+    out += 'f';
+    std::size_t i = 1;
+    while (i < row.size()) {
+      while (i < row.size() && std::isspace((unsigned char)row[i]))
+        ++i;
+      if (i >= row.size())
+        break;
+      const std::size_t token = i;
+      while (i < row.size() && !std::isspace((unsigned char)row[i]))
+        ++i;
+      std::string_view vertex = row.substr(token, i - token);
+      vertex = vertex.substr(0, vertex.find('/'));
+      long long index = 0;
+      const auto [ptr, ec] = std::from_chars(vertex.data(), vertex.data() + vertex.size(), index);
+      if (ec != std::errc() || ptr != vertex.data() + vertex.size() || index == 0)
+        fail(path, where + "face vertex '" + std::string(vertex.substr(0, 20)) +
+                       "' is not a vertex index");
+      // Negative: relative to the positions so far; positive: any position.
+      const long long resolved = index < 0 ? (long long)seen + index + 1 : index;
+      if (resolved < 1 || resolved > (long long)positions)
+        fail(path, where + "face vertex " + std::to_string(index) + " is not one of the " +
+                       std::to_string(index < 0 ? seen : positions) + " positions");
+      if (++corners > kMaxObjCorners)
+        fail(path, where + "more than " + std::to_string(kMaxObjCorners) + " face corners");
+      out += ' ';
+      out += std::to_string(resolved);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
 TriangleMesh load_obj(const Path &path) {
   const std::string text = read_file(path);
   check_exponents(path, text);
-  std::istringstream stream(text);
+  std::istringstream stream(mesh_lines(path, text));
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;

@@ -276,7 +276,7 @@ private:
     const std::filesystem::path path = file.path();
     Image plate;
     try {
-      plate = read_image(path);
+      plate = read_image(path, ImageSize{r.width, r.height});
     } catch (const ImageError &e) {
       file.fail(e.what());
     }

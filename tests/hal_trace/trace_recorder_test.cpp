@@ -137,7 +137,7 @@ TEST_F(TraceRecorderTest, RowsReachThePartialFileWhileRecording) {
   EXPECT_LE(partial.readings.size(), 25u);
   EXPECT_GE(partial.readings.back().t_ns, 240 * kMs - 100 * kMs);
 
-  recorder.reset(); // the destructor closes too
+  recorder->close();
   EXPECT_FALSE(std::filesystem::exists(dir_ / "live.csv.partial"));
   const std::string text = slurp(path);
   EXPECT_NE(text.find("# take 3\n"), std::string::npos);
@@ -178,9 +178,52 @@ TEST_F(TraceRecorderTest, UnwritablePlaceIsNamed) {
     TraceRecorder recorder(std::make_unique<ScriptedSource>(), path);
     FAIL() << "recorded into a folder that does not exist";
   } catch (const TraceError &e) {
-    EXPECT_EQ(std::string(e.what()).rfind(path.string() + ".partial: cannot create: ", 0), 0u)
+    EXPECT_EQ(std::string(e.what()).rfind(
+                  path.string() + ": cannot create " + path.string() + ".partial: ", 0),
+              0u)
         << e.what();
   }
+}
+
+// A recording that did not finish (an exception on the way: the recorder is
+// destroyed without close()) leaves the trace a user had as it was, and what
+// it recorded in PATH.partial.
+TEST_F(TraceRecorderTest, UnfinishedRecordingLeavesTheOldTrace) {
+  const std::filesystem::path path = dir_ / "take.csv";
+  {
+    std::ofstream old(path);
+    old << "the user's trace";
+  }
+  {
+    auto source = std::make_unique<ScriptedSource>();
+    source->queue.resize(1);
+    TraceRecorder recorder(std::move(source), path);
+    std::vector<EncoderReading> passed;
+    recorder.poll(milliseconds(0), passed);
+  }
+  EXPECT_EQ(slurp(path), "the user's trace");
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "take.csv.partial"));
+}
+
+// An output that is a device node is refused, not replaced; a symbolic link
+// stands for its target, which is replaced with the link kept.
+TEST_F(TraceRecorderTest, DeviceNodesAreRefusedAndLinksFollowed) {
+  try {
+    TraceRecorder recorder(std::make_unique<ScriptedSource>(), "/dev/null");
+    recorder.close();
+    FAIL() << "recorded over /dev/null";
+  } catch (const TraceError &e) {
+    EXPECT_NE(std::string(e.what()).find("device node"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
+
+  const std::filesystem::path target = dir_ / "target.csv", link = dir_ / "link.csv";
+  std::ofstream(target) << "an older take";
+  std::filesystem::create_symlink(target, link);
+  TraceRecorder recorder(std::make_unique<ScriptedSource>(), link);
+  recorder.close();
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_NO_THROW((void)read_lens_trace(target));
 }
 
 } // namespace

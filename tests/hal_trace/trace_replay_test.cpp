@@ -161,6 +161,27 @@ TEST(TraceReplay, SpeedFactorScalesTheSchedule) {
   }
 }
 
+// A very long trace played slowly: its later readings fall past what int64
+// nanoseconds hold. They are never due (once, the due time wrapped into the
+// past, undefined behaviour, and every reading came at once).
+TEST(TraceReplay, SlowPlayOfALongTraceDoesNotWrap) {
+  LensTrace t{"long.csv", {}};
+  for (const std::int64_t s : {std::int64_t(0), std::int64_t(1), std::int64_t(200'000'000)}) {
+    EncoderReading r;
+    r.t_ns = s * 1'000'000'000; // the last one 6 years in
+    r.focus = static_cast<std::int32_t>(t.readings.size());
+    t.readings.push_back(r);
+  }
+  FakeClock clock;
+  TraceReplay replay(std::move(t), with(clock, /*loop=*/false, /*speed=*/0.01));
+  std::vector<EncoderReading> out;
+  replay.poll(milliseconds(10), out); // the first reading
+  clock.now += 200'000 * kMs;         // past the second's 100 s
+  replay.poll(milliseconds(10), out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1].t_ns, kStart + 100'000 * kMs);
+}
+
 TEST(TraceReplay, TraceTimeNeedNotStartAtZero) {
   LensTrace t = four_readings();
   for (EncoderReading &r : t.readings) {

@@ -198,7 +198,9 @@ TEST(Calibration, MalformedLinesNameFileLineAndColumn) {
       {head + "focus,0,1,,\n", ":4: row: expected 6 fields as in the header, found 5"},
       {head + "focus,0,1,2.8,,\n", ":4: f_number: not used by focus rows"},
       {head + "focus,0,,,,\n", ":4: distance_m: missing"},
-      {head + "focus,0,-1,,,\n", ":4: distance_m: must be > 0 and <= 100000"},
+      {head + "focus,0,-1,,,\n", ":4: distance_m: must be within 0.001 .. 100000"},
+      // 1/d would overflow: an internal invariant must not be what answers.
+      {head + "focus,0,1e-310,,,\n", ":4: distance_m: must be within 0.001 .. 100000"},
       {head + "iris,0,,nan,,\n", ":4: f_number: must be a finite number"},
       {head + "iris,0,,200,,\n", ":4: f_number: must be within 0.5 .. 128"},
       {head + "iris,0,,2.8,2.5,\n", ":4: t_stop: must be >= f_number"},

@@ -286,6 +286,21 @@ TEST(ProfileErrors, SyntaxErrorsAndMissingFiles) {
   }
 }
 
+// A focus distance so small that 1/d overflows (1e-310 m) is an error on
+// its field, not an internal invariant of the curve fitted through it.
+TEST(ProfileErrors, TinyFocusDistanceFailsOnItsField) {
+  Json j = example();
+  j["focus"][0]["distance_m"] = 1e-310;
+  try {
+    (void)LensProfile::parse(j.dump(), kSource);
+    ADD_FAILURE() << "1e-310 m accepted";
+  } catch (const ProfileError &e) {
+    EXPECT_NE(std::string(e.what()).find("focus[0].distance_m: must be within 0.001 .. 100000"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ProfileErrors, NonFiniteAndHugeLiteralsFailOnTheirField) {
   // nlohmann refuses these while parsing; the reader names the field instead.
   const std::string text = example().dump();

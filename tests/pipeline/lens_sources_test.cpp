@@ -91,6 +91,31 @@ TEST_F(LensSources, EverySimulatedSourceFollowsItsTraceToTheSameLensState) {
   }
 }
 
+// A small trace that jumps by 2^31 counts would have the simulated GPIO chip
+// compute every edge of the jump ahead (gigabytes): refused, naming it.
+TEST_F(LensSources, SimulatedGpioRefusesAnImpossibleJump) {
+  {
+    std::ofstream out(dir_ / "jump.csv");
+    out << "# camhead lens trace v1\nt_s,focus,iris,zoom,focus_m,f_stop,focal_mm\n"
+        << "0,-2147483648,,,,,\n0.01,2147483647,,,,,\n";
+  }
+  const Board board = parse_board(R"({
+      "format": "camhead-board", "version": 1, "name": "jump",
+      "lens": {"sources": [
+        {"name": "gpio", "type": "gpio", "chip": "sim",
+         "axes": {"focus": {"a": 0, "b": 1}}, "simulate": "jump.csv"}]}})",
+                                  dir_ / "board.json");
+  try {
+    (void)open_lens_channels(board);
+    FAIL() << "opened";
+  } catch (const std::exception &e) {
+    EXPECT_NE(std::string(e.what()).find("jump.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("more than the simulated GPIO chip follows"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST_F(LensSources, BoardWithoutProfileUsesTheFlaggedFallback) {
   write_trace();
   const Board board = parse_board(R"({"format": "camhead-board", "version": 1, "name": "t",

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,9 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include "camhead/renderer/image_io.h"
@@ -309,6 +313,80 @@ TEST_F(ImageIo, WriteRejectsInvalidImagesAndPaths) {
   EXPECT_THROW(write_image(dir_ / "a.tif", Image(2, 2, 3)), ImageError);
   EXPECT_THROW(write_image(dir_ / "no" / "such" / "dir.exr", Image(2, 2, 3)), ImageError);
   EXPECT_THROW(write_image(dir_ / "no" / "such" / "dir.png", Image(2, 2, 3)), ImageError);
+}
+
+// A small file may claim a vast image (an 809 KB EXR claiming 11585 x
+// 11585 took gigabytes to decode): the claimed size is checked against what
+// the caller needs, and against the reader's limit, from the header.
+TEST_F(ImageIo, ClaimedSizeIsCheckedBeforeDecoding) {
+  std::string bytes = tiled_exr();
+  const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const std::int32_t huge[4] = {0, 0, 11584, 11584};
+  bytes.replace(at + key.size() + 4, 16, reinterpret_cast<const char *>(huge), 16);
+  const fs::path path = write("bomb.exr", bytes);
+  try {
+    (void)read_image(path, ImageSize{5, 3});
+    ADD_FAILURE() << "decoded";
+  } catch (const ImageError &e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": is 11585x11585, not the 5x3 needed");
+  }
+  try {
+    (void)read_image(path);
+    ADD_FAILURE() << "decoded";
+  } catch (const ImageError &e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": unsupported data window size");
+  }
+  // The right size still reads.
+  EXPECT_EQ(read_image(write("tiled.exr", tiled_exr()), ImageSize{5, 3}).width, 5);
+}
+
+// An empty IDAT chunk is valid PNG; stb_image would memcpy from a null
+// pointer for it (UBSan's report in the ASan build). The image reads the
+// same with it.
+TEST_F(ImageIo, EmptyIdatChunkReadsAsWithout) {
+  const std::vector<std::uint16_t> rgb = {0, 1000, 65535, 30000, 20000, 10000};
+  const std::string plain = png16(2, 1, rgb);
+  std::string with_empty = plain;
+  const std::size_t idat = with_empty.find("IDAT") - 4;
+  with_empty.insert(idat, std::string("\0\0\0\0IDAT\x35\xaf\x06\x1e", 12));
+  const Image a = read_image(write("plain.png", plain));
+  const Image b = read_image(write("empty_idat.png", with_empty));
+  EXPECT_EQ(a.data, b.data);
+}
+
+// A write that fails half-way (here a file-size limit) leaves the previous
+// file as it was, and no partial file beside it.
+TEST_F(ImageIo, FailedWriteLeavesThePreviousFile) {
+  const fs::path path = dir_ / "frame.exr";
+  Image small(4, 4, 3);
+  write_image(path, small);
+  const std::string before = read_bytes(path);
+  Image big(512, 512, 3);
+  std::mt19937 rng(1);
+  for (float &v : big.data)
+    v = std::uniform_real_distribution<float>(0.0f, 1.0f)(rng); // incompressible
+  // In a child, so that the limit and the ignored SIGXFSZ stay there.
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{64 * 1024, 64 * 1024};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      write_image(path, big);
+    } catch (const ImageError &) {
+      _exit(0); // failed, as it must
+    }
+    _exit(1);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "the write did not fail";
+  EXPECT_EQ(read_bytes(path), before);
+  EXPECT_FALSE(fs::exists(dir_ / "frame.exr.partial"));
 }
 
 } // namespace

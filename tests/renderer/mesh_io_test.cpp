@@ -141,9 +141,25 @@ TEST_F(MeshIo, ReadsBinaryPlyInBothByteOrders) {
   EXPECT_EQ(load_mesh(write("crlf.ply", crlf)).triangles, kPentagonFan);
 }
 
+// What a triangle mesh does not use is left out before tinyobjloader reads
+// the file: texture and normal indices, and vertex weights, whose `vw c 1e60`
+// made it convert an out-of-range float to int (UBSan).
+TEST_F(MeshIo, ObjKeepsPositionsAndFacesOnly) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nvw c 1e60\n"
+                          "mtllib none.mtl\nusemtl x\ng part\nf 1/1/1 2//1 -1\n";
+  const TriangleMesh m = load_mesh(write("extras.obj", obj));
+  ASSERT_EQ(m.triangles.size(), 1u);
+  EXPECT_EQ(m.triangles[0], glm::uvec3(0, 1, 2));
+}
+
 TEST_F(MeshIo, RejectsMalformedObj) {
   const std::string v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
-  EXPECT_NE(error_for("index.obj", v3 + "f 1 2 4\n").find("triangle 0"), std::string::npos);
+  // Refused at its line, before tinyobjloader stores a garbage face.
+  EXPECT_NE(
+      error_for("index.obj", v3 + "f 1 2 4\n").find("line 4: face vertex 4 is not one of the 3"),
+      std::string::npos);
+  EXPECT_NE(error_for("word.obj", v3 + "f 1 2 x\n").find("line 4: face vertex 'x'"),
+            std::string::npos);
   EXPECT_NE(error_for("zero.obj", v3 + "f 0 1 2\n").find("line 4"), std::string::npos);
   EXPECT_NE(error_for("relative.obj", v3 + "f -1 -2 -4\n"), "");
   EXPECT_NE(error_for("empty.obj", "").find("no faces"), std::string::npos);

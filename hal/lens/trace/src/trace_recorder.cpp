@@ -1,10 +1,8 @@
 // The recording decorator. See trace_recorder.h for the crash-safety model.
 #include "camhead/hal/lens/trace/trace_recorder.h"
 
-#include <cerrno>
-#include <cstring>
-
-#include <unistd.h>
+#include <cstdint>
+#include <span>
 
 #include "camhead/hal/lens/trace/lens_trace.h"
 
@@ -15,18 +13,22 @@ namespace {
 // the buffer stays small at high rates.
 constexpr std::size_t kMaxPending = 64 * 1024;
 
+std::optional<base::PartialFile> open_partial(const std::filesystem::path &path) {
+  std::string error;
+  std::optional<base::PartialFile> file = base::PartialFile::create(path, error);
+  if (!file) {
+    throw TraceError(path.string(), 0, "", error);
+  }
+  return file;
+}
+
 } // namespace
 
 TraceRecorder::TraceRecorder(std::unique_ptr<LensEncoder> inner, std::filesystem::path path,
                              TraceRecorderOptions options)
     : inner_(std::move(inner)), path_(std::move(path)),
-      flush_interval_ns_(std::chrono::nanoseconds(options.flush_interval).count()) {
-  const std::filesystem::path partial = partial_path();
-  file_.reset(std::fopen(partial.c_str(), "wb"));
-  if (!file_) {
-    throw TraceError(partial.string(), 0, "",
-                     std::string("cannot create: ") + std::strerror(errno));
-  }
+      flush_interval_ns_(std::chrono::nanoseconds(options.flush_interval).count()),
+      file_(open_partial(path_)) {
   std::string comment = "recorded from " + inner_->name();
   if (!options.comment.empty()) {
     comment += "\n" + options.comment;
@@ -34,19 +36,21 @@ TraceRecorder::TraceRecorder(std::unique_ptr<LensEncoder> inner, std::filesystem
   pending_ = format_trace_header(comment);
   flush();
   if (!error_.empty()) {
-    throw TraceError(partial.string(), 0, "", error_);
+    throw TraceError(partial_path().string(), 0, "", error_);
   }
 }
 
 TraceRecorder::~TraceRecorder() {
-  try {
-    close();
-  } catch (const TraceError &) {
-    // PATH.partial stays behind and says so.
+  if (!closed_ && file_) {
+    flush();
+    if (file_)
+      file_->abandon();
   }
 }
 
 std::filesystem::path TraceRecorder::partial_path() const {
+  if (file_)
+    return file_->partial_path();
   std::filesystem::path p = path_;
   p += ".partial";
   return p;
@@ -95,9 +99,10 @@ void TraceRecorder::flush() {
   if (!file_ || pending_.empty()) {
     return;
   }
-  if (std::fwrite(pending_.data(), 1, pending_.size(), file_.get()) != pending_.size() ||
-      std::fflush(file_.get()) != 0) {
-    fail(std::string("write: ") + std::strerror(errno));
+  std::string error;
+  const std::span bytes(reinterpret_cast<const std::uint8_t *>(pending_.data()), pending_.size());
+  if (!file_->write(bytes, error)) {
+    fail(error);
     return;
   }
   pending_.clear();
@@ -110,7 +115,10 @@ void TraceRecorder::fail(const std::string &what) {
   if (error_.empty()) {
     error_ = what;
   }
-  file_.reset();
+  if (file_) {
+    file_->abandon(); // what was written stays in PATH.partial
+    file_.reset();
+  }
   pending_.clear();
 }
 
@@ -121,19 +129,13 @@ void TraceRecorder::close() {
   closed_ = true;
   const std::filesystem::path partial = partial_path();
   flush();
-  if (file_ && ::fdatasync(::fileno(file_.get())) != 0) {
-    fail(std::string("fdatasync: ") + std::strerror(errno));
+  std::string error;
+  if (file_ && !file_->commit(true, error)) {
+    fail(error);
   }
-  if (file_ && std::fclose(file_.release()) != 0) {
-    fail(std::string("close: ") + std::strerror(errno));
-  }
+  file_.reset();
   if (!error_.empty()) {
     throw TraceError(partial.string(), 0, "", "recording stopped: " + error_);
-  }
-  std::error_code ec;
-  std::filesystem::rename(partial, path_, ec);
-  if (ec) {
-    throw TraceError(partial.string(), 0, "", "rename to " + path_.string() + ": " + ec.message());
   }
 }
 

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <ctime>
+#include <limits>
 
 #include "camhead/hal/lens/monotonic_clock.h"
 
@@ -68,11 +69,23 @@ std::string TraceReplay::name() const {
 }
 
 std::int64_t TraceReplay::due_ns(std::size_t index, std::uint64_t loop) const {
-  const std::int64_t offset = trace_.readings[index].t_ns - trace_.readings.front().t_ns +
-                              static_cast<std::int64_t>(loop) * period_ns_;
-  // Exact at speed 1; otherwise doubles are exact to the nanosecond for
-  // offsets up to 2^53 ns (104 days).
-  return start_ns_ + (speed_ == 1.0 ? offset : std::llround(static_cast<double>(offset) / speed_));
+  const std::int64_t t = trace_.readings[index].t_ns, t0 = trace_.readings.front().t_ns;
+  // Exact in integers at speed 1 while nothing overflows.
+  std::int64_t span = 0, looped = 0, offset = 0, due = 0;
+  if (speed_ == 1.0 && !__builtin_sub_overflow(t, t0, &span) &&
+      !__builtin_mul_overflow(static_cast<std::int64_t>(loop), period_ns_, &looped) &&
+      !__builtin_add_overflow(span, looped, &offset) &&
+      !__builtin_add_overflow(start_ns_, offset, &due))
+    return due;
+  // Otherwise in doubles, exact to the nanosecond up to 2^53 ns (104 days);
+  // a time past what int64 holds (a long trace played slowly) is never due,
+  // rather than wrapped into the past with every reading due at once.
+  const double at = static_cast<double>(start_ns_) +
+                    (static_cast<double>(t) - static_cast<double>(t0) +
+                     static_cast<double>(loop) * static_cast<double>(period_ns_)) /
+                        speed_;
+  constexpr double kLatest = 9.2e18; // below INT64_MAX, with a margin for llround
+  return at < kLatest ? std::llround(at) : std::numeric_limits<std::int64_t>::max();
 }
 
 void TraceReplay::join(std::int64_t from_ns) {

@@ -4,10 +4,10 @@
 #include <system_error>
 #include <vector>
 
+#include "camhead/base/partial_file.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/hal/video_file/frame_pattern.h"
 #include "camhead/hal/video_file/png_frame.h"
-#include "partial_file.h"
 
 namespace camhead::hal::output {
 namespace {
@@ -43,7 +43,7 @@ public:
       return fail("cannot encode PNG (out of memory)");
     const std::filesystem::path target = pattern_.path(next_);
     std::string error;
-    std::optional<PartialFile> file = PartialFile::create(target, error);
+    std::optional<base::PartialFile> file = base::PartialFile::create(target, error);
     if (!file || !file->write(png_, error) || !file->commit(false, error))
       return fail(target.string() + ": " + error);
     ++next_;
@@ -110,7 +110,7 @@ std::unique_ptr<FrameSink> open_png_sequence_sink(const std::string &pattern,
     throw FileSinkError(pattern + ": cannot create folder " + folder.string() + ": " +
                         ec.message());
   // Proves the folder writable now rather than at the first frame.
-  std::optional<PartialFile> probe = PartialFile::create(first, error);
+  std::optional<base::PartialFile> probe = base::PartialFile::create(first, error);
   if (!probe)
     throw FileSinkError(pattern + ": " + error);
   probe->discard();

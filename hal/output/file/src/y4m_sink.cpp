@@ -5,10 +5,10 @@
 #include <optional>
 #include <vector>
 
+#include "camhead/base/partial_file.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/hal/video_file/y4m_header.h"
 #include "camhead/hal/video_file/y4m_planes.h"
-#include "partial_file.h"
 
 namespace camhead::hal::output {
 namespace {
@@ -17,7 +17,7 @@ constexpr std::string_view kFrameLine = "FRAME\n";
 
 class Y4mSink final : public FrameSink {
 public:
-  Y4mSink(std::string name, base::VideoFormat format, PartialFile file)
+  Y4mSink(std::string name, base::VideoFormat format, base::PartialFile file)
       : name_(std::move(name)), format_(format), file_(std::move(file)),
         frame_(base::frame_bytes(format)),
         record_(kFrameLine.size() + video_file::y4m_plane_bytes(format)) {
@@ -93,7 +93,7 @@ private:
 
   const std::string name_;
   const base::VideoFormat format_;
-  PartialFile file_;
+  base::PartialFile file_;
   std::vector<std::uint8_t> frame_;
   std::vector<std::uint8_t> record_;
   bool acquired_ = false;
@@ -135,7 +135,7 @@ std::unique_ptr<FrameSink> open_y4m_sink(const std::filesystem::path &path,
   const std::string line = video_file::format_y4m_header(header);
 
   std::string error;
-  std::optional<PartialFile> file = PartialFile::create(path, error);
+  std::optional<base::PartialFile> file = base::PartialFile::create(path, error);
   if (!file)
     throw FileSinkError(name + ": " + error);
   if (!file->write({reinterpret_cast<const std::uint8_t *>(line.data()), line.size()}, error))

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 #include "camhead/renderer/image.h"
@@ -14,9 +15,17 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+struct ImageSize {
+  int width = 0;
+  int height = 0;
+};
+
 // EXR: RGB (or Y) channels as linear float. PNG: 8/16-bit sRGB decoded to
 // linear. Returns a 3-channel image. Throws ImageError naming the file.
-[[nodiscard]] Image read_image(const std::filesystem::path &path);
+// With `expected`, an image of another size is refused from its header,
+// before anything is decoded: a small file can claim a vast image.
+[[nodiscard]] Image read_image(const std::filesystem::path &path,
+                               std::optional<ImageSize> expected = std::nullopt);
 
 // Chosen by extension: .exr writes linear float32 (ZIP); .png writes 8-bit
 // sRGB, clipped to [0, 1] and rounded. 1-channel images are written as grey.

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "camhead/base/partial_file.h"
 #include "camhead/hal/lens/lens_encoder.h"
 
 namespace camhead::hal::lens {
@@ -43,11 +44,15 @@ struct TraceRecorderOptions {
 class TraceRecorder final : public LensEncoder {
 public:
   // Creates PATH.partial (replacing a stale one) and writes the head of the
-  // trace. Throws TraceError naming PATH.partial when it cannot.
+  // trace (base/partial_file.h: a PATH that is a symbolic link stands for
+  // its target; one that is a device node, a FIFO or a folder is refused).
+  // Throws TraceError naming the file when it cannot.
   TraceRecorder(std::unique_ptr<LensEncoder> inner, std::filesystem::path path,
                 TraceRecorderOptions options = {});
-  // Closes as close() does; a failure leaves PATH.partial behind, which is
-  // then the only sign of it (a destructor cannot throw).
+  // Writes what is buffered into PATH.partial and leaves it there, PATH
+  // untouched: a recorder destroyed without close() (an exception on the
+  // way) did not finish its recording, and must not replace the trace a
+  // user already had.
   ~TraceRecorder() override;
 
   // Writes what is buffered, syncs, closes and renames PATH.partial to PATH.
@@ -68,10 +73,6 @@ public:
   [[nodiscard]] std::uint64_t skipped() const { return skipped_; }
 
 private:
-  struct FileCloser {
-    void operator()(std::FILE *f) const { std::fclose(f); }
-  };
-
   void record(const EncoderReading &r);
   void flush();
   void fail(const std::string &what);
@@ -79,7 +80,7 @@ private:
   std::unique_ptr<LensEncoder> inner_;
   std::filesystem::path path_;
   std::int64_t flush_interval_ns_ = 0;
-  std::unique_ptr<std::FILE, FileCloser> file_;
+  std::optional<base::PartialFile> file_;
   std::string pending_;
   std::optional<std::int64_t> origin_ns_, last_ns_;
   std::int64_t last_flush_ns_ = 0;

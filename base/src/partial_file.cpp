@@ -1,5 +1,5 @@
 // See partial_file.h.
-#include "partial_file.h"
+#include "camhead/base/partial_file.h"
 
 #include <cerrno>
 #include <cstring>
@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-namespace camhead::hal::output {
+namespace camhead::base {
 namespace {
 
 std::string errno_text() {
@@ -145,6 +145,14 @@ bool PartialFile::commit(bool durable, std::string &error) {
   return true;
 }
 
+void PartialFile::abandon() {
+  if (fd_ >= 0) {
+    ::close(fd_);
+    fd_ = -1;
+  }
+  partial_.clear();
+}
+
 void PartialFile::discard() {
   if (fd_ >= 0) {
     ::close(fd_);
@@ -156,4 +164,4 @@ void PartialFile::discard() {
   }
 }
 
-} // namespace camhead::hal::output
+} // namespace camhead::base

@@ -1,6 +1,9 @@
-// A file written as NAME.partial and renamed over NAME when it is complete,
-// for the file sinks. Errors are values ("REASON", the caller adds the
-// name), since sinks must not throw once open.
+// A file written as NAME.partial and renamed over NAME when it is complete:
+// every file camhead writes (images, profiles, traces, video), so that a
+// write that fails half-way (disk full, a size limit, a crash) leaves the
+// previous NAME as it was, and a NAME that is a device node, a FIFO or a
+// folder is refused rather than replaced. Errors are values ("REASON", the
+// caller adds the name), since the file sinks must not throw once open.
 //
 // Thread safety: none; one sink thread owns it.
 #pragma once
@@ -13,7 +16,7 @@
 
 #include <sys/types.h>
 
-namespace camhead::hal::output {
+namespace camhead::base {
 
 // Why `path` cannot be replaced by a rename: it exists and is not a regular
 // file (followed through symbolic links). Empty when it can.
@@ -47,6 +50,10 @@ public:
   // Closes and removes the partial file.
   void discard();
 
+  // Closes and leaves the partial file where it is, unrenamed: what a crash
+  // would leave, for a recording that was not finished.
+  void abandon();
+
   [[nodiscard]] const std::filesystem::path &partial_path() const { return partial_; }
 
 private:
@@ -59,4 +66,4 @@ private:
   off_t size_ = 0;
 };
 
-} // namespace camhead::hal::output
+} // namespace camhead::base
