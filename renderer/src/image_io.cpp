@@ -354,6 +354,60 @@ std::vector<unsigned char> without_empty_idat(std::vector<unsigned char> bytes) 
   return bytes;
 }
 
+// stb_image inflates the IDAT stream into a buffer it doubles for as long
+// as the stream goes on, whatever the header claims: a 207-byte PNG made it
+// reallocate 2 GiB. The stream is inflated here first, into a small scratch
+// buffer, and refused once it outgrows the image its header describes.
+void check_inflated_size(const std::filesystem::path &path, const std::vector<unsigned char> &png) {
+  std::vector<unsigned char> idat;
+  std::uint64_t width = 0, height = 0, bits_per_pixel = 0;
+  bool interlaced = false;
+  for (std::size_t at = 8; at + 12 <= png.size();) {
+    const std::size_t length = std::size_t(png[at]) << 24 | std::size_t(png[at + 1]) << 16 |
+                               std::size_t(png[at + 2]) << 8 | png[at + 3];
+    if (length > png.size() - at - 12)
+      break; // truncated: stb says so
+    const unsigned char *type = &png[at + 4], *data = &png[at + 8];
+    if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13) {
+      width = std::uint64_t(data[0]) << 24 | data[1] << 16 | data[2] << 8 | data[3];
+      height = std::uint64_t(data[4]) << 24 | data[5] << 16 | data[6] << 8 | data[7];
+      constexpr int kChannels[7] = {1, 0, 3, 1, 2, 0, 4}; // by colour type
+      const int channels = data[9] < 7 ? kChannels[data[9]] : 0;
+      bits_per_pixel = std::uint64_t(channels) * data[8];
+      interlaced = data[12] != 0;
+    } else if (std::memcmp(type, "IDAT", 4) == 0) {
+      idat.insert(idat.end(), data, data + length);
+    }
+    at += 12 + length;
+  }
+  if (bits_per_pixel == 0)
+    return; // no usable header: stb says what is wrong
+  // A filter byte per row and the rows' bytes; interlacing adds at most a
+  // filter byte per row of each of its seven passes, and a byte's rounding.
+  const std::uint64_t row = (width * bits_per_pixel + 7) / 8;
+  const std::uint64_t most = height * (1 + row) + (interlaced ? 7 * (height + 1) * 2 : 0) + 1024;
+  z_stream z{};
+  if (inflateInit(&z) != Z_OK)
+    fail(path, "cannot start zlib");
+  z.next_in = idat.data();
+  z.avail_in = uInt(std::min<std::size_t>(idat.size(), UINT_MAX));
+  std::vector<unsigned char> scratch(64 * 1024);
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    z.next_out = scratch.data();
+    z.avail_out = uInt(scratch.size());
+    rc = inflate(&z, Z_NO_FLUSH);
+    if (z.total_out > most) {
+      inflateEnd(&z);
+      fail(path, "its image data inflates past the " + std::to_string(width) + "x" +
+                     std::to_string(height) + " image its header describes");
+    }
+    if (rc == Z_BUF_ERROR && z.avail_in == 0)
+      break; // the stream ends early: stb says so
+  }
+  inflateEnd(&z);
+}
+
 Image read_png(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
   const std::vector<unsigned char> bytes = without_empty_idat(read_file(path));
   if (bytes.size() > std::size_t(INT_MAX))
@@ -365,6 +419,7 @@ Image read_png(const std::filesystem::path &path, const std::optional<ImageSize>
   check_size(path, w, h, expected);
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported image size");
+  check_inflated_size(path, bytes);
   const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
   const std::unique_ptr<void, decltype(&stbi_image_free)> pixels(
       sixteen ? static_cast<void *>(stbi_load_16_from_memory(bytes.data(), len, &w, &h, &comp, 3))

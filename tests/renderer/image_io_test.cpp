@@ -356,6 +356,37 @@ TEST_F(ImageIo, EmptyIdatChunkReadsAsWithout) {
   EXPECT_EQ(a.data, b.data);
 }
 
+// A small PNG whose image data inflates far beyond its header's image (a
+// 207-byte one made stb_image reallocate 2 GiB) is refused before stb sees
+// it.
+TEST_F(ImageIo, InflationBombPngIsRefused) {
+  const auto be32 = [](std::uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  const auto chunk = [&](const std::string &type, const std::string &data) {
+    const std::string body = type + data;
+    const auto crc = crc32(0, reinterpret_cast<const Bytef *>(body.data()), uInt(body.size()));
+    return be32(std::uint32_t(data.size())) + body + be32(std::uint32_t(crc));
+  };
+  const std::string zeros(64 << 20, '\0'); // 64 MiB for a 2 x 2 image
+  uLongf size = compressBound(uLong(zeros.size()));
+  std::string z(size, '\0');
+  compress2(reinterpret_cast<Bytef *>(z.data()), &size,
+            reinterpret_cast<const Bytef *>(zeros.data()), uLong(zeros.size()), 9);
+  z.resize(size);
+  const std::string png = "\x89PNG\r\n\x1a\n" +
+                          chunk("IHDR", be32(2) + be32(2) + std::string{8, 2, 0, 0, 0}) +
+                          chunk("IDAT", z) + chunk("IEND", "");
+  const fs::path path = write("bomb.png", png);
+  try {
+    (void)read_image(path);
+    ADD_FAILURE() << "decoded";
+  } catch (const ImageError &e) {
+    EXPECT_NE(std::string(e.what()).find("inflates past the 2x2 image"), std::string::npos)
+        << e.what();
+  }
+}
+
 // A write that fails half-way (here a file-size limit) leaves the previous
 // file as it was, and no partial file beside it.
 TEST_F(ImageIo, FailedWriteLeavesThePreviousFile) {
