@@ -229,6 +229,17 @@ Image read_exr(const std::filesystem::path &path, const std::optional<ImageSize>
   check_size(path, w, h, expected);
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported data window size");
+  // tinyexr's PIZ decoder overruns its buffers on damaged files (found by
+  // tests/fuzz/exr_fuzz); ZIP, camhead's and Blender's default, and the
+  // simpler codecs are read.
+  const int compression = header.h.compression_type;
+  if (compression != TINYEXR_COMPRESSIONTYPE_NONE && compression != TINYEXR_COMPRESSIONTYPE_RLE &&
+      compression != TINYEXR_COMPRESSIONTYPE_ZIPS && compression != TINYEXR_COMPRESSIONTYPE_ZIP)
+    fail(path, "compression " +
+                   std::string(compression == TINYEXR_COMPRESSIONTYPE_PIZ
+                                   ? "PIZ"
+                                   : "type " + std::to_string(compression)) +
+                   " is not supported; save as ZIP (or uncompressed)");
   int idx[3] = {-1, -1, -1};
   int luma = -1;
   for (int c = 0; c < header.h.num_channels; ++c) {

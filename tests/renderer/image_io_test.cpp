@@ -387,6 +387,15 @@ TEST_F(ImageIo, InflationBombPngIsRefused) {
   }
 }
 
+// What tests/fuzz found, kept: each file is refused with ImageError and
+// nothing else (the ASan+UBSan build checks that nothing else happens).
+TEST_F(ImageIo, FuzzFindingsAreRefused) {
+  for (const char *name :
+       {"exr_piz_overflow_1.exr", "exr_piz_overflow_2.exr", "png_inflate_oom_1.png",
+        "png_inflate_oom_2.png", "png_empty_idat_null.png"})
+    EXPECT_TRUE(read_fails(test::source_dir() / "tests/assets/fuzz" / name)) << name;
+}
+
 // A write that fails half-way (here a file-size limit) leaves the previous
 // file as it was, and no partial file beside it.
 TEST_F(ImageIo, FailedWriteLeavesThePreviousFile) {

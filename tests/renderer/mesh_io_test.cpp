@@ -152,6 +152,18 @@ TEST_F(MeshIo, ObjKeepsPositionsAndFacesOnly) {
   EXPECT_EQ(m.triangles[0], glm::uvec3(0, 1, 2));
 }
 
+// What tests/fuzz found (tinyobjloader's float-to-int conversion on `vw`
+// lines): each file loads or is refused with MeshError, and nothing else.
+TEST_F(MeshIo, FuzzFindingsLoadOrAreRefused) {
+  for (const char *name :
+       {"obj_vw_float_to_int_1.obj", "obj_vw_float_to_int_2.obj", "obj_vw_float_to_int_3.obj"}) {
+    try {
+      (void)load_mesh(test::source_dir() / "tests/assets/fuzz" / name);
+    } catch (const MeshError &) {
+    }
+  }
+}
+
 TEST_F(MeshIo, RejectsMalformedObj) {
   const std::string v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   // Refused at its line, before tinyobjloader stores a garbage face.
