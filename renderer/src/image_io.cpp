@@ -347,6 +347,24 @@ void write_exr(const std::filesystem::path &path, const Image &image) {
 // A copy of a PNG without its empty IDAT chunks: stb_image copies each
 // IDAT's bytes with memcpy, from a null buffer for an empty first one
 // (undefined behaviour, UBSan says); the image is the same without them.
+// Every chunk whole, up to IEND: stb_image reallocates its IDAT buffer to
+// the length a chunk claims before it finds the bytes missing (1.3 GB for
+// a 41-byte file, tests/fuzz/png_fuzz), and copies from a truncated one.
+void check_chunks(const std::filesystem::path &path, const std::vector<unsigned char> &bytes) {
+  for (std::size_t at = 8;;) {
+    if (at + 12 > bytes.size())
+      fail(path, "not a readable PNG: ends inside a chunk, or without IEND");
+    const std::size_t length = std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
+                               std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    if (length > bytes.size() - at - 12)
+      fail(path, "not a readable PNG: a chunk claims " + std::to_string(length) +
+                     " bytes, more than the file has");
+    if (std::memcmp(&bytes[at + 4], "IEND", 4) == 0)
+      return;
+    at += 12 + length;
+  }
+}
+
 std::vector<unsigned char> without_empty_idat(std::vector<unsigned char> bytes) {
   constexpr std::size_t kSignature = 8;
   std::size_t at = kSignature;
@@ -420,7 +438,10 @@ void check_inflated_size(const std::filesystem::path &path, const std::vector<un
 }
 
 Image read_png(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
-  const std::vector<unsigned char> bytes = without_empty_idat(read_file(path));
+  std::vector<unsigned char> file = read_file(path);
+  if (file.size() >= 8)
+    check_chunks(path, file);
+  const std::vector<unsigned char> bytes = without_empty_idat(std::move(file));
   if (bytes.size() > std::size_t(INT_MAX))
     fail(path, "file too large");
   const int len = int(bytes.size());

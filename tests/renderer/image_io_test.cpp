@@ -392,7 +392,8 @@ TEST_F(ImageIo, InflationBombPngIsRefused) {
 TEST_F(ImageIo, FuzzFindingsAreRefused) {
   for (const char *name :
        {"exr_piz_overflow_1.exr", "exr_piz_overflow_2.exr", "png_inflate_oom_1.png",
-        "png_inflate_oom_2.png", "png_empty_idat_null.png"})
+        "png_inflate_oom_2.png", "png_empty_idat_null.png", "png_inflate_oom_1_min.png",
+        "png_inflate_oom_2_min.png", "png_empty_idat_null_min.png"})
     EXPECT_TRUE(read_fails(test::source_dir() / "tests/assets/fuzz" / name)) << name;
 }
 
