@@ -344,18 +344,21 @@ void write_exr(const std::filesystem::path &path, const Image &image) {
   write_file(path, mem.get(), size);
 }
 
-// A copy of a PNG without its empty IDAT chunks: stb_image copies each
-// IDAT's bytes with memcpy, from a null buffer for an empty first one
-// (undefined behaviour, UBSan says); the image is the same without them.
+// The big-endian length of the PNG chunk at `at` (its type follows).
+std::size_t png_chunk_length(const std::vector<unsigned char> &bytes, std::size_t at) {
+  return std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
+         std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+}
+
 // Every chunk whole, up to IEND: stb_image reallocates its IDAT buffer to
 // the length a chunk claims before it finds the bytes missing (1.3 GB for
 // a 41-byte file, tests/fuzz/png_fuzz), and copies from a truncated one.
+// The walks below rely on it.
 void check_chunks(const std::filesystem::path &path, const std::vector<unsigned char> &bytes) {
   for (std::size_t at = 8;;) {
     if (at + 12 > bytes.size())
       fail(path, "not a readable PNG: ends inside a chunk, or without IEND");
-    const std::size_t length = std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
-                               std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    const std::size_t length = png_chunk_length(bytes, at);
     if (length > bytes.size() - at - 12)
       fail(path, "not a readable PNG: a chunk claims " + std::to_string(length) +
                      " bytes, more than the file has");
@@ -365,20 +368,17 @@ void check_chunks(const std::filesystem::path &path, const std::vector<unsigned 
   }
 }
 
+// A copy of a PNG (its chunks checked) without its empty IDAT chunks:
+// stb_image copies each IDAT's bytes with memcpy, from a null buffer for an
+// empty first one (undefined behaviour, UBSan says); the image is the same
+// without them.
 std::vector<unsigned char> without_empty_idat(std::vector<unsigned char> bytes) {
-  constexpr std::size_t kSignature = 8;
-  std::size_t at = kSignature;
-  while (at + 12 <= bytes.size()) {
-    const std::size_t length = std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
-                               std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
-    const bool empty_idat = length == 0 && std::memcmp(&bytes[at + 4], "IDAT", 4) == 0;
-    if (empty_idat) {
+  for (std::size_t at = 8; std::memcmp(&bytes[at + 4], "IEND", 4) != 0;) {
+    const std::size_t length = png_chunk_length(bytes, at);
+    if (length == 0 && std::memcmp(&bytes[at + 4], "IDAT", 4) == 0)
       bytes.erase(bytes.begin() + std::ptrdiff_t(at), bytes.begin() + std::ptrdiff_t(at + 12));
-      continue;
-    }
-    if (length > bytes.size() - at - 12)
-      break; // truncated: stb says so
-    at += 12 + length;
+    else
+      at += 12 + length;
   }
   return bytes;
 }
@@ -391,11 +391,8 @@ void check_inflated_size(const std::filesystem::path &path, const std::vector<un
   std::vector<unsigned char> idat;
   std::uint64_t width = 0, height = 0, bits_per_pixel = 0;
   bool interlaced = false;
-  for (std::size_t at = 8; at + 12 <= png.size();) {
-    const std::size_t length = std::size_t(png[at]) << 24 | std::size_t(png[at + 1]) << 16 |
-                               std::size_t(png[at + 2]) << 8 | png[at + 3];
-    if (length > png.size() - at - 12)
-      break; // truncated: stb says so
+  for (std::size_t at = 8; std::memcmp(&png[at + 4], "IEND", 4) != 0;) {
+    const std::size_t length = png_chunk_length(png, at);
     const unsigned char *type = &png[at + 4], *data = &png[at + 8];
     if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13) {
       width = std::uint64_t(data[0]) << 24 | data[1] << 16 | data[2] << 8 | data[3];
@@ -439,8 +436,9 @@ void check_inflated_size(const std::filesystem::path &path, const std::vector<un
 
 Image read_png(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
   std::vector<unsigned char> file = read_file(path);
-  if (file.size() >= 8)
-    check_chunks(path, file);
+  if (file.size() < 8 || std::memcmp(file.data(), "\x89PNG\r\n\x1a\n", 8) != 0)
+    fail(path, "not a readable PNG: no PNG signature");
+  check_chunks(path, file);
   const std::vector<unsigned char> bytes = without_empty_idat(std::move(file));
   if (bytes.size() > std::size_t(INT_MAX))
     fail(path, "file too large");

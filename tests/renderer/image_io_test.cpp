@@ -34,16 +34,19 @@ std::string read_bytes(const fs::path &path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+std::string be32(std::uint32_t v) {
+  return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+}
+
+// One PNG chunk: length, type, data and CRC.
+std::string chunk(const std::string &type, const std::string &data) {
+  const std::string body = type + data;
+  const auto crc = crc32(0, reinterpret_cast<const Bytef *>(body.data()), uInt(body.size()));
+  return be32(std::uint32_t(data.size())) + body + be32(std::uint32_t(crc));
+}
+
 // A 16-bit RGB PNG, which stb_image_write cannot produce.
 std::string png16(int w, int h, const std::vector<std::uint16_t> &rgb) {
-  const auto be32 = [](std::uint32_t v) {
-    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
-  };
-  const auto chunk = [&](const std::string &type, const std::string &data) {
-    const std::string body = type + data;
-    const auto crc = crc32(0, reinterpret_cast<const Bytef *>(body.data()), uInt(body.size()));
-    return be32(std::uint32_t(data.size())) + body + be32(std::uint32_t(crc));
-  };
   std::string raw;
   for (int y = 0; y < h; ++y) {
     raw += '\0'; // filter: none
@@ -360,14 +363,6 @@ TEST_F(ImageIo, EmptyIdatChunkReadsAsWithout) {
 // 207-byte one made stb_image reallocate 2 GiB) is refused before stb sees
 // it.
 TEST_F(ImageIo, InflationBombPngIsRefused) {
-  const auto be32 = [](std::uint32_t v) {
-    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
-  };
-  const auto chunk = [&](const std::string &type, const std::string &data) {
-    const std::string body = type + data;
-    const auto crc = crc32(0, reinterpret_cast<const Bytef *>(body.data()), uInt(body.size()));
-    return be32(std::uint32_t(data.size())) + body + be32(std::uint32_t(crc));
-  };
   const std::string zeros(64 << 20, '\0'); // 64 MiB for a 2 x 2 image
   uLongf size = compressBound(uLong(zeros.size()));
   std::string z(size, '\0');
