@@ -1,12 +1,10 @@
 // ConfigError, the reading of a configuration file, and the words of a range.
 #include "camhead/base/config_error.h"
 
-#include <fstream>
-#include <iterator>
 #include <sstream>
-#include <system_error>
 
 #include "camhead/base/config_range.h"
+#include "camhead/base/input_file.h"
 #include "config_words.h"
 
 namespace camhead::base {
@@ -20,18 +18,11 @@ ConfigError::ConfigError(std::string file, int line, std::string field, std::str
       file_(std::move(file)), line_(line), field_(std::move(field)), reason_(std::move(reason)) {}
 
 std::string read_config_file(const std::filesystem::path &path) {
-  // An ifstream opens a folder on Linux and then reads nothing: say so
-  // rather than report a syntax error in an empty text.
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ConfigError(path.string(), "(file)", "is a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw ConfigError(path.string(), "(file)", "cannot be opened");
-  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad())
-    throw ConfigError(path.string(), "(file)", "cannot be read");
-  return text;
+  std::string error;
+  std::optional<std::string> text = read_input_file(path, kMaxConfigFileBytes, error);
+  if (!text)
+    throw ConfigError(path.string(), "(file)", error);
+  return std::move(*text);
 }
 
 bool Range::contains(double v) const {

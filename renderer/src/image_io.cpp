@@ -6,14 +6,11 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <memory>
 #include <optional>
 #include <span>
@@ -22,7 +19,9 @@
 
 #include <zlib.h>
 
+#include "camhead/base/input_file.h"
 #include "camhead/base/partial_file.h"
+#include "camhead/base/png_guard.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
@@ -65,16 +64,8 @@ constexpr std::size_t kMaxPixels = std::size_t(1) << 25;
   throw ImageError(path.string() + ": " + reason);
 }
 
-std::vector<unsigned char> read_file(const std::filesystem::path &path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    fail(path, std::string("cannot open: ") + std::strerror(errno));
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                   std::istreambuf_iterator<char>());
-  if (in.bad())
-    fail(path, "read error");
-  return bytes;
-}
+// An uncompressed float RGBA EXR of kMaxPixels is 512 MiB.
+constexpr std::size_t kMaxImageFileBytes = std::size_t(1) << 30;
 
 // Beside `path` and renamed over it when whole (base/partial_file.h): a
 // write that fails half-way leaves the previous file as it was.
@@ -150,7 +141,7 @@ template <typename T> T load_le(const unsigned char *p) {
 // tinyexr's header parser asserts on (and, without asserts, reads past) a
 // "tiles" attribute that is not 9 bytes and runs strlen() over "name" and
 // "type" values; such attributes are refused before it sees them.
-void check_attributes(const std::filesystem::path &path, const std::vector<unsigned char> &bytes) {
+void check_attributes(const std::filesystem::path &path, std::span<const unsigned char> bytes) {
   const auto *text = reinterpret_cast<const char *>(bytes.data());
   const auto skip_string = [&](std::size_t at) { // one past its NUL, or past the end
     return at >= bytes.size() ? bytes.size() + 1 : at + strnlen(text + at, bytes.size() - at) + 1;
@@ -175,7 +166,7 @@ void check_attributes(const std::filesystem::path &path, const std::vector<unsig
 // them unchecked), so a tiled file's offset table and chunk headers are
 // checked here first: one level, every offset inside the file, every chunk
 // at the tile its table slot names.
-void check_tiles(const std::filesystem::path &path, const std::vector<unsigned char> &bytes,
+void check_tiles(const std::filesystem::path &path, std::span<const unsigned char> bytes,
                  const EXRHeader &h, long long w, long long hgt) {
   const long long tx = h.tile_size_x, ty = h.tile_size_y;
   if (h.tile_level_mode != TINYEXR_TILE_ONE_LEVEL || tx < 1 || ty < 1 || tx > 65536 || ty > 65536)
@@ -204,8 +195,8 @@ void check_size(const std::filesystem::path &path, long long w, long long h,
                    " needed");
 }
 
-Image read_exr(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
-  const std::vector<unsigned char> bytes = read_file(path);
+Image read_exr(const std::filesystem::path &path, std::span<const unsigned char> bytes,
+               const std::optional<ImageSize> &expected) {
   EXRVersion version;
   if (ParseEXRVersionFromMemory(&version, bytes.data(), bytes.size()) != TINYEXR_SUCCESS)
     fail(path, "not an OpenEXR file");
@@ -344,102 +335,13 @@ void write_exr(const std::filesystem::path &path, const Image &image) {
   write_file(path, mem.get(), size);
 }
 
-// The big-endian length of the PNG chunk at `at` (its type follows).
-std::size_t png_chunk_length(const std::vector<unsigned char> &bytes, std::size_t at) {
-  return std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
-         std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
-}
-
-// Every chunk whole, up to IEND: stb_image reallocates its IDAT buffer to
-// the length a chunk claims before it finds the bytes missing (1.3 GB for
-// a 41-byte file, tests/fuzz/png_fuzz), and copies from a truncated one.
-// The walks below rely on it.
-void check_chunks(const std::filesystem::path &path, const std::vector<unsigned char> &bytes) {
-  for (std::size_t at = 8;;) {
-    if (at + 12 > bytes.size())
-      fail(path, "not a readable PNG: ends inside a chunk, or without IEND");
-    const std::size_t length = png_chunk_length(bytes, at);
-    if (length > bytes.size() - at - 12)
-      fail(path, "not a readable PNG: a chunk claims " + std::to_string(length) +
-                     " bytes, more than the file has");
-    if (std::memcmp(&bytes[at + 4], "IEND", 4) == 0)
-      return;
-    at += 12 + length;
-  }
-}
-
-// A copy of a PNG (its chunks checked) without its empty IDAT chunks:
-// stb_image copies each IDAT's bytes with memcpy, from a null buffer for an
-// empty first one (undefined behaviour, UBSan says); the image is the same
-// without them.
-std::vector<unsigned char> without_empty_idat(std::vector<unsigned char> bytes) {
-  for (std::size_t at = 8; std::memcmp(&bytes[at + 4], "IEND", 4) != 0;) {
-    const std::size_t length = png_chunk_length(bytes, at);
-    if (length == 0 && std::memcmp(&bytes[at + 4], "IDAT", 4) == 0)
-      bytes.erase(bytes.begin() + std::ptrdiff_t(at), bytes.begin() + std::ptrdiff_t(at + 12));
-    else
-      at += 12 + length;
-  }
-  return bytes;
-}
-
-// stb_image inflates the IDAT stream into a buffer it doubles for as long
-// as the stream goes on, whatever the header claims: a 207-byte PNG made it
-// reallocate 2 GiB. The stream is inflated here first, into a small scratch
-// buffer, and refused once it outgrows the image its header describes.
-void check_inflated_size(const std::filesystem::path &path, const std::vector<unsigned char> &png) {
-  std::vector<unsigned char> idat;
-  std::uint64_t width = 0, height = 0, bits_per_pixel = 0;
-  bool interlaced = false;
-  for (std::size_t at = 8; std::memcmp(&png[at + 4], "IEND", 4) != 0;) {
-    const std::size_t length = png_chunk_length(png, at);
-    const unsigned char *type = &png[at + 4], *data = &png[at + 8];
-    if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13) {
-      width = std::uint64_t(data[0]) << 24 | data[1] << 16 | data[2] << 8 | data[3];
-      height = std::uint64_t(data[4]) << 24 | data[5] << 16 | data[6] << 8 | data[7];
-      constexpr int kChannels[7] = {1, 0, 3, 1, 2, 0, 4}; // by colour type
-      const int channels = data[9] < 7 ? kChannels[data[9]] : 0;
-      bits_per_pixel = std::uint64_t(channels) * data[8];
-      interlaced = data[12] != 0;
-    } else if (std::memcmp(type, "IDAT", 4) == 0) {
-      idat.insert(idat.end(), data, data + length);
-    }
-    at += 12 + length;
-  }
-  if (bits_per_pixel == 0)
-    return; // no usable header: stb says what is wrong
-  // A filter byte per row and the rows' bytes; interlacing adds at most a
-  // filter byte per row of each of its seven passes, and a byte's rounding.
-  const std::uint64_t row = (width * bits_per_pixel + 7) / 8;
-  const std::uint64_t most = height * (1 + row) + (interlaced ? 7 * (height + 1) * 2 : 0) + 1024;
-  z_stream z{};
-  if (inflateInit(&z) != Z_OK)
-    fail(path, "cannot start zlib");
-  z.next_in = idat.data();
-  z.avail_in = uInt(std::min<std::size_t>(idat.size(), UINT_MAX));
-  std::vector<unsigned char> scratch(64 * 1024);
-  int rc = Z_OK;
-  while (rc == Z_OK) {
-    z.next_out = scratch.data();
-    z.avail_out = uInt(scratch.size());
-    rc = inflate(&z, Z_NO_FLUSH);
-    if (z.total_out > most) {
-      inflateEnd(&z);
-      fail(path, "its image data inflates past the " + std::to_string(width) + "x" +
-                     std::to_string(height) + " image its header describes");
-    }
-    if (rc == Z_BUF_ERROR && z.avail_in == 0)
-      break; // the stream ends early: stb says so
-  }
-  inflateEnd(&z);
-}
-
-Image read_png(const std::filesystem::path &path, const std::optional<ImageSize> &expected) {
-  std::vector<unsigned char> file = read_file(path);
-  if (file.size() < 8 || std::memcmp(file.data(), "\x89PNG\r\n\x1a\n", 8) != 0)
-    fail(path, "not a readable PNG: no PNG signature");
-  check_chunks(path, file);
-  const std::vector<unsigned char> bytes = without_empty_idat(std::move(file));
+Image read_png(const std::filesystem::path &path, std::span<const unsigned char> file,
+               const std::optional<ImageSize> &expected) {
+  std::string error;
+  const std::optional<std::vector<unsigned char>> checked = base::png_chunks_checked(file, error);
+  if (!checked)
+    fail(path, error);
+  const std::vector<unsigned char> &bytes = *checked;
   if (bytes.size() > std::size_t(INT_MAX))
     fail(path, "file too large");
   const int len = int(bytes.size());
@@ -449,7 +351,8 @@ Image read_png(const std::filesystem::path &path, const std::optional<ImageSize>
   check_size(path, w, h, expected);
   if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
     fail(path, "unsupported image size");
-  check_inflated_size(path, bytes);
+  if (!base::png_inflates_within_header(bytes, error))
+    fail(path, error);
   const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
   const std::unique_ptr<void, decltype(&stbi_image_free)> pixels(
       sixteen ? static_cast<void *>(stbi_load_16_from_memory(bytes.data(), len, &w, &h, &comp, 3))
@@ -497,13 +400,25 @@ float linear_to_srgb(float v) {
   return float(linear_to_srgb_d(v));
 }
 
-Image read_image(const std::filesystem::path &path, std::optional<ImageSize> expected) {
+Image decode_image(std::span<const unsigned char> bytes, const std::filesystem::path &path,
+                   std::optional<ImageSize> expected) {
   const std::string ext = lower_extension(path);
   if (ext == ".exr")
-    return read_exr(path, expected);
+    return read_exr(path, bytes, expected);
   if (ext == ".png")
-    return read_png(path, expected);
+    return read_png(path, bytes, expected);
   fail(path, "unsupported image type (expected .exr or .png)");
+}
+
+Image read_image(const std::filesystem::path &path, std::optional<ImageSize> expected) {
+  const std::string ext = lower_extension(path);
+  if (ext != ".exr" && ext != ".png")
+    fail(path, "unsupported image type (expected .exr or .png)");
+  std::vector<unsigned char> bytes;
+  std::string error;
+  if (!base::read_input_file(path, kMaxImageFileBytes, bytes, error))
+    fail(path, error);
+  return decode_image(bytes, path, expected);
 }
 
 void write_image(const std::filesystem::path &path, const Image &image) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -26,6 +27,7 @@
 #include <tiny_obj_loader.h>
 #pragma GCC diagnostic pop
 
+#include "camhead/base/input_file.h"
 #include "mesh_common.h"
 #include "ply_reader.h"
 
@@ -35,7 +37,18 @@ namespace {
 using Path = std::filesystem::path;
 using detail::add_polygon;
 using detail::fail;
-using detail::read_file;
+
+// 2^24 corners (kMaxObjCorners) written as OBJ text take well under this.
+constexpr std::size_t kMaxMeshFileBytes = std::size_t(1) << 30;
+
+enum class MeshType { obj, ply, unknown };
+
+MeshType mesh_type(const Path &path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".obj" ? MeshType::obj : ext == ".ply" ? MeshType::ply : MeshType::unknown;
+}
 
 void validate(const Path &path, const TriangleMesh &mesh) {
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
@@ -150,8 +163,7 @@ std::string mesh_lines(const Path &path, const std::string &text) {
   return out;
 }
 
-TriangleMesh load_obj(const Path &path) {
-  const std::string text = read_file(path);
+TriangleMesh parse_obj(const Path &path, const std::string &text) {
   check_exponents(path, text);
   std::istringstream stream(mesh_lines(path, text));
   tinyobj::attrib_t attrib;
@@ -191,19 +203,30 @@ TriangleMesh load_obj(const Path &path) {
 
 } // namespace
 
-TriangleMesh load_mesh(const std::filesystem::path &path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
+TriangleMesh parse_mesh(const std::string &text, const std::filesystem::path &path) {
   TriangleMesh mesh;
-  if (ext == ".obj")
-    mesh = load_obj(path);
-  else if (ext == ".ply")
-    mesh = detail::load_ply(path);
-  else
+  switch (mesh_type(path)) {
+  case MeshType::obj:
+    mesh = parse_obj(path, text);
+    break;
+  case MeshType::ply:
+    mesh = detail::parse_ply(path, text);
+    break;
+  case MeshType::unknown:
     fail(path, "unsupported mesh type (expected .obj or .ply)");
+  }
   validate(path, mesh);
   return mesh;
+}
+
+TriangleMesh load_mesh(const std::filesystem::path &path) {
+  if (mesh_type(path) == MeshType::unknown)
+    fail(path, "unsupported mesh type (expected .obj or .ply)");
+  std::string error;
+  const std::optional<std::string> text = base::read_input_file(path, kMaxMeshFileBytes, error);
+  if (!text)
+    fail(path, error);
+  return parse_mesh(*text, path);
 }
 
 } // namespace camhead::renderer

@@ -228,8 +228,7 @@ PlyRoles find_roles(const Path &path, const PlyElement &e) {
 
 } // namespace
 
-TriangleMesh load_ply(const Path &path) {
-  const std::string text = read_file(path);
+TriangleMesh parse_ply(const Path &path, const std::string &text) {
   const PlyHeader header = parse_ply_header(path, text);
   PlyBody body(std::string_view(text).substr(header.body_offset), header.format);
   // The whole layout is checked before any data is read.

@@ -10,7 +10,8 @@
 
 namespace camhead::renderer::detail {
 
-// The mesh as the file has it; load_mesh() validates it. Throws MeshError.
-TriangleMesh load_ply(const std::filesystem::path &path);
+// The mesh as the file `path` has it (its bytes in `text`); parse_mesh()
+// validates it. Throws MeshError.
+TriangleMesh parse_ply(const std::filesystem::path &path, const std::string &text);
 
 } // namespace camhead::renderer::detail

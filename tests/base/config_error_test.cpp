@@ -47,7 +47,7 @@ TEST(ConfigError, ReadingAFile) {
   };
   EXPECT_EQ(error_of(dir), dir.string() + ": (file): is a folder, not a file");
   EXPECT_EQ(error_of(dir / "none.json"),
-            (dir / "none.json").string() + ": (file): cannot be opened");
+            (dir / "none.json").string() + ": (file): cannot be opened: No such file or directory");
   std::filesystem::remove_all(dir);
 }
 

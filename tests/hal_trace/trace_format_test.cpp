@@ -184,7 +184,9 @@ TEST(LensTraceFormat, WholeFileProblemsNameTheFile) {
     (void)read_lens_trace("/nonexistent/camhead/trace.csv");
     FAIL();
   } catch (const TraceError &e) {
-    EXPECT_EQ(std::string(e.what()), "/nonexistent/camhead/trace.csv: (file): cannot be opened");
+    EXPECT_EQ(
+        std::string(e.what()),
+        "/nonexistent/camhead/trace.csv: (file): cannot be opened: No such file or directory");
   }
 }
 

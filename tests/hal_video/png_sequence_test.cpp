@@ -1,12 +1,14 @@
 // PNG sequences: pixel-exact through the sink and the camera, by pattern and
 // by folder; numbering from 0 or 1; sizes checked from the header before
-// decoding; the sink's pattern and format checks.
+// decoding; damaged frames refused before stb_image; the sink's pattern and
+// format checks.
 #include <string>
 #include <vector>
 
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/hal/video_file/png_frame.h"
+#include "png_chunks.h"
 #include "video_test_files.h"
 
 #include <gtest/gtest.h>
@@ -141,6 +143,35 @@ TEST(PngSequence, AFrameThatIsNotAPngEndsTheStream) {
   EXPECT_EQ(test::read_all(*camera).size(), 1u);
   EXPECT_EQ(camera->status().detail.rfind((dir / "1.png").string() + ":frame 1: PNG: ", 0), 0u)
       << camera->status().detail;
+}
+
+// The file camera decodes with stb_image too, behind the same checks as the
+// renderer's plates (base/png_guard.h): the fuzzers' findings (chunks cut
+// short, where stb reallocated to the length claimed: 1.3 GB for 41 bytes)
+// and image data that inflates far past its header's image are refused
+// before stb sees them, by the frame decoder itself.
+TEST(PngSequence, DamagedFramesAreRefusedBeforeStbImage) {
+  const auto decode_error = [](const std::string &png) {
+    const std::vector<std::uint8_t> bytes(png.begin(), png.end());
+    std::string error;
+    const auto size = hal::video_file::png_size(bytes, error);
+    if (!size)
+      return "size: " + error;
+    std::vector<std::uint8_t> rgb(std::size_t(size->width) * std::size_t(size->height) * 3);
+    return hal::video_file::decode_png_rgb(bytes, *size, rgb, error) ? std::string("decoded")
+                                                                     : error;
+  };
+  for (const char *name :
+       {"png_inflate_oom_1.png", "png_inflate_oom_2.png", "png_empty_idat_null.png",
+        "png_inflate_oom_1_min.png", "png_inflate_oom_2_min.png", "png_empty_idat_null_min.png"}) {
+    const std::string error = decode_error(
+        test::read_text(std::filesystem::path(CAMHEAD_SOURCE_DIR) / "tests/assets/fuzz" / name));
+    EXPECT_EQ(error.rfind("PNG: not a readable PNG: ", 0), 0u) << name << ": " << error;
+    EXPECT_NE(error.find("chunk"), std::string::npos) << name << ": " << error;
+  }
+  EXPECT_EQ(decode_error(test::rgb8_png(2, 2, std::string(64 << 20, '\0'))),
+            "PNG: its image data inflates past the 2x2 image its header describes");
+  EXPECT_EQ(decode_error(test::rgb8_png(2, 1, std::string(1, '\0') + "abcdef")), "decoded");
 }
 
 TEST(PngSequence, FoldersWithoutPngsAreRefused) {

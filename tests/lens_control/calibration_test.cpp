@@ -276,7 +276,8 @@ TEST(Calibration, UnreadableFileIsAnError) {
     (void)read_measurements("/nonexistent/marks.csv");
     FAIL() << "no error";
   } catch (const CalibrationError &e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/marks.csv: (file): cannot be opened");
+    EXPECT_STREQ(e.what(),
+                 "/nonexistent/marks.csv: (file): cannot be opened: No such file or directory");
   }
 }
 

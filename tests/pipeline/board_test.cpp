@@ -115,7 +115,8 @@ TEST(Board, MissingFileIsNamed) {
     static_cast<void>(load_board("/nonexistent/rig.json"));
     FAIL() << "no error";
   } catch (const BoardError &e) {
-    EXPECT_EQ(std::string(e.what()), "/nonexistent/rig.json: (file): cannot be opened");
+    EXPECT_EQ(std::string(e.what()),
+              "/nonexistent/rig.json: (file): cannot be opened: No such file or directory");
   }
 }
 

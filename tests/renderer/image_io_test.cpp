@@ -17,9 +17,9 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include "camhead/renderer/image_io.h"
+#include "png_chunks.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -34,17 +34,8 @@ std::string read_bytes(const fs::path &path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-std::string be32(std::uint32_t v) {
-  return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
-}
-
-// One PNG chunk: length, type, data and CRC.
-std::string chunk(const std::string &type, const std::string &data) {
-  const std::string body = type + data;
-  const auto crc = crc32(0, reinterpret_cast<const Bytef *>(body.data()), uInt(body.size()));
-  return be32(std::uint32_t(data.size())) + body + be32(std::uint32_t(crc));
-}
-
+using test::be32;
+using test::png_chunk;
 // A 16-bit RGB PNG, which stb_image_write cannot produce.
 std::string png16(int w, int h, const std::vector<std::uint16_t> &rgb) {
   std::string raw;
@@ -53,13 +44,8 @@ std::string png16(int w, int h, const std::vector<std::uint16_t> &rgb) {
     for (int i = 0; i < w * 3; ++i)
       raw += std::string{char(rgb[y * w * 3 + i] >> 8), char(rgb[y * w * 3 + i] & 0xff)};
   }
-  uLongf size = compressBound(uLong(raw.size()));
-  std::string z(size, '\0');
-  compress(reinterpret_cast<Bytef *>(z.data()), &size, reinterpret_cast<const Bytef *>(raw.data()),
-           uLong(raw.size()));
-  z.resize(size);
-  return "\x89PNG\r\n\x1a\n" + chunk("IHDR", be32(w) + be32(h) + std::string{16, 2, 0, 0, 0}) +
-         chunk("IDAT", z) + chunk("IEND", "");
+  return "\x89PNG\r\n\x1a\n" + png_chunk("IHDR", be32(w) + be32(h) + std::string{16, 2, 0, 0, 0}) +
+         png_chunk("IDAT", test::zlib_compressed(raw)) + png_chunk("IEND", "");
 }
 
 // A 5x3 float RGB OpenEXR in 2x2 tiles (partial ones at the edges), written
@@ -363,15 +349,7 @@ TEST_F(ImageIo, EmptyIdatChunkReadsAsWithout) {
 // 207-byte one made stb_image reallocate 2 GiB) is refused before stb sees
 // it.
 TEST_F(ImageIo, InflationBombPngIsRefused) {
-  const std::string zeros(64 << 20, '\0'); // 64 MiB for a 2 x 2 image
-  uLongf size = compressBound(uLong(zeros.size()));
-  std::string z(size, '\0');
-  compress2(reinterpret_cast<Bytef *>(z.data()), &size,
-            reinterpret_cast<const Bytef *>(zeros.data()), uLong(zeros.size()), 9);
-  z.resize(size);
-  const std::string png = "\x89PNG\r\n\x1a\n" +
-                          chunk("IHDR", be32(2) + be32(2) + std::string{8, 2, 0, 0, 0}) +
-                          chunk("IDAT", z) + chunk("IEND", "");
+  const std::string png = test::rgb8_png(2, 2, std::string(64 << 20, '\0')); // 64 MiB
   const fs::path path = write("bomb.png", png);
   try {
     (void)read_image(path);

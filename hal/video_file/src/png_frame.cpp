@@ -2,11 +2,13 @@
 // the renderer's own copy in image_io.cpp does not clash). See png_frame.h.
 #include "camhead/hal/video_file/png_frame.h"
 
-#include <cerrno>
 #include <climits>
-#include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
+#include <vector>
+
+#include "camhead/base/png_guard.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
@@ -36,10 +38,6 @@
 namespace camhead::hal::video_file {
 namespace {
 
-struct FileCloser {
-  void operator()(std::FILE *file) const { std::fclose(file); }
-};
-
 std::string stb_reason() {
   const char *reason = stbi_failure_reason();
   return reason != nullptr ? reason : "unknown error";
@@ -52,30 +50,6 @@ void append_bytes(void *context, void *data, int size) {
 }
 
 } // namespace
-
-bool read_whole_file(const std::filesystem::path &path, std::vector<std::uint8_t> &bytes,
-                     std::string &error) {
-  const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rbe"));
-  if (!file) {
-    error = std::string("read: ") + std::strerror(errno);
-    return false;
-  }
-  bytes.clear();
-  std::uint8_t chunk[65536];
-  std::size_t got = 0;
-  while ((got = std::fread(chunk, 1, sizeof chunk, file.get())) > 0) {
-    if (bytes.size() + got > kMaxPngFileBytes) {
-      error = "read: over " + std::to_string(kMaxPngFileBytes >> 20) + " MiB";
-      return false;
-    }
-    bytes.insert(bytes.end(), chunk, chunk + got);
-  }
-  if (std::ferror(file.get())) {
-    error = std::string("read: ") + std::strerror(errno);
-    return false;
-  }
-  return true;
-}
 
 std::optional<PngSize> png_size(std::span<const std::uint8_t> file, std::string &error) {
   int width = 0, height = 0, channels = 0;
@@ -90,12 +64,17 @@ std::optional<PngSize> png_size(std::span<const std::uint8_t> file, std::string 
 
 bool decode_png_rgb(std::span<const std::uint8_t> file, PngSize expected,
                     std::span<std::uint8_t> rgb, std::string &error) {
+  const std::optional<std::vector<std::uint8_t>> checked = base::png_chunks_checked(file, error);
+  if (!checked || !base::png_inflates_within_header(*checked, error)) {
+    error = "PNG: " + error;
+    return false;
+  }
   int width = 0, height = 0, channels = 0;
   const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> pixels(
-      file.size() > std::size_t(INT_MAX)
+      checked->size() > std::size_t(INT_MAX)
           ? nullptr
-          : stbi_load_from_memory(file.data(), static_cast<int>(file.size()), &width, &height,
-                                  &channels, 3),
+          : stbi_load_from_memory(checked->data(), static_cast<int>(checked->size()), &width,
+                                  &height, &channels, 3),
       &stbi_image_free);
   if (!pixels) {
     error = "PNG: cannot decode (" + stb_reason() + ")";

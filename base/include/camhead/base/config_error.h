@@ -16,6 +16,7 @@
 // derived from this one, so that its callers can tell whose file it was.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -39,8 +40,13 @@ private:
   std::string field_, reason_;
 };
 
-// The whole text of a configuration file. Throws ConfigError on the field
-// "(file)": "cannot be opened", "is a folder, not a file", "cannot be read".
+// Larger than any configuration file, lens trace or calibration a rig
+// writes (an hour of a 1 kHz trace is about 150 MB).
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t(256) << 20;
+
+// The whole text of a configuration file (input_file.h). Throws ConfigError
+// on the field "(file)": "cannot be opened: REASON", "is a folder, not a
+// file", "is larger than 256 MiB", "cannot be read: REASON".
 [[nodiscard]] std::string read_config_file(const std::filesystem::path &path);
 
 } // namespace camhead::base

@@ -8,6 +8,7 @@
 #include <system_error>
 #include <vector>
 
+#include "camhead/base/input_file.h"
 #include "camhead/hal/video_file/frame_pattern.h"
 #include "camhead/hal/video_file/png_frame.h"
 #include "frame_reader.h"
@@ -76,7 +77,7 @@ PngSequenceReader::PngSequenceReader(const std::filesystem::path &path) {
 
   const std::filesystem::path first = frame_path(0);
   std::string error;
-  if (!video_file::read_whole_file(first, bytes_, error))
+  if (!base::read_input_file(first, video_file::kMaxPngFileBytes, bytes_, error))
     throw FileCameraError(first.string() + ": " + error);
   const auto size = video_file::png_size(bytes_, error);
   if (!size)
@@ -123,7 +124,7 @@ FrameReader::Read PngSequenceReader::read(std::span<std::uint8_t> frame, std::st
   if (path.empty() || (pattern_ && !std::filesystem::exists(path, ec)))
     return Read::end;
   const std::string at = path.string() + ":frame " + std::to_string(index_) + ": ";
-  if (!video_file::read_whole_file(path, bytes_, error)) {
+  if (!base::read_input_file(path, video_file::kMaxPngFileBytes, bytes_, error)) {
     error = at + error;
     return Read::error;
   }

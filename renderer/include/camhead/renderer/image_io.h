@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <stdexcept>
 
 #include "camhead/renderer/image.h"
@@ -24,8 +25,15 @@ struct ImageSize {
 // linear. Returns a 3-channel image. Throws ImageError naming the file.
 // With `expected`, an image of another size is refused from its header,
 // before anything is decoded: a small file can claim a vast image.
+// Files over 1 GiB are refused unread.
 [[nodiscard]] Image read_image(const std::filesystem::path &path,
                                std::optional<ImageSize> expected = std::nullopt);
+
+// The same from the file's bytes; `path` picks the format by its extension
+// and names the file in errors.
+[[nodiscard]] Image decode_image(std::span<const unsigned char> bytes,
+                                 const std::filesystem::path &path,
+                                 std::optional<ImageSize> expected = std::nullopt);
 
 // Chosen by extension: .exr writes linear float32 (ZIP); .png writes 8-bit
 // sRGB, clipped to [0, 1] and rounded. 1-channel images are written as grey.

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 
 #include "camhead/renderer/scene.h"
 
@@ -16,6 +17,11 @@ public:
 // Polygons are fan-triangulated; normals and texture coordinates are ignored
 // (the tracer shades with flat face normals, as Cycles does for these scenes).
 // Throws MeshError naming the file (and the line or element where known).
+// Files over 1 GiB are refused unread.
 [[nodiscard]] TriangleMesh load_mesh(const std::filesystem::path &path);
+
+// The same from the file's text; `path` picks the format by its extension
+// and names the file in errors.
+[[nodiscard]] TriangleMesh parse_mesh(const std::string &text, const std::filesystem::path &path);
 
 } // namespace camhead::renderer

@@ -8,7 +8,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
 #include <optional>
 #include <span>
 #include <string>
@@ -16,14 +15,9 @@
 
 namespace camhead::hal::video_file {
 
-// A 16384 x 16384 RGB PNG that does not compress at all is about 805 MB.
+// A 16384 x 16384 RGB PNG that does not compress at all is about 805 MB
+// (the most base::read_input_file reads of a frame).
 inline constexpr std::size_t kMaxPngFileBytes = std::size_t(1) << 30;
-
-// Reads `path` into `bytes` (reused between frames, so that playing a
-// sequence does not reallocate). False with `error` ("read: REASON") on
-// failure.
-[[nodiscard]] bool read_whole_file(const std::filesystem::path &path,
-                                   std::vector<std::uint8_t> &bytes, std::string &error);
 
 struct PngSize {
   int width = 0;
