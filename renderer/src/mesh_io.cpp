@@ -96,6 +96,16 @@ void check_exponents(const Path &path, const std::string &text) {
 // triangles, a few hundred MB inside tinyobjloader.
 constexpr std::size_t kMaxObjCorners = std::size_t(1) << 24;
 
+// Lines end as tinyobjloader ends them: at "\n", "\r\n" or a lone "\r".
+// A filter that split at "\n" alone let a `vw` line through behind a "\r"
+// (tests/fuzz/obj_fuzz).
+std::size_t line_end(const std::string &text, std::size_t at) {
+  return std::min(text.find_first_of("\r\n", at), text.size());
+}
+std::size_t next_line(const std::string &text, std::size_t end) {
+  return end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+}
+
 // The lines of an OBJ that make a triangle mesh, as tinyobjloader is given
 // them: positions, and faces with their vertex indices alone. The rest
 // (normals, texture coordinates, vertex weights, whose `vw c 1e60` makes
@@ -106,19 +116,19 @@ constexpr std::size_t kMaxObjCorners = std::size_t(1) << 24;
 std::string mesh_lines(const Path &path, const std::string &text) {
   std::size_t positions = 0;
   for (std::size_t at = 0; at < text.size();) {
-    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::size_t end = line_end(text, at);
     if (end - at > 2 && text[at] == 'v' && (text[at + 1] == ' ' || text[at + 1] == '\t'))
       ++positions;
-    at = end + 1;
+    at = next_line(text, end);
   }
   std::string out;
   std::size_t corners = 0, seen = 0;
   int line = 0;
   for (std::size_t at = 0; at < text.size();) {
-    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::size_t end = line_end(text, at);
     ++line;
     std::string_view row(text.data() + at, end - at);
-    at = end + 1;
+    at = next_line(text, end);
     while (!row.empty() && std::isspace((unsigned char)row.front()))
       row.remove_prefix(1);
     const bool blank_after = row.size() > 1 && (row[1] == ' ' || row[1] == '\t');

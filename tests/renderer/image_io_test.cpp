@@ -366,8 +366,36 @@ TEST_F(ImageIo, FuzzFindingsAreRefused) {
   for (const char *name :
        {"exr_piz_overflow_1.exr", "exr_piz_overflow_2.exr", "png_inflate_oom_1.png",
         "png_inflate_oom_2.png", "png_empty_idat_null.png", "png_inflate_oom_1_min.png",
-        "png_inflate_oom_2_min.png", "png_empty_idat_null_min.png"})
+        "png_inflate_oom_2_min.png", "png_empty_idat_null_min.png", "exr_chunk_count_oom.exr",
+        "exr_uint_overrun.exr"})
     EXPECT_TRUE(read_fails(test::source_dir() / "tests/assets/fuzz" / name)) << name;
+  // tinyexr sized its offset table by the chunkCount attribute (11 GB for
+  // exr_chunk_count_oom.exr, which is refused above for its integer
+  // channels); here the attribute alone, in a file camhead wrote.
+  write_image(dir_ / "three_lines.exr", Image(4, 3, 3));
+  std::string bytes = read_bytes(dir_ / "three_lines.exr");
+  const std::int32_t size = 4, claimed = 1468006400;
+  bytes.insert(8, std::string("chunkCount\0int\0", 15) +
+                      std::string(reinterpret_cast<const char *>(&size), 4) +
+                      std::string(reinterpret_cast<const char *>(&claimed), 4));
+  const fs::path chunks = write("chunk_count.exr", bytes);
+  try {
+    (void)read_image(chunks);
+    ADD_FAILURE() << "decoded";
+  } catch (const ImageError &e) {
+    EXPECT_EQ(std::string(e.what()),
+              chunks.string() + ": chunkCount is 1468006400; its data window needs 1");
+  }
+  // tinyexr read 3 bytes past a cut-short chunk of a 32-bit integer channel.
+  const fs::path uint = test::source_dir() / "tests/assets/fuzz/exr_uint_overrun.exr";
+  try {
+    (void)read_image(uint);
+    ADD_FAILURE() << "decoded";
+  } catch (const ImageError &e) {
+    EXPECT_EQ(std::string(e.what()),
+              uint.string() + ": channel B holds 32-bit integers; only half and float channels "
+                              "are read");
+  }
 }
 
 // A write that fails half-way (here a file-size limit) leaves the previous
