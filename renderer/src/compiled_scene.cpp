@@ -17,6 +17,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -213,6 +214,26 @@ bool primitive_bounds(const std::vector<gpu::Primitive> &prims, std::size_t firs
   return true;
 }
 
+// The extent of primitives [first, end) of `prims` along the columns of b.axes.
+void axis_bounds(const std::vector<gpu::Primitive> &prims, std::size_t first, ObjectBounds &b) {
+  b.axis_lo = glm::vec3(std::numeric_limits<float>::infinity());
+  b.axis_hi = -b.axis_lo;
+  const glm::mat3 to_axes = glm::transpose(b.axes);
+  for (std::size_t i = first; i < prims.size(); ++i) {
+    const gpu::Primitive &p = prims[i];
+    const glm::vec3 p0(p.p0);
+    if ((glm::floatBitsToUint(p.p0.w) >> 24) == PRIM_SPHERE) {
+      b.axis_lo = glm::min(b.axis_lo, to_axes * p0 - glm::vec3(p.p1.x));
+      b.axis_hi = glm::max(b.axis_hi, to_axes * p0 + glm::vec3(p.p1.x));
+      continue;
+    }
+    for (const glm::vec3 &v : {p0, p0 + glm::vec3(p.p1), p0 + glm::vec3(p.p2)}) {
+      b.axis_lo = glm::min(b.axis_lo, to_axes * v);
+      b.axis_hi = glm::max(b.axis_hi, to_axes * v);
+    }
+  }
+}
+
 std::vector<glm::vec4> compile_plate(const Scene &scene) {
   const Image &img = *scene.plate;
   if (img.width != scene.render.width || img.height != scene.render.height ||
@@ -254,6 +275,8 @@ CompiledScene compile_scene(const Scene &scene) {
     bounds.real = o.real;
     bounds.specular = type == MaterialType::mirror || type == MaterialType::glass;
     bounds.shaded = type == MaterialType::diffuse;
+    bounds.axes = euler_xyz(o.rotation_deg);
+    axis_bounds(prims, first, bounds);
     if (o.type == ShapeType::sphere) {
       bounds.sphere = true;
       bounds.centre = glm::vec3(prims.back().p0);

@@ -2,7 +2,9 @@
 //
 // 1. World space. The points where a virtual object can change what a camera
 //    ray brings back, as convex polyhedra:
-//    - each virtual object's bounds: a ray that meets it;
+//    - each virtual object's bounds (its box aligned with the world, cut to
+//      its box along its own axes, which a rotated box or plane fills): a
+//      ray that meets it;
 //    - each real mirror's or glass's bounds: a ray that meets one may go on
 //      to a virtual object or its shadow (however many bounces follow);
 //    - for each light, virtual object and real diffuse object: the points of
@@ -11,8 +13,9 @@
 //      l on the light (a point, the rectangle of an area light, or a sun's
 //      direction at infinity) and t >= 0, a subset of B + cone(D) with D
 //      the differences of their corners; that set is cut out of the real
-//      object's box by the supporting planes of B + cone(D) (normals across
-//      pairs of generators, each kept only if the whole set lies behind it).
+//      object's bounds by the supporting planes of B + cone(D) (normals
+//      across pairs of generators, each kept only if the whole set lies
+//      behind it), for each of the caster's two boxes.
 //      A sphere counts as its box with edges and corners cut off, and its
 //      shadow from a point light or a sun as the planes tangent to its
 //      round shadow cone or cylinder.
@@ -22,13 +25,13 @@
 //    f A |1/F - 1/z| pixels of its pinhole projection (aperture radius A,
 //    focal-plane depth F, focal length f in pixels); for a given aperture
 //    point a lens ray is a perspective projection, so a polyhedron's image
-//    is bounded by its vertices' images, each grown by its own blur. Points
-//    behind the lens are cut off; a piece within a millimetre of it, where
-//    the projection diverges, takes the whole frame if a camera ray can
-//    get there.
-// 3. Pixels and tiles. Each pixel rectangle, widened by the pixel filter and
-//    a pixel of margin, marks the tiles it touches; runs of tiles are merged
-//    into rectangles.
+//    lies in the convex hull of its vertices' images, each grown by its own
+//    blur (an octagon around the blur circle). Points behind the lens are
+//    cut off; a piece within a millimetre of it, where the projection
+//    diverges, takes the whole frame if a camera ray can get there.
+// 3. Pixels and tiles. Each hull, widened by the pixel filter and a pixel of
+//    margin, marks the tiles it touches, a row of tiles at a time; runs of
+//    tiles are merged into rectangles.
 #include "camhead/renderer/influence_region.h"
 
 #include <algorithm>
@@ -129,35 +132,49 @@ private:
   std::vector<std::vector<dvec3>> faces_;
 };
 
-struct Box {
+// A box along three orthonormal axes: the points x with lo_i <= axes_i . x
+// <= hi_i. The world's axes make it an axis-aligned box.
+struct OrientedBox {
+  std::array<dvec3, 3> axes;
   dvec3 lo, hi;
+
+  [[nodiscard]] std::array<dvec3, 8> corners() const {
+    std::array<dvec3, 8> c;
+    for (int i = 0; i < 8; ++i)
+      c[i] = axes[0] * (i & 4 ? hi.x : lo.x) + axes[1] * (i & 2 ? hi.y : lo.y) +
+             axes[2] * (i & 1 ? hi.z : lo.z);
+    return c;
+  }
+  // Its six faces' half-spaces.
+  [[nodiscard]] std::array<Halfspace, 6> faces() const {
+    std::array<Halfspace, 6> f;
+    for (int i = 0; i < 3; ++i) {
+      f[2 * i] = {axes[i], hi[i]};
+      f[2 * i + 1] = {-axes[i], -lo[i]};
+    }
+    return f;
+  }
 };
 
-std::array<dvec3, 8> corners(const Box &b) {
-  std::array<dvec3, 8> c;
-  for (int i = 0; i < 8; ++i)
-    c[i] = dvec3(i & 4 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 1 ? b.hi.z : b.lo.z);
-  return c;
-}
-
-// Supporting half-spaces of B + cone(dirs) (B a box): candidate normals
-// across the pairs of generators (the box's edges and the directions), each
-// kept if no generator leaves it. Every half-space kept contains the set, so
-// the cut is safe whether or not the list is complete; it is complete (the
-// facets of a Minkowski sum lie across pairs of generators), so it is tight.
-std::vector<Halfspace> cone_halfspaces(const Box &box, std::span<const dvec3> dirs, double margin) {
+// Supporting half-spaces of B + cone(dirs): candidate normals across the
+// pairs of generators (the box's edges and the directions), each kept if no
+// generator leaves it. Every half-space kept contains the set, so the cut is
+// safe whether or not the list is complete; it is complete (the facets of a
+// Minkowski sum lie across pairs of generators), so it is tight.
+std::vector<Halfspace> cone_halfspaces(const OrientedBox &box, std::span<const dvec3> dirs,
+                                       double margin) {
   std::vector<dvec3> unit;
   for (const dvec3 &d : dirs)
     if (const double len = glm::length(d); len > 0.0)
       unit.push_back(d / len);
-  std::vector<dvec3> candidates = {dvec3(1, 0, 0), dvec3(0, 1, 0), dvec3(0, 0, 1)};
+  std::vector<dvec3> candidates(box.axes.begin(), box.axes.end());
   for (std::size_t i = 0; i < unit.size(); ++i) {
     for (int axis = 0; axis < 3; ++axis)
-      candidates.push_back(glm::cross(candidates[std::size_t(axis)], unit[i]));
+      candidates.push_back(glm::cross(box.axes[std::size_t(axis)], unit[i]));
     for (std::size_t j = i + 1; j < unit.size(); ++j)
       candidates.push_back(glm::cross(unit[i], unit[j]));
   }
-  const std::array<dvec3, 8> box_corners = corners(box);
+  const std::array<dvec3, 8> box_corners = box.corners();
   std::vector<Halfspace> planes;
   for (const dvec3 &c : candidates) {
     const double len = glm::length(c);
@@ -180,6 +197,37 @@ std::vector<Halfspace> cone_halfspaces(const Box &box, std::span<const dvec3> di
     }
   }
   return planes;
+}
+
+// A point of the image plane, in pixels: u to the right, v down.
+struct Point {
+  double u, v;
+};
+
+// Andrew's monotone chain: the hull's corners in order (collinear points
+// dropped); fewer than three points come back as they are.
+std::vector<Point> convex_hull(std::vector<Point> points) {
+  std::sort(points.begin(), points.end(),
+            [](const Point &a, const Point &b) { return a.u != b.u ? a.u < b.u : a.v < b.v; });
+  if (points.size() < 3)
+    return points;
+  const auto turn = [](const Point &o, const Point &a, const Point &b) {
+    return (a.u - o.u) * (b.v - o.v) - (a.v - o.v) * (b.u - o.u);
+  };
+  std::vector<Point> hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) { // lower chain
+    while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0)
+      --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) { // upper chain
+    while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0)
+      --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1); // the last point is the first
+  return hull;
 }
 
 // The frame's thin lens in the compiled scene's frame, and the tiles marked
@@ -229,19 +277,28 @@ public:
     poly.clip({-forward_, -glm::dot(forward_, centre_) - kNearM});
     if (poly.empty())
       return;
-    double u_lo = INFINITY, u_hi = -INFINITY, v_lo = INFINITY, v_hi = -INFINITY;
+    // Each vertex's blur circle by the octagon around it; the image lies in
+    // the convex hull of the octagons.
+    constexpr double kOctagon = 1.0823922002923940; // 1 / cos(pi / 8)
+    std::vector<Point> points;
+    bool finite = true;
     poly.for_each_vertex([&](const dvec3 &p) {
       const dvec3 d = p - centre_;
       const double z = glm::dot(forward_, d);
       const double u = 0.5 * width_ + focal_px_ * glm::dot(right_, d) / z;
       const double v = 0.5 * height_ - focal_px_ * glm::dot(up_, d) / z;
-      const double blur = focal_px_ * aperture_ * std::abs(1.0 / focus_ - 1.0 / z);
-      u_lo = std::min(u_lo, u - blur);
-      u_hi = std::max(u_hi, u + blur);
-      v_lo = std::min(v_lo, v - blur);
-      v_hi = std::max(v_hi, v + blur);
+      const double blur = focal_px_ * aperture_ * std::abs(1.0 / focus_ - 1.0 / z) * kOctagon;
+      finite = finite && std::isfinite(u) && std::isfinite(v) && std::isfinite(blur);
+      for (int k = 0; k < 8; ++k) {
+        const double phi = 0.7853981633974483 * k;
+        points.push_back({u + blur * std::cos(phi), v + blur * std::sin(phi)});
+      }
     });
-    mark(u_lo, u_hi, v_lo, v_hi);
+    if (!finite) {
+      mark(0.0, double(width_), 0.0, double(height_)); // unknown: everywhere
+      return;
+    }
+    mark_polygon(convex_hull(std::move(points)));
   }
 
   [[nodiscard]] InfluenceRegion region() const;
@@ -251,7 +308,7 @@ private:
   // half the filter width) can fall in [u_lo, u_hi] x [v_lo, v_hi], image
   // coordinates; one pixel more on each side for the rays' rounding.
   void mark(double u_lo, double u_hi, double v_lo, double v_hi) {
-    const double reach = 0.5 * filter_px_ + 1.0;
+    const double reach = kReachPx + 0.5 * filter_px_;
     const auto first = [&](double lo) { return std::floor(lo - 0.5 - reach); };
     const auto last = [&](double hi) { return std::ceil(hi - 0.5 + reach); };
     const double x0 = std::max(0.0, first(u_lo)), x1 = std::min(double(width_) - 1, last(u_hi));
@@ -268,6 +325,52 @@ private:
            ++tx)
         marked_[std::size_t(ty) * tiles_x_ + tx] = 1;
   }
+
+  // The same for a convex polygon (image coordinates, in order), a row of
+  // tiles at a time: its x-range within the row's band of sample positions.
+  void mark_polygon(const std::vector<Point> &hull) {
+    if (hull.empty())
+      return;
+    double v_lo = INFINITY, v_hi = -INFINITY;
+    for (const Point &p : hull) {
+      v_lo = std::min(v_lo, p.v);
+      v_hi = std::max(v_hi, p.v);
+    }
+    const double reach = kReachPx + 0.5 * filter_px_;
+    for (std::uint32_t ty = 0; ty < tiles_y_; ++ty) {
+      // The sample positions of the row's pixels: their centres within reach.
+      const double band_lo = double(ty * CAMHEAD_TILE_Y) + 0.5 - reach;
+      const double band_hi = double(std::min((ty + 1) * CAMHEAD_TILE_Y, height_)) - 0.5 + reach;
+      if (band_hi < v_lo || band_lo > v_hi)
+        continue;
+      double u_lo = INFINITY, u_hi = -INFINITY;
+      const auto take = [&](double u) {
+        u_lo = std::min(u_lo, u);
+        u_hi = std::max(u_hi, u);
+      };
+      for (std::size_t i = 0; i < hull.size(); ++i) {
+        const Point &a = hull[i];
+        const Point &b = hull[(i + 1) % hull.size()];
+        if (a.v >= band_lo && a.v <= band_hi)
+          take(a.u);
+        for (const double line : {band_lo, band_hi})
+          if ((a.v < line && b.v > line) || (a.v > line && b.v < line))
+            take(a.u + (b.u - a.u) * ((line - a.v) / (b.v - a.v)));
+      }
+      if (!(u_lo <= u_hi))
+        continue;
+      const double x0 = std::max(0.0, std::floor(u_lo - 0.5 - reach));
+      const double x1 = std::min(double(width_) - 1, std::ceil(u_hi - 0.5 + reach));
+      if (!(x0 <= x1))
+        continue;
+      for (auto tx = std::uint32_t(x0) / CAMHEAD_TILE_X; tx <= std::uint32_t(x1) / CAMHEAD_TILE_X;
+           ++tx)
+        marked_[std::size_t(ty) * tiles_x_ + tx] = 1;
+    }
+  }
+
+  // A pixel of margin for the rays' rounding, beyond the pixel filter.
+  static constexpr double kReachPx = 1.0;
 
   dvec3 centre_, right_, up_, forward_;
   double aperture_, focus_, focal_px_, filter_px_;
@@ -349,8 +452,32 @@ std::pair<dvec3, dvec3> orthogonal_pair(const dvec3 &a) {
 std::optional<std::vector<Halfspace>> sphere_shadow_cuts(const dvec3 &centre, double radius,
                                                          const struct LightShape &light);
 
-Box bounds_of(const ObjectBounds &o, double margin) {
-  return {dvec3(o.lo) - margin, dvec3(o.hi) + margin};
+// The object's two boxes, each grown by `margin`: aligned with the world,
+// and along its own axes (none when those are the world's).
+OrientedBox world_box_of(const ObjectBounds &o, double margin) {
+  return {
+      {dvec3(1, 0, 0), dvec3(0, 1, 0), dvec3(0, 0, 1)}, dvec3(o.lo) - margin, dvec3(o.hi) + margin};
+}
+std::optional<OrientedBox> own_box_of(const ObjectBounds &o, double margin) {
+  if (o.axes == glm::mat3(1.0f))
+    return std::nullopt;
+  return OrientedBox{{dvec3(o.axes[0]), dvec3(o.axes[1]), dvec3(o.axes[2])},
+                     dvec3(o.axis_lo) - margin,
+                     dvec3(o.axis_hi) + margin};
+}
+
+// Where the object can be: its world box, cut down to its own box, and for a
+// sphere to its round shape.
+ConvexPolyhedron object_polyhedron(const ObjectBounds &o, double margin) {
+  const OrientedBox world = world_box_of(o, margin);
+  ConvexPolyhedron poly = ConvexPolyhedron::box(world.lo, world.hi);
+  if (const std::optional<OrientedBox> own = own_box_of(o, margin))
+    for (const Halfspace &h : own->faces())
+      poly.clip(h);
+  if (o.sphere)
+    for (const Halfspace &h : sphere_cuts(dvec3(o.centre), double(o.radius) + margin))
+      poly.clip(h);
+  return poly;
 }
 
 // Where the shadow rays toward a light end: the light's corners, or a sun's
@@ -463,19 +590,9 @@ InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FramePar
   if (std::none_of(scene.objects.begin(), scene.objects.end(),
                    [](const ObjectBounds &o) { return !o.real; }))
     return builder.region();
-  for (const ObjectBounds &o : scene.objects) {
-    if (o.real)
-      continue;
-    const Box v = bounds_of(o, margin);
-    ConvexPolyhedron poly = ConvexPolyhedron::box(v.lo, v.hi);
-    if (o.sphere)
-      for (const Halfspace &h : sphere_cuts(dvec3(o.centre), double(o.radius) + margin))
-        poly.clip(h);
-    builder.add(std::move(poly));
-  }
   for (const ObjectBounds &o : scene.objects)
-    if (o.real && o.specular)
-      builder.add(ConvexPolyhedron::box(bounds_of(o, margin).lo, bounds_of(o, margin).hi));
+    if (!o.real || o.specular)
+      builder.add(object_polyhedron(o, margin));
 
   const std::size_t lights = std::min<std::size_t>(frame.image.w, scene.lights.size());
   for (std::size_t li = 0; li < lights; ++li) {
@@ -485,7 +602,6 @@ InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FramePar
     for (const ObjectBounds &caster : scene.objects) {
       if (caster.real)
         continue;
-      const Box v = bounds_of(caster, margin);
       std::vector<Halfspace> cut;
       std::optional<std::vector<Halfspace>> round;
       if (caster.sphere && !shape->anywhere)
@@ -493,21 +609,28 @@ InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FramePar
       if (round) {
         cut = std::move(*round);
       } else if (!shape->anywhere) {
-        std::vector<dvec3> dirs;
-        if (shape->travel)
-          dirs.push_back(*shape->travel);
-        for (const dvec3 &l : shape->points)
-          for (const dvec3 &c : corners(v))
-            dirs.push_back(c - l);
-        cut = cone_halfspaces(v, dirs, margin);
+        // The shadow of each of the caster's boxes contains its shadow.
+        const std::optional<OrientedBox> own = own_box_of(caster, margin);
+        for (const std::optional<OrientedBox> &box :
+             {std::optional(world_box_of(caster, margin)), own}) {
+          if (!box)
+            continue;
+          std::vector<dvec3> dirs;
+          if (shape->travel)
+            dirs.push_back(*shape->travel);
+          for (const dvec3 &l : shape->points)
+            for (const dvec3 &c : box->corners())
+              dirs.push_back(c - l);
+          const std::vector<Halfspace> planes = cone_halfspaces(*box, dirs, margin);
+          cut.insert(cut.end(), planes.begin(), planes.end());
+        }
       }
       if (shape->lit)
         cut.push_back(*shape->lit);
       for (const ObjectBounds &o : scene.objects) {
         if (!o.real || !o.shaded)
           continue;
-        const Box receiver = bounds_of(o, margin);
-        ConvexPolyhedron poly = ConvexPolyhedron::box(receiver.lo, receiver.hi);
+        ConvexPolyhedron poly = object_polyhedron(o, margin);
         for (const Halfspace &h : cut) {
           poly.clip(h);
           if (poly.empty())

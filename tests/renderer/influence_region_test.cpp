@@ -214,23 +214,28 @@ TEST(InfluenceRegion, RandomScenesCompositeBitForBit) {
 // The region's reach in the image: the blur circle of a defocused object
 // in front of and behind the focal plane, and a wide pixel filter. Many
 // small objects, so that some rim lies just past a tile's edge; enough
-// samples that the rims' outermost pixels are hit.
+// samples that the rims' outermost pixels are hit. And a blur circle of
+// about 24 px around a ball half as wide, larger than the tiles' slack: a
+// blur taken 45 % too small fails here (17 % too small still passes).
 TEST(InfluenceRegion, BlurAndFilterReachBitForBit) {
   struct Case {
     const char *name;
     float f_number, focus_m, depth_m, filter_px;
+    int balls;
+    float radius; // of a ball, over its depth
   };
-  for (const Case &c : {Case{"near focus, far objects, f/1.2", 1.2f, 0.6f, 3.0f, 1.0f},
-                        Case{"far focus, near objects, f/1.2", 1.2f, 10.0f, 1.0f, 1.0f},
-                        Case{"pinhole, 6 px filter", 0.0f, 1.0f, 3.0f, 6.0f}}) {
+  for (const Case &c : {Case{"near focus, far objects, f/1.2", 1.2f, 0.6f, 3.0f, 1.0f, 12, 0.004f},
+                        Case{"far focus, near objects, f/1.2", 1.2f, 10.0f, 1.0f, 1.0f, 12, 0.004f},
+                        Case{"pinhole, 6 px filter", 0.0f, 1.0f, 3.0f, 6.0f, 12, 0.004f},
+                        Case{"wide blur, f/0.7", 0.7f, 0.3f, 3.0f, 1.0f, 2, 0.05f}}) {
     Scene scene = test::empty_scene(c.name, c.f_number, c.focus_m, 160, 120);
     scene.render.pixel_filter_width_px = c.filter_px;
     scene.materials = {{"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
-    for (int i = 0; i < 12; ++i) {
+    for (int i = 0; i < c.balls; ++i) {
       const float x = (float(i % 4) - 1.37f) * 0.23f * c.depth_m;
       const float y = (float(i / 4) - 0.91f) * 0.19f * c.depth_m;
       scene.objects.push_back(
-          test::sphere("ball", glm::vec3(x, y, -c.depth_m), 0.004f * c.depth_m, 0, false));
+          test::sphere("ball", glm::vec3(x, y, -c.depth_m), c.radius * c.depth_m, 0, false));
     }
     scene = with_noise_plate(std::move(scene), 5);
     const Comparison result = compare_cpu(scene, 16);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -22,6 +23,12 @@ struct ObjectBounds {
   bool real = false;     // part of the real proxy
   bool specular = false; // mirror or glass: shows what lies elsewhere
   bool shaded = false;   // diffuse: receives light, and so shadows
+  // Its extent along its own axes (the columns of `axes`, orthonormal: the
+  // object's rotation): an oriented box, which a rotated box or plane fills
+  // exactly where lo/hi, aligned with the world, does not.
+  glm::mat3 axes{1.0f};
+  glm::vec3 axis_lo{0.0f};
+  glm::vec3 axis_hi{0.0f};
   // A sphere's own shape, tighter than its box.
   bool sphere = false;
   glm::vec3 centre{0.0f};
