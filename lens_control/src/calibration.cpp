@@ -58,6 +58,10 @@ struct Block {
   std::size_t distinct = 0;
 
   [[nodiscard]] double mean(std::size_t c) const { return sum[c] / weight; }
+  // What the profile will say for channel c.
+  [[nodiscard]] double written(CalibrationAxis axis, std::size_t c) const {
+    return same[c] ? *same[c] : from_linear(axis, mean(c));
+  }
 
   void absorb(const Block &b) {
     counts_sum += b.counts_sum;
@@ -72,10 +76,17 @@ struct Block {
   }
 };
 
-// Strictly monotone in direction dir[c] in every channel between a and b.
-bool in_order(const Block &a, const Block &b, const std::vector<double> &dir) {
+// Strictly monotone in direction dir[c] in every channel between a and b,
+// both in the linear space and as written: repeats that all say 20 m average
+// to 1 ulp off 1/20 D, which orders them against a lone 20 m beside them,
+// yet both are written as 20 and the profile reader refuses the tie
+// (tests/fuzz/calibration_fuzz). Distance falls as diopters rise.
+bool in_order(const Block &a, const Block &b, const std::vector<double> &dir,
+              CalibrationAxis axis) {
+  const double written_dir = axis == CalibrationAxis::focus ? -1.0 : 1.0;
   for (std::size_t c = 0; c < dir.size(); ++c)
-    if (!((b.mean(c) - a.mean(c)) * dir[c] > 0.0))
+    if (!((b.mean(c) - a.mean(c)) * dir[c] > 0.0) ||
+        !((b.written(axis, c) - a.written(axis, c)) * dir[c] * written_dir > 0.0))
       return false;
   return true;
 }
@@ -86,18 +97,24 @@ bool in_order(const Block &a, const Block &b, const std::vector<double> &dir) {
 // a merged mean lies between its parts, so the pairs below stay in order.
 // With one channel this is the least-squares isotonic regression; with two
 // (f-number and T-stop) a pair out of order in either is merged in both.
-std::vector<Block> pool_adjacent_violators(const std::vector<Block> &blocks,
-                                           const std::vector<double> &dir) {
-  std::vector<Block> out;
-  for (const Block &b : blocks) {
-    out.push_back(b);
-    while (out.size() >= 2 && !in_order(out[out.size() - 2], out.back(), dir)) {
-      const Block top = out.back();
-      out.pop_back();
-      out.back().absorb(top);
+// The written values can break that invariant by rounding, so the passes
+// repeat until one merges nothing.
+std::vector<Block> pool_adjacent_violators(std::vector<Block> blocks,
+                                           const std::vector<double> &dir, CalibrationAxis axis) {
+  for (std::size_t before = 0; before != blocks.size();) {
+    before = blocks.size();
+    std::vector<Block> out;
+    for (const Block &b : blocks) {
+      out.push_back(b);
+      while (out.size() >= 2 && !in_order(out[out.size() - 2], out.back(), dir, axis)) {
+        const Block top = out.back();
+        out.pop_back();
+        out.back().absorb(top);
+      }
     }
+    blocks = std::move(out);
   }
-  return out;
+  return blocks;
 }
 
 // +1 or -1: the sign of the least-squares slope of channel c over counts, over
@@ -173,7 +190,7 @@ AxisFit fit_axis(const std::string &source, const std::string &name, Calibration
     std::vector<double> dir;
     for (std::size_t c = 0; c < channels; ++c)
       dir.push_back(trend(blocks, c));
-    blocks = pool_adjacent_violators(blocks, dir);
+    blocks = pool_adjacent_violators(std::move(blocks), dir, axis);
     if (blocks.size() < 2)
       fail("the monotone fit pools all " + std::to_string(rows.size()) +
            " measurements into one point: the values show no trend over counts (fewer than 2 "
@@ -183,9 +200,9 @@ AxisFit fit_axis(const std::string &source, const std::string &name, Calibration
   for (const Block &b : blocks) {
     FittedPoint p;
     p.counts = std::int32_t(std::llround(b.counts_sum / b.weight));
-    p.value = b.same[0] ? *b.same[0] : from_linear(axis, b.mean(0));
+    p.value = b.written(axis, 0);
     if (channels == 2)
-      p.t_stop = b.same[1] ? *b.same[1] : from_linear(axis, b.mean(1));
+      p.t_stop = b.written(axis, 1);
     p.first_counts = b.first;
     p.last_counts = b.last;
     p.distinct_counts = b.distinct;

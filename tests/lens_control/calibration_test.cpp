@@ -149,6 +149,29 @@ TEST(Calibration, NoisyNonMonotoneDataArePooledIntoAProfileThatLoads) {
       << report;
 }
 
+// Three marks at 20 m average to 1 ulp off 1/20 D, which ordered them
+// against a lone 20 m mark at the next counts; both points were written as
+// 20 m, and the profile reader refused the tie (found by
+// tests/fuzz/calibration_fuzz). Points that would be written alike pool.
+TEST(Calibration, PointsWrittenAlikePool) {
+  ASSERT_NE((1.0 / 20 + 1.0 / 20 + 1.0 / 20) / 3, 1.0 / 20); // the rounding this is about
+  const std::string csv = kHeader + focus(0, "0.3") + focus(13600, "20") + focus(13600, "20") +
+                          focus(13600, "20") + focus(13601, "20") + focus(16384, "inf") +
+                          kIrisPrime;
+  const Calibration c = fit(csv);
+  ASSERT_EQ(c.focus.points.size(), 3u);
+  EXPECT_EQ(c.focus.points[1].first_counts, 13600);
+  EXPECT_EQ(c.focus.points[1].last_counts, 13601);
+  EXPECT_EQ(c.focus.points[1].value, 20.0); // all four said 20
+  EXPECT_NO_THROW((void)loaded(c));
+  // The fuzzer's own file, as `camhead calibrate --prime` reads it.
+  const Calibration found =
+      fit_calibration(read_measurements(fs::path(CAMHEAD_SOURCE_DIR) /
+                                        "tests/assets/fuzz/calibration_tie_written_alike.csv"),
+                      {"test lens", "", true});
+  EXPECT_NO_THROW((void)loaded(found));
+}
+
 TEST(Calibration, PoolingFollowsTheTrendAndKeepsIrisChannelsTogether) {
   // Focus rising in diopters (infinity at low counts, as on many zooms) with
   // a tie at the close end; iris where only the T-stop runs backwards.
