@@ -1,10 +1,13 @@
 #include "camhead/base/input_file.h"
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <system_error>
+
+#include <sys/stat.h>
 
 namespace camhead::base {
 namespace {
@@ -25,7 +28,8 @@ std::string in_units(std::size_t bytes) {
 }
 
 // Reads in chunks rather than by the size the file reports: a device or a
-// pipe reports none, and a file can grow while it is read.
+// pipe reports none, and a file can grow while it is read. A regular file
+// over the bound is refused unread.
 template <typename Bytes>
 bool read_bounded(const std::filesystem::path &path, std::size_t max_bytes, Bytes &out,
                   std::string &error) {
@@ -40,6 +44,14 @@ bool read_bounded(const std::filesystem::path &path, std::size_t max_bytes, Byte
     return false;
   }
   out.clear();
+  struct stat st {};
+  if (::fstat(::fileno(file.get()), &st) == 0 && S_ISREG(st.st_mode)) {
+    if (std::uintmax_t(st.st_size) > max_bytes) {
+      error = "is larger than " + in_units(max_bytes);
+      return false;
+    }
+    out.reserve(std::size_t(st.st_size));
+  }
   char chunk[65536];
   std::size_t got = 0;
   while ((got = std::fread(chunk, 1, sizeof chunk, file.get())) > 0) {
