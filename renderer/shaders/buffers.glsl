@@ -8,8 +8,34 @@
 #define PRECISE precise
 #define CAMHEAD_PI 3.14159265358979f
 
-layout(std430, binding = BINDING_PRIMITIVES) readonly buffer Primitives { Primitive primitives[]; };
-layout(std430, binding = BINDING_NODES) readonly buffer Nodes { BvhNode nodes[]; };
+layout(constant_id = 0) const uint KERNEL_FEATURES = KERNEL_ALL; // layout.h
+
+// The scene's geometry, read at every step of every traversal, is read
+// through texel buffers rather than storage buffers: lavapipe (Mesa 22.3)
+// loads a storage buffer at an index that differs between lanes one lane at
+// a time, in a loop with a branch per lane and component (lp_bld_nir_soa.c,
+// emit_load_mem), where a texel fetch is one gather (bench/RESULTS.md,
+// "Where lavapipe's time goes"). Integer texels keep the bits of the
+// integers that .w holds exactly.
+layout(binding = BINDING_PRIMITIVES) uniform usamplerBuffer primitive_texels;
+layout(binding = BINDING_NODES) uniform usamplerBuffer node_texels;
+
+Primitive primitive_at(uint index) {
+  int texel = int(index * PRIMITIVE_TEXELS);
+  Primitive prim;
+  prim.p0 = uintBitsToFloat(texelFetch(primitive_texels, texel));
+  prim.p1 = uintBitsToFloat(texelFetch(primitive_texels, texel + 1));
+  prim.p2 = uintBitsToFloat(texelFetch(primitive_texels, texel + 2));
+  return prim;
+}
+
+BvhNode node_at(uint index) {
+  int texel = int(index * NODE_TEXELS);
+  BvhNode node;
+  node.bmin = uintBitsToFloat(texelFetch(node_texels, texel));
+  node.bmax = uintBitsToFloat(texelFetch(node_texels, texel + 1));
+  return node;
+}
 layout(std430, binding = BINDING_MATERIALS) readonly buffer Materials { Material materials[]; };
 layout(std430, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };
 layout(std140, binding = BINDING_FRAME) uniform Frame { FrameParams frame; };

@@ -21,16 +21,18 @@ struct Hit {
 #define OCCLUDED_BY_VIRTUAL 1u
 #define OCCLUDED_BY_REAL 2u
 
-uint prim_bits(uint index) {
-  return floatBitsToUint(primitives[index].p0.w);
+// The primitive's flags are in p0.w; callers fetch a primitive once and ask
+// it everything (on lavapipe a fetch is a gather of three texels).
+uint prim_bits(Primitive prim) {
+  return floatBitsToUint(prim.p0.w);
 }
 
-bool prim_is_real(uint index) {
-  return (prim_bits(index) & PRIM_REAL_BIT) != 0u;
+bool prim_is_real(Primitive prim) {
+  return (prim_bits(prim) & PRIM_REAL_BIT) != 0u;
 }
 
-uint prim_material(uint index) {
-  return prim_bits(index) & PRIM_MATERIAL_MASK;
+uint prim_material(Primitive prim) {
+  return prim_bits(prim) & PRIM_MATERIAL_MASK;
 }
 
 // Reciprocal direction without infinities, so that the slab test never
@@ -107,11 +109,15 @@ float intersect_sphere(Ray ray, Primitive prim, float t_min, float t_max) {
   return CAMHEAD_NO_HIT;
 }
 
-float intersect_primitive(Ray ray, uint index, float t_min, float t_max) {
-  Primitive prim = primitives[index];
-  uint kind = floatBitsToUint(prim.p0.w) >> 24;
-  return kind == PRIM_SPHERE ? intersect_sphere(ray, prim, t_min, t_max)
-                             : intersect_triangle(ray, prim, t_min, t_max);
+// Whether a primitive is a sphere; constant where the pipeline has one kind.
+bool prim_is_sphere(Primitive prim) {
+  return KERNEL_HAS(KERNEL_SPHERES) &&
+         (!KERNEL_HAS(KERNEL_TRIANGLES) || (prim_bits(prim) >> 24) == PRIM_SPHERE);
+}
+
+float intersect_primitive(Ray ray, Primitive prim, float t_min, float t_max) {
+  return prim_is_sphere(prim) ? intersect_sphere(ray, prim, t_min, t_max)
+                              : intersect_triangle(ray, prim, t_min, t_max);
 }
 
 // Closest hit in (t_min, t_max). real_only: the real radiance ray, which sees
@@ -125,39 +131,42 @@ Hit closest_hit(Ray ray, float t_min, float t_max, bool real_only) {
   uint stack[CAMHEAD_STACK_SIZE];
   int top = 0;
   uint node_index = 0u;
-  if (box_entry(ray.origin, inv_dir, nodes[0].bmin, nodes[0].bmax, t_best) == CAMHEAD_NO_HIT) {
+  BvhNode root = node_at(0u);
+  if (box_entry(ray.origin, inv_dir, root.bmin, root.bmax, t_best) == CAMHEAD_NO_HIT) {
     return hit;
   }
   for (;;) {
-    BvhNode node = nodes[node_index];
+    BvhNode node = node_at(node_index);
     uint count = floatBitsToUint(node.bmax.w);
     uint first = floatBitsToUint(node.bmin.w);
     if (count > 0u) {
-      for (uint i = first; i < first + count; ++i) {
-        if (real_only && !prim_is_real(i)) {
-          continue;
+      uint i = first;
+      do {
+        Primitive prim = primitive_at(i);
+        if (!real_only || prim_is_real(prim)) {
+          float t = intersect_primitive(ray, prim, t_min, t_best);
+          if (t < t_best) {
+            t_best = t;
+            hit.t = t;
+            hit.prim = i;
+          }
         }
-        float t = intersect_primitive(ray, i, t_min, t_best);
-        if (t < t_best) {
-          t_best = t;
-          hit.t = t;
-          hit.prim = i;
-        }
-      }
+      } while (++i < first + count);
     } else {
       // Visit the nearer child first; the farther one waits on the stack.
       uint left = first;
       uint right = first + 1u;
-      float t_left = box_entry(ray.origin, inv_dir, nodes[left].bmin, nodes[left].bmax, t_best);
-      float t_right = box_entry(ray.origin, inv_dir, nodes[right].bmin, nodes[right].bmax, t_best);
+      BvhNode left_node = node_at(left);
+      BvhNode right_node = node_at(right);
+      float t_left = box_entry(ray.origin, inv_dir, left_node.bmin, left_node.bmax, t_best);
+      float t_right = box_entry(ray.origin, inv_dir, right_node.bmin, right_node.bmax, t_best);
       if (t_left != CAMHEAD_NO_HIT && t_right != CAMHEAD_NO_HIT) {
-        uint near_child = t_left <= t_right ? left : right;
-        uint far_child = t_left <= t_right ? right : left;
+        bool left_first = t_left <= t_right;
         if (top < CAMHEAD_STACK_SIZE) {
-          stack[top] = far_child;
+          stack[top] = left_first ? right : left;
           ++top;
         }
-        node_index = near_child;
+        node_index = left_first ? left : right;
         continue;
       }
       if (t_left != CAMHEAD_NO_HIT) {
@@ -171,11 +180,13 @@ Hit closest_hit(Ray ray, float t_min, float t_max, bool real_only) {
     }
     // Pop, skipping subtrees that now start beyond the best hit.
     bool found = false;
-    while (top > 0 && !found) {
-      --top;
-      node_index = stack[top];
-      found = box_entry(ray.origin, inv_dir, nodes[node_index].bmin, nodes[node_index].bmax,
-                        t_best) != CAMHEAD_NO_HIT;
+    if (top > 0) {
+      do {
+        --top;
+        node_index = stack[top];
+        BvhNode popped = node_at(node_index);
+        found = box_entry(ray.origin, inv_dir, popped.bmin, popped.bmax, t_best) != CAMHEAD_NO_HIT;
+      } while (top > 0 && !found);
     }
     if (!found) {
       break;
@@ -196,9 +207,9 @@ uint shadow_query(Ray ray, float t_min, float t_max, bool real_only, bool stop_a
   int top = 0;
   stack[top] = 0u;
   ++top;
-  while (top > 0) {
+  do {
     --top;
-    BvhNode node = nodes[stack[top]];
+    BvhNode node = node_at(stack[top]);
     if (box_entry(ray.origin, inv_dir, node.bmin, node.bmax, t_max) == CAMHEAD_NO_HIT) {
       continue;
     }
@@ -212,22 +223,24 @@ uint shadow_query(Ray ray, float t_min, float t_max, bool real_only, bool stop_a
       }
       continue;
     }
-    for (uint i = first; i < first + count; ++i) {
-      bool real = prim_is_real(i);
+    uint i = first;
+    do {
+      Primitive prim = primitive_at(i);
+      bool real = prim_is_real(prim);
       if (real_only && !real) {
         continue;
       }
       if ((occluded & OCCLUDED_BY_VIRTUAL) != 0u && !real) {
         continue; // already known; only a real blocker can add information
       }
-      if (intersect_primitive(ray, i, t_min, t_max) != CAMHEAD_NO_HIT) {
+      if (intersect_primitive(ray, prim, t_min, t_max) != CAMHEAD_NO_HIT) {
         occluded |= real ? OCCLUDED_BY_REAL : OCCLUDED_BY_VIRTUAL;
         if (real || stop_at_any) {
           return occluded;
         }
       }
-    }
-  }
+    } while (++i < first + count);
+  } while (top > 0);
   return occluded;
 }
 
@@ -236,7 +249,11 @@ uint shadow_query(Ray ray, float t_min, float t_max, bool real_only, bool stop_a
 // front side, and lets the ray continue behind them.
 vec3 area_lights_along(Ray ray, float t_max) {
   vec3 sum = vec3(0.0f);
-  for (uint li = 0u; li < frame.image.w; ++li) {
+  if (!KERNEL_HAS(KERNEL_AREA_LIGHTS) || frame.image.w == 0u) {
+    return sum;
+  }
+  uint li = 0u;
+  do {
     Light light = lights[li];
     if (floatBitsToUint(light.position.w) != LIGHT_AREA) {
       continue;
@@ -258,6 +275,6 @@ vec3 area_lights_along(Ray ray, float t_max) {
     if (abs(a) <= 0.5f && abs(b) <= 0.5f) {
       sum += vec3(light.emission);
     }
-  }
+  } while (++li < frame.image.w);
   return sum;
 }

@@ -8,7 +8,14 @@
 // INOUT(T) / OUT(T) for reference parameters, and no names that would hide a
 // glm function inside a C++ class.
 //
-// Expects: primitives[], nodes[], materials[], lights[], frame (FrameParams).
+// Expects: primitive_at(), node_at(), materials[], lights[], frame (FrameParams).
+//
+// Loops test their condition at the bottom (do-while, behind a test for
+// none at all). lavapipe runs every branch masked and ends a loop only when
+// no lane is left at its bottom, so a loop tested at the top runs its whole
+// body once more, masked, after its last lane is done: one more traversal
+// step, primitive test, shadow ray or sample each time (bench/RESULTS.md,
+// "Where lavapipe's time goes").
 
 #include "sampling.glsl"
 #include "intersect.glsl"
@@ -24,7 +31,8 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   //    and form the pinhole direction; row 0 is the top of the image.
   vec2 jitter;
   vec2 aperture;
-  if (frame.tracing.z == SAMPLER_SOBOL) {
+  if (KERNEL_HAS(KERNEL_CAMERA_SOBOL) &&
+      (!KERNEL_HAS(KERNEL_CAMERA_CMJ) || frame.tracing.z == SAMPLER_SOBOL)) {
     vec4 q = sobol_owen_4d(s, pixel_pattern);
     jitter = vec2(q.x, q.y);
     aperture = vec2(q.z, q.w);
@@ -65,9 +73,8 @@ float ray_epsilon(vec3 p) {
   return CAMHEAD_RAY_EPSILON * (1.0f + max(abs(p.x), max(abs(p.y), abs(p.z))));
 }
 
-vec3 surface_normal(uint index, vec3 p) {
-  Primitive prim = primitives[index];
-  if ((floatBitsToUint(prim.p0.w) >> 24) == PRIM_SPHERE) {
+vec3 surface_normal(Primitive prim, vec3 p) {
+  if (prim_is_sphere(prim)) {
     return normalize(p - vec3(prim.p0));
   }
   return normalize(cross(vec3(prim.p1), vec3(prim.p2))); // flat face normal
@@ -95,7 +102,11 @@ void direct_light(vec3 p, vec3 n, vec3 brdf_weight, uint surface_dim, uint s, ui
   float eps = ray_epsilon(p);
   Ray shadow;
   shadow.origin = p + n * eps;
-  for (uint li = 0u; li < frame.image.w; ++li) {
+  if (frame.image.w == 0u) {
+    return;
+  }
+  uint li = 0u;
+  do {
     Light light = lights[li];
     uint type = floatBitsToUint(light.position.w);
     vec3 wi;
@@ -108,14 +119,15 @@ void direct_light(vec3 p, vec3 n, vec3 brdf_weight, uint surface_dim, uint s, ui
     } else {
       vec3 target = vec3(light.position);
       float geometry = 1.0f;
-      if (type == LIGHT_AREA) {
+      bool area = KERNEL_HAS(KERNEL_AREA_LIGHTS) && type == LIGHT_AREA;
+      if (area) {
         vec2 u = sample_dimension(s, count, pixel_pattern, surface_dim + 1u + li);
         target += (u.x - 0.5f) * vec3(light.axis_u) + (u.y - 0.5f) * vec3(light.axis_v);
       }
       vec3 to_light = target - shadow.origin;
       dist = length(to_light);
       wi = to_light / dist;
-      if (type == LIGHT_AREA) {
+      if (area) {
         // Uniform area sampling: pdf 1/A, cosine at the light, front side only.
         geometry = max(-dot(wi, vec3(light.normal)), 0.0f) * light.axis_u.w;
       }
@@ -134,7 +146,7 @@ void direct_light(vec3 p, vec3 n, vec3 brdf_weight, uint surface_dim, uint s, ui
     if ((want_real || real_only) && (occluded & OCCLUDED_BY_REAL) == 0u) {
       lr += contribution;
     }
-  }
+  } while (++li < frame.image.w);
 }
 
 // ---------------------------------------------------------------- paths
@@ -189,7 +201,8 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
   for (;;) {
     Hit hit = closest_hit(ray, 0.0f, CAMHEAD_NO_HIT, real_only);
     bool missed = hit.t == CAMHEAD_NO_HIT;
-    bool is_virtual = !missed && !prim_is_real(hit.prim);
+    Primitive surface_prim = primitive_at(hit.prim); // primitive 0 where missed
+    bool is_virtual = !missed && !prim_is_real(surface_prim);
     if (surface == 1u && !real_only) {
       result.hit = !missed;
       result.is_virtual = is_virtual;
@@ -205,7 +218,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
     bool add_mixed = !real_only;
     bool add_real = real_only || coupled;
 
-    Material material = materials[missed ? 0u : prim_material(hit.prim)];
+    Material material = materials[missed ? 0u : prim_material(surface_prim)];
     uint type = floatBitsToUint(material.params.w);
     vec3 emitted = surface > 1u ? area_lights_along(ray, hit.t) : vec3(0.0f);
     if (missed) {
@@ -214,7 +227,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
       emitted += vec3(material.color);
     }
     vec3 p = ray.origin + hit.t * ray.dir;
-    vec3 n = missed ? vec3(0.0f, 0.0f, 1.0f) : surface_normal(hit.prim, p);
+    vec3 n = missed ? vec3(0.0f, 0.0f, 1.0f) : surface_normal(surface_prim, p);
     bool entering = dot(n, ray.dir) < 0.0f;
     vec3 n_facing = entering ? n : -n; // planes and meshes are two-sided
     uint surface_dim = DIM_SURFACE_BASE + (surface - 1u) * DIM_PER_SURFACE;
@@ -235,7 +248,8 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
       result.real += add_real ? weight * emitted : vec3(0.0f);
     }
 
-    if (path_ends) {
+    // Without mirrors and glass every path ends at its first shaded surface.
+    if (path_ends || !KERNEL_HAS(KERNEL_MIRRORS | KERNEL_GLASS)) {
       if (!branch.pending) {
         break;
       }
@@ -250,7 +264,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
     }
 
     float eps = ray_epsilon(p);
-    if (type == MAT_MIRROR) {
+    if (KERNEL_HAS(KERNEL_MIRRORS) && (!KERNEL_HAS(KERNEL_GLASS) || type == MAT_MIRROR)) {
       weight *= vec3(material.color); // reflectance = tint at every angle, no Fresnel
       ray.dir = reflect(ray.dir, n_facing);
       ray.origin = p + n_facing * eps;
@@ -302,7 +316,8 @@ bool bundle_meets_box(vec3 origin, vec3 inv_dir, float footprint, vec4 bmin4, ve
 // bundle test above that stops at the first leaf the bundle may reach;
 // conservative (a full stack counts as a leaf reached).
 bool pixel_misses_scene(uint x, uint y) {
-  if (!(abs(nodes[0].bmin.x) < 1e30f)) {
+  BvhNode root = node_at(0u);
+  if (!(abs(root.bmin.x) < 1e30f)) {
     return true; // the empty BVH (bounds at +inf) admits no ray
   }
   vec3 origin = vec3(frame.cam_position);
@@ -315,27 +330,30 @@ bool pixel_misses_scene(uint x, uint y) {
   float footprint = 0.70710678f * frame.lens.w * frame.lens.y / frame.lens.z;
   uint stack[CAMHEAD_STACK_SIZE];
   int top = 0;
-  if (bundle_meets_box(origin, inv_dir, footprint, nodes[0].bmin, nodes[0].bmax)) {
-    stack[0] = 0u;
-    top = 1;
+  if (!bundle_meets_box(origin, inv_dir, footprint, root.bmin, root.bmax)) {
+    return true;
   }
-  while (top > 0) {
+  stack[0] = 0u;
+  top = 1;
+  do {
     --top;
-    BvhNode node = nodes[stack[top]];
+    BvhNode node = node_at(stack[top]);
     if (floatBitsToUint(node.bmax.w) > 0u) {
       return false; // a leaf
     }
     uint left = floatBitsToUint(node.bmin.w);
-    for (uint child = left; child <= left + 1u; ++child) {
-      if (bundle_meets_box(origin, inv_dir, footprint, nodes[child].bmin, nodes[child].bmax)) {
+    uint child = left;
+    do {
+      BvhNode child_node = node_at(child);
+      if (bundle_meets_box(origin, inv_dir, footprint, child_node.bmin, child_node.bmax)) {
         if (top == CAMHEAD_STACK_SIZE) {
           return false;
         }
         stack[top] = child;
         ++top;
       }
-    }
-  }
+    } while (++child <= left + 1u);
+  } while (top > 0);
   return true;
 }
 
@@ -376,15 +394,19 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
   // One sample for all where none can differ. A shorter loop rather than a
   // second path: SIMD executors (lavapipe) run a branch's both sides but a
   // loop only as long as its longest lane.
-  if (first < end && (frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u &&
-      pixel_misses_scene(x, y)) {
+  if (KERNEL_HAS(KERNEL_SKIP_EMPTY_PIXELS) && first < end &&
+      (frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u && pixel_misses_scene(x, y)) {
     weight = float(end - first);
     end = first + 1u;
   }
-  for (uint s = first; s < end; ++s) {
+  if (first >= end) {
+    return;
+  }
+  uint s = first;
+  do {
     SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern), s, count, pixel_pattern);
     accumulate_sample(r, weight, camera, has_plate, acc_mixed, acc_real, acc_aux);
-  }
+  } while (++s < end);
 }
 
 // ---------------------------------------------------------------- compositing

@@ -23,6 +23,7 @@ struct Primitive {
   vec4 p1;
   vec4 p2;
 };
+#define PRIMITIVE_TEXELS 3u // 16-byte texels per Primitive (BINDING_PRIMITIVES)
 
 // Bounding volume hierarchy node, 32 bytes.
 //   bmin.xyz / bmax.xyz: bounds
@@ -34,6 +35,7 @@ struct BvhNode {
   vec4 bmin;
   vec4 bmax;
 };
+#define NODE_TEXELS 2u // 16-byte texels per BvhNode (BINDING_NODES)
 
 #define MAT_DIFFUSE 0u
 #define MAT_MIRROR 1u
@@ -95,6 +97,24 @@ struct FrameParams {
 // CPU reference, but up to 1.4x slower on lavapipe where the proxy covers the
 // frame, and not yet measured on a GPU; the CPU reference sets it.
 #define TRACING_SKIP_EMPTY_PIXELS 1u
+
+// What a trace pipeline is built for: specialization constant 0 of
+// trace.comp, KERNEL_FEATURES (buffers.glsl), the scene's primitive kinds,
+// materials and lights and the frame's sampler and flags (gpu_tracer.cpp,
+// kernel_features). The driver removes the code of every feature left out;
+// lavapipe, which runs both sides of each branch masked, runs the rest
+// faster for it (bench/RESULTS.md, "Where lavapipe's time goes"). The CPU
+// reference has them all and decides at run time.
+#define KERNEL_SPHERES 1u
+#define KERNEL_TRIANGLES 2u
+#define KERNEL_MIRRORS 4u
+#define KERNEL_GLASS 8u
+#define KERNEL_AREA_LIGHTS 16u
+#define KERNEL_CAMERA_CMJ 32u   // camera samples may be SAMPLER_CMJ
+#define KERNEL_CAMERA_SOBOL 64u // ... or SAMPLER_SOBOL
+#define KERNEL_SKIP_EMPTY_PIXELS 128u
+#define KERNEL_ALL 255u
+#define KERNEL_HAS(feature) ((KERNEL_FEATURES & (feature)) != 0u)
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.
 #define BINDING_PRIMITIVES 0

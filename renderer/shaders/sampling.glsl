@@ -123,7 +123,11 @@ uint sobol_u32(uint i, uint d) {
   uint v1 = 0u; // V_{k-1}
   uint v2 = 0u; // V_{k-2}
   uint v3 = 0u; // V_{k-3}
-  for (uint k = 1u; i != 0u; ++k) {
+  if (i == 0u) {
+    return result;
+  }
+  uint k = 1u;
+  do { // bottom-tested, as every loop here (kernel.glsl)
     uint v;
     if (k == 1u) {
       v = 0x80000000u;
@@ -145,7 +149,8 @@ uint sobol_u32(uint i, uint d) {
     v2 = v1;
     v1 = v;
     i >>= 1u;
-  }
+    ++k;
+  } while (i != 0u);
   return result;
 }
 

@@ -41,6 +41,12 @@ struct CpuKernel {
   const Light *lights = nullptr;
   const uint *sample_counts = nullptr; // adaptive second pass only (tracing.y > 0)
   FrameParams frame{};
+  // Every feature, chosen at run time (layout.h).
+  static constexpr uint KERNEL_FEATURES = KERNEL_ALL;
+
+  // The GLSL kernel reads the geometry through texel buffers (buffers.glsl).
+  [[nodiscard]] Primitive primitive_at(uint index) const { return primitives[index]; }
+  [[nodiscard]] BvhNode node_at(uint index) const { return nodes[index]; }
 
 #include "kernel.glsl"
 };

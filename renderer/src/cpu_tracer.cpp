@@ -41,7 +41,10 @@ private:
 cpu::CpuKernel cpu::make_cpu_kernel(const CompiledScene &scene, const gpu::FrameParams &frame,
                                     std::vector<gpu::BvhNode> &nodes) {
   cpu::CpuKernel kernel;
-  kernel.primitives = scene.primitives.data();
+  // Rays that miss read primitive 0 (and ignore it), as on the GPU, which
+  // binds a zeroed placeholder for an empty array.
+  static const gpu::Primitive placeholder_primitive{};
+  kernel.primitives = scene.primitives.empty() ? &placeholder_primitive : scene.primitives.data();
   // As the GPU tracer: a scene without nodes traverses the empty BVH.
   nodes = scene.nodes.empty() ? build_bvh({}).nodes : scene.nodes;
   kernel.nodes = nodes.data();

@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <optional>
 #include <span>
 
@@ -64,7 +66,37 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   types.fill(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
   types[BINDING_FRAME] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   types[BINDING_VIDEO] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  types[BINDING_PRIMITIVES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER; // buffers.glsl says why
+  types[BINDING_NODES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   return types;
+}
+
+// The features of kernel.glsl that `scene` can reach (layout.h, KERNEL_*):
+// its primitive kinds, material types and light types.
+std::uint32_t scene_kernel_features(const CompiledScene &scene) {
+  const auto bits = [](float word) { return std::bit_cast<std::uint32_t>(word); };
+  std::uint32_t features = 0;
+  for (const gpu::Primitive &p : scene.primitives)
+    features |= (bits(p.p0.w) >> 24) == PRIM_SPHERE ? KERNEL_SPHERES : KERNEL_TRIANGLES;
+  for (const gpu::Material &m : scene.materials) {
+    if (bits(m.params.w) == MAT_MIRROR)
+      features |= KERNEL_MIRRORS;
+    if (bits(m.params.w) == MAT_GLASS)
+      features |= KERNEL_GLASS;
+  }
+  for (const gpu::Light &l : scene.lights)
+    if (bits(l.position.w) == LIGHT_AREA)
+      features |= KERNEL_AREA_LIGHTS;
+  return features;
+}
+
+// ... and those `frame` asks for.
+std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
+  std::uint32_t features =
+      frame.tracing.z == SAMPLER_SOBOL ? KERNEL_CAMERA_SOBOL : KERNEL_CAMERA_CMJ;
+  if ((frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u)
+    features |= KERNEL_SKIP_EMPTY_PIXELS;
+  return features;
 }
 
 template <typename T> std::span<const std::byte> bytes_of(const std::vector<T> &values) {
@@ -170,6 +202,8 @@ struct GpuTracer::Impl {
   // Dispatches `pipeline` (made with dispatch_base) over the tiles of the
   // frame's region.
   void dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
+  // The trace kernel built for the loaded scene and `frame`, built on first use.
+  VkPipeline trace_pipeline(const gpu::FrameParams &frame);
 
   // Declaration order is destruction order in reverse: everything made from
   // the device goes before it, and the device before the instance.
@@ -177,7 +211,8 @@ struct GpuTracer::Impl {
   vk::Device device;
   vk::DescriptorSet descriptors;
   vk::UniquePipelineLayout pipeline_layout;
-  vk::UniquePipeline trace;
+  // trace.comp by KERNEL_FEATURES (layout.h): a scene uses one or two.
+  std::map<std::uint32_t, vk::UniquePipeline> trace_pipelines;
   vk::UniquePipeline resolve;
   vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
@@ -199,9 +234,10 @@ struct GpuTracer::Impl {
   std::uint32_t width = 0;
   std::uint32_t height = 0;
   bool has_plate = false;
-  glm::uvec2 video_blocks{0}; // 4 x 2 pixel blocks of the video kernels
-  gpu::uvec4 counts{};        // primitives, nodes, lights
-  glm::vec3 origin{0.0f};     // CompiledScene::origin of the loaded scene
+  glm::uvec2 video_blocks{0};                // 4 x 2 pixel blocks of the video kernels
+  gpu::uvec4 counts{};                       // primitives, nodes, lights
+  glm::vec3 origin{0.0f};                    // CompiledScene::origin of the loaded scene
+  std::uint32_t scene_features = KERNEL_ALL; // scene_kernel_features of the loaded scene
   // Batch sizes, one per kind of pass, for the loaded scene.
   BatchSizer uniform_sizer;
   BatchSizer second_pass_sizer;
@@ -213,10 +249,6 @@ GpuTracer::Impl::Impl(const std::string &wanted)
     : device(vk::choose_device(instance.compute_devices(), wanted)),
       descriptors(device, binding_types()),
       pipeline_layout(vk::make_pipeline_layout(device, descriptors.layout())),
-      trace(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                               .spirv = trace_spv,
-                                               .name = "trace.comp",
-                                               .dispatch_base = true})),
       resolve(vk::make_compute_pipeline(
           device, {.layout = pipeline_layout.get(), .spirv = resolve_spv, .name = "resolve.comp"})),
       adaptive_weights(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
@@ -276,10 +308,21 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   // admit no ray.
   const auto upload = [&](int binding, std::span<const std::byte> data, std::size_t element,
                           const char *name) {
-    buffers[binding] = vk::Buffer(
-        device, {.size = std::max<VkDeviceSize>(data.size(), element),
-                 .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                 .name = name});
+    const VkDeviceSize size = std::max<VkDeviceSize>(data.size(), element);
+    vk::BufferCreateInfo create{.size = size,
+                                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                .name = name};
+    if (binding_types()[std::size_t(binding)] == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
+      // 16-byte texels (layout.h: PRIMITIVE_TEXELS, NODE_TEXELS).
+      if (size / 16 > limits.maxTexelBufferElements)
+        throw GpuError(std::string("the scene's ") + name + " take " + std::to_string(size / 16) +
+                       " texels; device '" + device.name() + "' allows " +
+                       std::to_string(limits.maxTexelBufferElements) + " in a texel buffer");
+      create.usage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+      create.texel_format = VK_FORMAT_R32G32B32A32_UINT;
+    }
+    buffers[binding] = vk::Buffer(device, create);
     uploader.upload(buffers[binding], data);
   };
   upload(BINDING_PRIMITIVES, bytes_of(scene.primitives), sizeof(gpu::Primitive), "primitives");
@@ -350,9 +393,25 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   video_blocks = glm::uvec2((width + 3) / 4, (height + 1) / 2);
   counts = gpu::uvec4(scene.primitives.size(), scene.nodes.size(), scene.lights.size(), 0);
   origin = scene.origin;
+  scene_features = scene_kernel_features(scene);
+  // Built now rather than in the first frame: the kernel for the usual
+  // frame (CMJ samples, every pixel traced).
+  static_cast<void>(trace_pipeline(gpu::FrameParams{}));
   uniform_sizer = {};
   second_pass_sizer = {};
   loaded = true;
+}
+
+VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame) {
+  const std::uint32_t features = scene_features | frame_kernel_features(frame);
+  vk::UniquePipeline &pipeline = trace_pipelines[features];
+  if (pipeline.get() == VK_NULL_HANDLE)
+    pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                  .spirv = trace_spv,
+                                                  .name = "trace.comp",
+                                                  .dispatch_base = true,
+                                                  .constants = std::span(&features, 1)});
+  return pipeline.get();
 }
 
 void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
@@ -634,7 +693,7 @@ int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, B
     if (done == 0 && prologue)
       prologue(command_buffer);
     if (batch > 0) {
-      dispatch_region(command_buffer, trace.get());
+      dispatch_region(command_buffer, trace_pipeline(frame));
       // Orders this batch's accumulation before the next batch or the resolve.
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,

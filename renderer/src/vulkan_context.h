@@ -66,6 +66,7 @@ private:
 };
 
 using UniqueBuffer = DeviceHandle<VkBuffer, vkDestroyBuffer>;
+using UniqueBufferView = DeviceHandle<VkBufferView, vkDestroyBufferView>;
 using UniqueMemory = DeviceHandle<VkDeviceMemory, vkFreeMemory>;
 using UniqueDescriptorSetLayout = DeviceHandle<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout>;
 using UniqueDescriptorPool = DeviceHandle<VkDescriptorPool, vkDestroyDescriptorPool>;
@@ -181,6 +182,9 @@ struct BufferCreateInfo {
   VkBufferUsageFlags usage = 0;
   MemoryUse memory = MemoryUse::device_local;
   const char *name = "buffer"; // for error messages
+  // Set for a texel buffer (usage includes a texel buffer bit): the buffer
+  // gets a view of its whole range in this format.
+  VkFormat texel_format = VK_FORMAT_UNDEFINED;
 };
 
 // A buffer with its own allocation, persistently mapped when host-visible.
@@ -191,11 +195,13 @@ public:
 
   [[nodiscard]] VkBuffer get() const { return buffer_.get(); }
   [[nodiscard]] VkDeviceSize size() const { return size_; }
-  [[nodiscard]] void *mapped() const { return mapped_; } // null unless host-visible
+  [[nodiscard]] void *mapped() const { return mapped_; }          // null unless host-visible
+  [[nodiscard]] VkBufferView view() const { return view_.get(); } // null unless texel_format
 
 private:
   UniqueMemory memory_; // declared first: the buffer goes before its memory
   UniqueBuffer buffer_;
+  UniqueBufferView view_; // and its view before it
   VkDeviceSize size_ = 0;
   void *mapped_ = nullptr;
 };
@@ -268,7 +274,8 @@ public:
 
   [[nodiscard]] VkDescriptorSetLayout layout() const { return layout_.get(); }
   [[nodiscard]] VkDescriptorSet get() const { return set_; }
-  // Points `binding` at the whole of `buffer`. The set must not be in use.
+  // Points `binding` at the whole of `buffer`, through its view for a
+  // texel buffer binding. The set must not be in use.
   void write(std::uint32_t binding, const Buffer &buffer);
 
 private:
@@ -289,6 +296,8 @@ struct ComputePipelineCreateInfo {
   const char *name = "kernel"; // for error messages
   // Dispatched with vkCmdDispatchBase (a part of the grid).
   bool dispatch_base = false;
+  // Specialization constant i (32 bits each, constant_id i) = constants[i].
+  std::span<const std::uint32_t> constants = {};
 };
 
 [[nodiscard]] UniquePipeline make_compute_pipeline(const Device &device,

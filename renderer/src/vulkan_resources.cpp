@@ -2,6 +2,7 @@
 #include <array>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "vulkan_context.h"
 
@@ -49,6 +50,19 @@ Buffer::Buffer(const Device &device, const BufferCreateInfo &info) : size_(info.
   if (device.mappable(type))
     device.check(vkMapMemory(device.get(), memory, 0, VK_WHOLE_SIZE, 0, &mapped_),
                  describe("vkMapMemory", info.name, info.size));
+
+  if (info.texel_format != VK_FORMAT_UNDEFINED) {
+    VkBufferViewCreateInfo view_create{};
+    view_create.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+    view_create.buffer = buffer;
+    view_create.format = info.texel_format;
+    view_create.offset = 0;
+    view_create.range = VK_WHOLE_SIZE;
+    VkBufferView view = VK_NULL_HANDLE;
+    device.check(vkCreateBufferView(device.get(), &view_create, nullptr, &view),
+                 describe("vkCreateBufferView", info.name, info.size));
+    view_ = UniqueBufferView(device.get(), view);
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -236,7 +250,16 @@ void DescriptorSet::write(std::uint32_t binding, const Buffer &buffer) {
   write.dstBinding = binding;
   write.descriptorCount = 1;
   write.descriptorType = types_.at(binding);
-  write.pBufferInfo = &buffer_info;
+  const VkBufferView view = buffer.view();
+  if (write.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER ||
+      write.descriptorType == VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER) {
+    if (view == VK_NULL_HANDLE)
+      throw GpuError("descriptor binding " + std::to_string(binding) +
+                     " is a texel buffer, but the buffer has no texel view");
+    write.pTexelBufferView = &view;
+  } else {
+    write.pBufferInfo = &buffer_info;
+  }
   vkUpdateDescriptorSets(device_->get(), 1, &write, 0, nullptr);
 }
 
@@ -272,6 +295,16 @@ UniquePipeline make_compute_pipeline(const Device &device, const ComputePipeline
   create.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   create.stage.module = module;
   create.stage.pName = info.entry;
+  std::vector<VkSpecializationMapEntry> entries;
+  for (std::uint32_t id = 0; id < info.constants.size(); ++id)
+    entries.push_back({id, id * std::uint32_t(sizeof(std::uint32_t)), sizeof(std::uint32_t)});
+  VkSpecializationInfo specialization{};
+  specialization.mapEntryCount = std::uint32_t(entries.size());
+  specialization.pMapEntries = entries.data();
+  specialization.dataSize = info.constants.size_bytes();
+  specialization.pData = info.constants.data();
+  if (!entries.empty())
+    create.stage.pSpecializationInfo = &specialization;
   create.layout = info.layout;
   create.flags = info.dispatch_base ? VK_PIPELINE_CREATE_DISPATCH_BASE_BIT : 0;
   VkPipeline pipeline = VK_NULL_HANDLE;
