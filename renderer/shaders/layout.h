@@ -116,6 +116,17 @@ struct FrameParams {
 #define KERNEL_ALL 255u
 #define KERNEL_HAS(feature) ((KERNEL_FEATURES & (feature)) != 0u)
 
+// The layers resolve.comp writes: specialization constant 1, RESOLVE_LAYERS.
+// A live frame wants the display image alone (and the composite where the
+// video kernels encode it); the four float layers cost lavapipe a sixth of
+// a 1-rpp frame (bench/RESULTS.md).
+#define RESOLVE_COMPOSITE 1u
+#define RESOLVE_MIXED 2u
+#define RESOLVE_REAL 4u
+#define RESOLVE_MASK_AND_DEPTH 8u
+#define RESOLVE_DISPLAY 16u
+#define RESOLVE_ALL 31u
+
 // Descriptor bindings, one set shared by the trace and resolve kernels.
 #define BINDING_PRIMITIVES 0
 #define BINDING_NODES 1

@@ -6,6 +6,8 @@
 
 layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
 
+layout(constant_id = 1) const uint RESOLVE_LAYERS = RESOLVE_ALL; // layout.h
+
 // The sRGB transfer function (IEC 61966-2-1) as image_io's PNG writer applies
 // it, in float where the writer uses double: the bytes may differ by one.
 vec3 linear_to_srgb(vec3 v) {
@@ -24,11 +26,21 @@ void main() {
   vec4 camera = has_plate ? plate[i] : vec4(0.0f);
   uint samples = frame.tracing.y != 0u ? sample_counts[i] : frame.sampling.z;
   Resolved r = resolve_pixel(accum_mixed[i], accum_real[i], accum_aux[i], camera, has_plate, samples);
-  out_composite[i] = vec4(r.composite, 1.0f);
-  out_mixed[i] = vec4(r.mixed, 1.0f);
-  out_real[i] = vec4(r.real, 1.0f);
-  out_aux[i] = vec4(r.mask, r.depth, 0.0f, 0.0f);
+  if ((RESOLVE_LAYERS & RESOLVE_COMPOSITE) != 0u) {
+    out_composite[i] = vec4(r.composite, 1.0f);
+  }
+  if ((RESOLVE_LAYERS & RESOLVE_MIXED) != 0u) {
+    out_mixed[i] = vec4(r.mixed, 1.0f);
+  }
+  if ((RESOLVE_LAYERS & RESOLVE_REAL) != 0u) {
+    out_real[i] = vec4(r.real, 1.0f);
+  }
+  if ((RESOLVE_LAYERS & RESOLVE_MASK_AND_DEPTH) != 0u) {
+    out_aux[i] = vec4(r.mask, r.depth, 0.0f, 0.0f);
+  }
   // The frame as a display or a V4L2 sink takes it: a quarter of the bytes of
   // out_composite, and no conversion left for the host.
-  out_display[i] = packUnorm4x8(vec4(linear_to_srgb(r.composite), r.mask));
+  if ((RESOLVE_LAYERS & RESOLVE_DISPLAY) != 0u) {
+    out_display[i] = packUnorm4x8(vec4(linear_to_srgb(r.composite), r.mask));
+  }
 }

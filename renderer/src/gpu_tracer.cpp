@@ -204,6 +204,8 @@ struct GpuTracer::Impl {
   void dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
   // The trace kernel built for the loaded scene and `frame`, built on first use.
   VkPipeline trace_pipeline(const gpu::FrameParams &frame);
+  // The resolve kernel writing `layers` (RESOLVE_*), built on first use.
+  VkPipeline resolve_pipeline(std::uint32_t layers);
 
   // Declaration order is destruction order in reverse: everything made from
   // the device goes before it, and the device before the instance.
@@ -213,7 +215,8 @@ struct GpuTracer::Impl {
   vk::UniquePipelineLayout pipeline_layout;
   // trace.comp by KERNEL_FEATURES (layout.h): a scene uses one or two.
   std::map<std::uint32_t, vk::UniquePipeline> trace_pipelines;
-  vk::UniquePipeline resolve;
+  // resolve.comp by RESOLVE_LAYERS (layout.h).
+  std::map<std::uint32_t, vk::UniquePipeline> resolve_pipelines;
   vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
   vk::UniquePipeline adaptive_shares;
@@ -249,8 +252,6 @@ GpuTracer::Impl::Impl(const std::string &wanted)
     : device(vk::choose_device(instance.compute_devices(), wanted)),
       descriptors(device, binding_types()),
       pipeline_layout(vk::make_pipeline_layout(device, descriptors.layout())),
-      resolve(vk::make_compute_pipeline(
-          device, {.layout = pipeline_layout.get(), .spirv = resolve_spv, .name = "resolve.comp"})),
       adaptive_weights(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                           .spirv = adaptive_weights_spv,
                                                           .name = "adaptive_weights.comp",
@@ -414,6 +415,17 @@ VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame) {
   return pipeline.get();
 }
 
+VkPipeline GpuTracer::Impl::resolve_pipeline(std::uint32_t layers) {
+  vk::UniquePipeline &pipeline = resolve_pipelines[layers];
+  const std::array<std::uint32_t, 2> constants = {KERNEL_ALL, layers};
+  if (pipeline.get() == VK_NULL_HANDLE)
+    pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                  .spirv = resolve_spv,
+                                                  .name = "resolve.comp",
+                                                  .constants = constants});
+  return pipeline.get();
+}
+
 void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
   vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   const VkDescriptorSet set = descriptors.get();
@@ -523,8 +535,16 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   // Its last: the resolve kernel (which reads sampling.z and tracing.y alone,
   // so it shares the last batch's uniform and submission), the copies to the
   // read-back buffer and the second timestamp.
+  std::uint32_t layers = 0;
+  layers |=
+      selection.composite || video_outputs > 0 ? RESOLVE_COMPOSITE : 0u; // video_encode reads it
+  layers |= selection.mixed ? RESOLVE_MIXED : 0u;
+  layers |= selection.real ? RESOLVE_REAL : 0u;
+  layers |= selection.mask_and_depth ? RESOLVE_MASK_AND_DEPTH : 0u;
+  layers |= selection.display ? RESOLVE_DISPLAY : 0u;
+  const VkPipeline resolve = resolve_pipeline(layers);
   const auto end_frame = [&](VkCommandBuffer command_buffer) {
-    dispatch(command_buffer, resolve.get());
+    dispatch(command_buffer, resolve);
     if (video_outputs > 0) {
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
