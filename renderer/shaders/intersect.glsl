@@ -130,16 +130,43 @@ Hit closest_hit(Ray ray, float t_min, float t_max, bool real_only) {
   vec3 inv_dir = safe_reciprocal(ray.dir);
   uint stack[CAMHEAD_STACK_SIZE];
   int top = 0;
-  uint node_index = 0u;
-  BvhNode root = node_at(0u);
-  if (box_entry(ray.origin, inv_dir, root.bmin, root.bmax, t_best) == CAMHEAD_NO_HIT) {
+  BvhNode node = node_at(0u);
+  if (box_entry(ray.origin, inv_dir, node.bmin, node.bmax, t_best) == CAMHEAD_NO_HIT) {
     return hit;
   }
+  // Each round takes the ray down through interior nodes, nearer child
+  // first, to a leaf (or a dead end), tests the leaf and pops the next
+  // subtree. In separate loops a SIMD executor runs an interior step
+  // without a masked leaf test and pop beside it (bench/RESULTS.md).
   for (;;) {
-    BvhNode node = node_at(node_index);
-    uint count = floatBitsToUint(node.bmax.w);
-    uint first = floatBitsToUint(node.bmin.w);
-    if (count > 0u) {
+    bool dead_end = false;
+    if (floatBitsToUint(node.bmax.w) == 0u) {
+      do {
+        uint left = floatBitsToUint(node.bmin.w);
+        uint right = left + 1u;
+        BvhNode left_node = node_at(left);
+        BvhNode right_node = node_at(right);
+        float t_left = box_entry(ray.origin, inv_dir, left_node.bmin, left_node.bmax, t_best);
+        float t_right = box_entry(ray.origin, inv_dir, right_node.bmin, right_node.bmax, t_best);
+        if (t_left != CAMHEAD_NO_HIT && t_right != CAMHEAD_NO_HIT) {
+          bool left_first = t_left <= t_right;
+          if (top < CAMHEAD_STACK_SIZE) {
+            stack[top] = left_first ? right : left;
+            ++top;
+          }
+          node = left_first ? left_node : right_node;
+        } else if (t_left != CAMHEAD_NO_HIT) {
+          node = left_node;
+        } else if (t_right != CAMHEAD_NO_HIT) {
+          node = right_node;
+        } else {
+          dead_end = true;
+        }
+      } while (!dead_end && floatBitsToUint(node.bmax.w) == 0u);
+    }
+    if (!dead_end) {
+      uint first = floatBitsToUint(node.bmin.w);
+      uint count = floatBitsToUint(node.bmax.w);
       uint i = first;
       do {
         Primitive prim = primitive_at(i);
@@ -152,40 +179,14 @@ Hit closest_hit(Ray ray, float t_min, float t_max, bool real_only) {
           }
         }
       } while (++i < first + count);
-    } else {
-      // Visit the nearer child first; the farther one waits on the stack.
-      uint left = first;
-      uint right = first + 1u;
-      BvhNode left_node = node_at(left);
-      BvhNode right_node = node_at(right);
-      float t_left = box_entry(ray.origin, inv_dir, left_node.bmin, left_node.bmax, t_best);
-      float t_right = box_entry(ray.origin, inv_dir, right_node.bmin, right_node.bmax, t_best);
-      if (t_left != CAMHEAD_NO_HIT && t_right != CAMHEAD_NO_HIT) {
-        bool left_first = t_left <= t_right;
-        if (top < CAMHEAD_STACK_SIZE) {
-          stack[top] = left_first ? right : left;
-          ++top;
-        }
-        node_index = left_first ? left : right;
-        continue;
-      }
-      if (t_left != CAMHEAD_NO_HIT) {
-        node_index = left;
-        continue;
-      }
-      if (t_right != CAMHEAD_NO_HIT) {
-        node_index = right;
-        continue;
-      }
     }
     // Pop, skipping subtrees that now start beyond the best hit.
     bool found = false;
     if (top > 0) {
       do {
         --top;
-        node_index = stack[top];
-        BvhNode popped = node_at(node_index);
-        found = box_entry(ray.origin, inv_dir, popped.bmin, popped.bmax, t_best) != CAMHEAD_NO_HIT;
+        node = node_at(stack[top]);
+        found = box_entry(ray.origin, inv_dir, node.bmin, node.bmax, t_best) != CAMHEAD_NO_HIT;
       } while (top > 0 && !found);
     }
     if (!found) {
@@ -205,42 +206,63 @@ uint shadow_query(Ray ray, float t_min, float t_max, bool real_only, bool stop_a
   vec3 inv_dir = safe_reciprocal(ray.dir);
   uint stack[CAMHEAD_STACK_SIZE];
   int top = 0;
-  stack[top] = 0u;
-  ++top;
-  do {
-    --top;
-    BvhNode node = node_at(stack[top]);
-    if (box_entry(ray.origin, inv_dir, node.bmin, node.bmax, t_max) == CAMHEAD_NO_HIT) {
-      continue;
-    }
-    uint count = floatBitsToUint(node.bmax.w);
-    uint first = floatBitsToUint(node.bmin.w);
-    if (count == 0u) {
-      if (top + 2 <= CAMHEAD_STACK_SIZE) {
-        stack[top] = first + 1u;
-        stack[top + 1] = first;
-        top += 2;
-      }
-      continue;
-    }
-    uint i = first;
-    do {
-      Primitive prim = primitive_at(i);
-      bool real = prim_is_real(prim);
-      if (real_only && !real) {
-        continue;
-      }
-      if ((occluded & OCCLUDED_BY_VIRTUAL) != 0u && !real) {
-        continue; // already known; only a real blocker can add information
-      }
-      if (intersect_primitive(ray, prim, t_min, t_max) != CAMHEAD_NO_HIT) {
-        occluded |= real ? OCCLUDED_BY_REAL : OCCLUDED_BY_VIRTUAL;
-        if (real || stop_at_any) {
-          return occluded;
+  BvhNode node = node_at(0u);
+  if (box_entry(ray.origin, inv_dir, node.bmin, node.bmax, t_max) == CAMHEAD_NO_HIT) {
+    return occluded;
+  }
+  // In rounds as closest_hit: down to a leaf, its primitives, a pop.
+  for (;;) {
+    bool dead_end = false;
+    if (floatBitsToUint(node.bmax.w) == 0u) {
+      do {
+        uint left = floatBitsToUint(node.bmin.w);
+        uint right = left + 1u;
+        BvhNode left_node = node_at(left);
+        BvhNode right_node = node_at(right);
+        bool enters_left =
+            box_entry(ray.origin, inv_dir, left_node.bmin, left_node.bmax, t_max) != CAMHEAD_NO_HIT;
+        bool enters_right = box_entry(ray.origin, inv_dir, right_node.bmin, right_node.bmax,
+                                      t_max) != CAMHEAD_NO_HIT;
+        if (enters_left && enters_right && top < CAMHEAD_STACK_SIZE) {
+          stack[top] = right;
+          ++top;
         }
-      }
-    } while (++i < first + count);
-  } while (top > 0);
+        if (enters_left) {
+          node = left_node;
+        } else if (enters_right) {
+          node = right_node;
+        } else {
+          dead_end = true;
+        }
+      } while (!dead_end && floatBitsToUint(node.bmax.w) == 0u);
+    }
+    if (!dead_end) {
+      uint first = floatBitsToUint(node.bmin.w);
+      uint count = floatBitsToUint(node.bmax.w);
+      uint i = first;
+      do {
+        Primitive prim = primitive_at(i);
+        bool real = prim_is_real(prim);
+        if (real_only && !real) {
+          continue;
+        }
+        if ((occluded & OCCLUDED_BY_VIRTUAL) != 0u && !real) {
+          continue; // already known; only a real blocker can add information
+        }
+        if (intersect_primitive(ray, prim, t_min, t_max) != CAMHEAD_NO_HIT) {
+          occluded |= real ? OCCLUDED_BY_REAL : OCCLUDED_BY_VIRTUAL;
+          if (real || stop_at_any) {
+            return occluded;
+          }
+        }
+      } while (++i < first + count);
+    }
+    if (top == 0) {
+      break;
+    }
+    --top;
+    node = node_at(stack[top]);
+  }
   return occluded;
 }
 
