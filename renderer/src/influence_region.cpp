@@ -270,7 +270,7 @@ public:
       const bool reachable =
           x_lo <= reach_x && x_hi >= -reach_x && y_lo <= reach_y && y_hi >= -reach_y;
       if (reachable) {
-        mark(0.0, double(width_), 0.0, double(height_));
+        mark_everywhere();
         return;
       }
     }
@@ -295,7 +295,7 @@ public:
       }
     });
     if (!finite) {
-      mark(0.0, double(width_), 0.0, double(height_)); // unknown: everywhere
+      mark_everywhere(); // unknown
       return;
     }
     mark_polygon(convex_hull(std::move(points)));
@@ -304,29 +304,12 @@ public:
   [[nodiscard]] InfluenceRegion region() const;
 
 private:
-  // Marks the tiles of the pixels whose samples (the pixel's centre within
-  // half the filter width) can fall in [u_lo, u_hi] x [v_lo, v_hi], image
-  // coordinates; one pixel more on each side for the rays' rounding.
-  void mark(double u_lo, double u_hi, double v_lo, double v_hi) {
-    const double reach = kReachPx + 0.5 * filter_px_;
-    const auto first = [&](double lo) { return std::floor(lo - 0.5 - reach); };
-    const auto last = [&](double hi) { return std::ceil(hi - 0.5 + reach); };
-    const double x0 = std::max(0.0, first(u_lo)), x1 = std::min(double(width_) - 1, last(u_hi));
-    const double y0 = std::max(0.0, first(v_lo)), y1 = std::min(double(height_) - 1, last(v_hi));
-    if (std::isnan(u_lo) || std::isnan(u_hi) || std::isnan(v_lo) || std::isnan(v_hi)) {
-      mark(0.0, double(width_), 0.0, double(height_)); // unknown: everywhere
-      return;
-    }
-    if (!(x0 <= x1) || !(y0 <= y1))
-      return; // off the frame
-    for (auto ty = std::uint32_t(y0) / CAMHEAD_TILE_Y; ty <= std::uint32_t(y1) / CAMHEAD_TILE_Y;
-         ++ty)
-      for (auto tx = std::uint32_t(x0) / CAMHEAD_TILE_X; tx <= std::uint32_t(x1) / CAMHEAD_TILE_X;
-           ++tx)
-        marked_[std::size_t(ty) * tiles_x_ + tx] = 1;
-  }
+  // Marks every tile: where a piece's image is not known.
+  void mark_everywhere() { std::fill(marked_.begin(), marked_.end(), std::uint8_t(1)); }
 
-  // The same for a convex polygon (image coordinates, in order), a row of
+  // Marks the tiles of the pixels whose samples (the pixel's centre within
+  // half the filter width, and one pixel more for the rays' rounding) can
+  // fall in a convex polygon (image coordinates, in order), a row of
   // tiles at a time: its x-range within the row's band of sample positions.
   void mark_polygon(const std::vector<Point> &hull) {
     if (hull.empty())
