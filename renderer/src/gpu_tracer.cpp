@@ -431,16 +431,6 @@ void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline
   const VkDescriptorSet set = descriptors.get();
   vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
                           1, &set, 0, nullptr);
-  // The whole frame by a plain dispatch: lavapipe (Mesa 22.3.6) traced
-  // light_transport_test's glass ball 8 % too dark through
-  // vkCmdDispatchBase even with a zero base (as with the video bindings,
-  // buffers.glsl; the cause is not known). A region's dispatches give the
-  // same composite as the whole frame's (influence_region_test.cpp).
-  if (frame_region.whole_frame()) {
-    vkCmdDispatch(command_buffer, (width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
-                  (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y, 1);
-    return;
-  }
   for (const PixelRect &rect : frame_region.rects)
     vkCmdDispatchBase(command_buffer, rect.x0 / CAMHEAD_TILE_X, rect.y0 / CAMHEAD_TILE_Y, 0,
                       (rect.x1 - rect.x0 + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
