@@ -19,8 +19,12 @@ const std::string kPrimarySuffix = "_primary";
 
 } // namespace
 
+fs::path source_dir() {
+  return dir_from("CAMHEAD_SOURCE_DIR", CAMHEAD_SOURCE_DIR);
+}
+
 std::vector<BenchScene> bench_scenes() {
-  const fs::path source = dir_from("CAMHEAD_SOURCE_DIR", CAMHEAD_SOURCE_DIR);
+  const fs::path source = source_dir();
   const fs::path basic = source / "tests" / "assets" / "reference" / "ar_basic.json";
   const fs::path demo = source / "scenes" / "ar_demo.json";
   return {{"ar_basic", basic, false},

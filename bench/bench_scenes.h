@@ -19,9 +19,11 @@ struct BenchScene {
   bool primary_only = false;
 };
 
-// ar_basic, ar_demo and their primary-only variants, in the source tree: the
-// CAMHEAD_SOURCE_DIR environment variable if set, else the one the build was
-// configured from.
+// The source tree: the CAMHEAD_SOURCE_DIR environment variable if set, else
+// the one the build was configured from.
+[[nodiscard]] std::filesystem::path source_dir();
+
+// ar_basic, ar_demo and their primary-only variants, in source_dir().
 [[nodiscard]] std::vector<BenchScene> bench_scenes();
 [[nodiscard]] BenchScene find_bench_scene(const std::string &name_or_file);
 

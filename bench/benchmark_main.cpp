@@ -71,6 +71,7 @@ int main(int argc, char **argv) {
   const camhead::renderer::GpuTracer *gpu = BenchCache::get().gpu(error);
   benchmark::AddCustomContext("vulkan_device", gpu ? gpu->device_name() : "none: " + error);
   register_frame_benchmarks();
+  register_live_frame_benchmarks();
   register_micro_benchmarks();
   benchmark::RunSpecifiedBenchmarks();
   BenchCache::get().release_gpu();

@@ -393,8 +393,10 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
   float weight = 1.0f;
   // One sample for all where none can differ. A shorter loop rather than a
   // second path: SIMD executors (lavapipe) run a branch's both sides but a
-  // loop only as long as its longest lane.
-  if (KERNEL_HAS(KERNEL_SKIP_EMPTY_PIXELS) && first < end &&
+  // loop only as long as its longest lane. A pixel of one sample has none to
+  // save, and the test would cost a fifth of a live 1-rpp frame
+  // (bench/RESULTS.md).
+  if (KERNEL_HAS(KERNEL_SKIP_EMPTY_PIXELS) && first + 1u < end &&
       (frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u && pixel_misses_scene(x, y)) {
     weight = float(end - first);
     end = first + 1u;

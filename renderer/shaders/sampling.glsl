@@ -68,6 +68,12 @@ float cmj_randfloat(uint i, uint p) {
 
 // Sample s of n of a 2-D stratified pattern p in [0, 1)^2.
 vec2 cmj_sample(uint s, uint n, uint p) {
+  // One sample: its one cell is the square, and the general case below
+  // gives the jitter alone, bit for bit, through six permutations and
+  // divisions that cost a fifth of a live 1-rpp frame on a CPU.
+  if (n == 1u) {
+    return vec2(cmj_randfloat(0u, p * 0x967a889bu), cmj_randfloat(0u, p * 0x368cc8b7u));
+  }
   uint m = uint(sqrt(float(n)));
   if ((m + 1u) * (m + 1u) <= n) { // guard float rounding of sqrt
     m += 1u;
