@@ -175,6 +175,11 @@ struct AdaptiveSolution {
 #define VIDEO_BGR24 3u
 #define VIDEO_XRGB8888 4u
 #define VIDEO_MAX_OUTPUTS 4
+// The video kernels' workgroup: VIDEO_LOCAL_SIZE^2 invocations of a 4 x 2
+// pixel block each, VIDEO_GROUP_X x VIDEO_GROUP_Y pixels.
+#define VIDEO_LOCAL_SIZE 8
+#define VIDEO_GROUP_X 32u
+#define VIDEO_GROUP_Y 16u
 
 // One video frame in BINDING_VIDEO_IN or _OUT.
 //   format: x VIDEO_*, y VIDEO_MATRIX_*, z VIDEO_RANGE_* (video.glsl), w the

@@ -7,7 +7,7 @@
 #include "buffers.glsl"
 #include "video.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = VIDEO_LOCAL_SIZE, local_size_y = VIDEO_LOCAL_SIZE) in;
 
 uint byte_in(uint first_word, uint offset) {
   return (video_in[first_word + offset / 4u] >> (8u * (offset % 4u))) & 0xffu;

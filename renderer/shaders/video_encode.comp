@@ -8,7 +8,7 @@
 #include "buffers.glsl"
 #include "video.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = VIDEO_LOCAL_SIZE, local_size_y = VIDEO_LOCAL_SIZE) in;
 
 uint pack4(uint a, uint b, uint c, uint d) {
   return a | (b << 8u) | (c << 16u) | (d << 24u);

@@ -168,12 +168,6 @@ private:
     return scene;
   }
 
-  // The same pixels in the same bytes, whatever the rows' padding.
-  static bool same_pixels(base::VideoFormat a, base::VideoFormat b) {
-    a.stride = b.stride = 0;
-    return a == b;
-  }
-
   // Rows of every plane (nv12's chroma rows after the luma rows).
   static int copied_rows(const base::VideoFormat &f) {
     return f.height + (f.pixel == base::PixelFormat::nv12 ? f.height / 2 : 0);

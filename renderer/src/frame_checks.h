@@ -38,6 +38,14 @@ check_frames(const VideoFrame &plate, std::span<const VideoBuffer> outputs, int 
   return {};
 }
 
+// The same pixels in the same bytes, whatever the rows' padding: an output
+// in the camera frame's own format, which outside the influence region takes
+// the camera's bytes as they are.
+[[nodiscard]] inline bool same_pixels(base::VideoFormat a, base::VideoFormat b) {
+  a.stride = b.stride = 0;
+  return a == b;
+}
+
 [[nodiscard]] inline FrameReport bad_frame(std::string detail) {
   FrameReport report;
   report.status = FrameStatus::bad_input;

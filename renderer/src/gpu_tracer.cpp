@@ -14,12 +14,14 @@
 #include <map>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "adaptive_shares_spv.h"
 #include "adaptive_solve_spv.h"
 #include "adaptive_weights_spv.h"
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/bvh.h"
+#include "frame_checks.h"
 #include "resolve_spv.h"
 #include "trace_spv.h"
 #include "video_decode_spv.h"
@@ -150,6 +152,51 @@ void copy_rows(const std::uint8_t *from, std::size_t from_stride, std::uint8_t *
     std::memcpy(to + y * to_stride, from + y * from_stride, row);
 }
 
+// The bytes of `rects` alone, as copy_rows copies all of them. The rects are
+// whole tiles (influence_region.h): even rows and columns, so no 4:2:2 pixel
+// pair or 4:2:0 chroma sample straddles an edge.
+void copy_rects(const std::uint8_t *from, std::size_t from_stride, std::uint8_t *to,
+                std::size_t to_stride, const base::VideoFormat &f,
+                std::span<const PixelRect> rects) {
+  const std::size_t pixel_bytes = base::packed_stride(f.pixel, 2) / 2; // NV12: its luma
+  const std::size_t chroma_row = f.pixel == base::PixelFormat::nv12 ? std::size_t(f.height) : 0;
+  const auto copy = [&](std::size_t row, std::size_t x0, std::size_t x1) {
+    std::memcpy(to + row * to_stride + x0 * pixel_bytes,
+                from + row * from_stride + x0 * pixel_bytes, (x1 - x0) * pixel_bytes);
+  };
+  for (const PixelRect &rect : rects)
+    for (std::uint32_t y = rect.y0; y < rect.y1; ++y) {
+      copy(y, rect.x0, rect.x1);
+      if (chroma_row != 0 && y % 2 == 0) // a Cb Cr pair per luma pair, a row per two
+        copy(chroma_row + y / 2, rect.x0, rect.x1);
+    }
+}
+
+// A run of the video kernels' workgroups (VIDEO_GROUP_X x VIDEO_GROUP_Y
+// pixels) along a row of them.
+struct GroupRun {
+  std::uint32_t x = 0, y = 0, count = 0;
+};
+
+// The video kernels' workgroups that `region` touches, each once, as runs.
+void video_group_runs(const InfluenceRegion &region, glm::uvec2 groups, std::vector<GroupRun> &runs,
+                      std::vector<glm::uvec2> &spans) {
+  runs.clear();
+  for (std::uint32_t gy = 0; gy < groups.y; ++gy) {
+    spans.clear();
+    const std::uint32_t y0 = gy * VIDEO_GROUP_Y;
+    for (const PixelRect &rect : region.rects)
+      if (rect.y0 < y0 + VIDEO_GROUP_Y && rect.y1 > y0)
+        spans.emplace_back(rect.x0 / VIDEO_GROUP_X, (rect.x1 + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X);
+    std::sort(spans.begin(), spans.end(), [](glm::uvec2 a, glm::uvec2 b) { return a.x < b.x; });
+    for (const glm::uvec2 span : spans)
+      if (!runs.empty() && runs.back().y == gy && runs.back().x + runs.back().count >= span.x)
+        runs.back().count = std::max(runs.back().count, span.y - runs.back().x);
+      else
+        runs.push_back({span.x, gy, span.y - span.x});
+  }
+}
+
 } // namespace
 
 std::string format_gpu_devices(const std::vector<GpuDeviceInfo> &devices) {
@@ -202,6 +249,10 @@ struct GpuTracer::Impl {
   // Dispatches `pipeline` (made with dispatch_base) over the tiles of the
   // frame's region.
   void dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
+  // Dispatches a video kernel over the whole frame, or over video_runs, with
+  // `frames` layers of workgroups (one per output).
+  void dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline, std::uint32_t frames,
+                      bool region_only) const;
   // The trace kernel built for the loaded scene and `frame`, built on first use.
   VkPipeline trace_pipeline(const gpu::FrameParams &frame);
   // The resolve kernel writing `layers` (RESOLVE_*), built on first use.
@@ -237,7 +288,6 @@ struct GpuTracer::Impl {
   std::uint32_t width = 0;
   std::uint32_t height = 0;
   bool has_plate = false;
-  glm::uvec2 video_blocks{0};                // 4 x 2 pixel blocks of the video kernels
   gpu::uvec4 counts{};                       // primitives, nodes, lights
   glm::vec3 origin{0.0f};                    // CompiledScene::origin of the loaded scene
   std::uint32_t scene_features = KERNEL_ALL; // scene_kernel_features of the loaded scene
@@ -246,6 +296,10 @@ struct GpuTracer::Impl {
   BatchSizer second_pass_sizer;
   // The current frame's tiles to trace (influence_region.h).
   InfluenceRegion frame_region;
+  // ... and the video kernels' workgroups that cover them (kept for their
+  // capacity: a live frame allocates nothing).
+  std::vector<GroupRun> video_runs;
+  std::vector<glm::uvec2> video_spans;
 };
 
 GpuTracer::Impl::Impl(const std::string &wanted)
@@ -265,10 +319,12 @@ GpuTracer::Impl::Impl(const std::string &wanted)
                                                          .dispatch_base = true})),
       video_decode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                       .spirv = video_decode_spv,
-                                                      .name = "video_decode.comp"})),
+                                                      .name = "video_decode.comp",
+                                                      .dispatch_base = true})),
       video_encode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                       .spirv = video_encode_spv,
-                                                      .name = "video_encode.comp"})),
+                                                      .name = "video_encode.comp",
+                                                      .dispatch_base = true})),
       commands(device), frame_uniform(device, {.size = sizeof(gpu::FrameParams),
                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                                .memory = vk::MemoryUse::upload,
@@ -391,7 +447,6 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   width = std::uint32_t(scene.width);
   height = std::uint32_t(scene.height);
   has_plate = !scene.plate.empty();
-  video_blocks = glm::uvec2((width + 3) / 4, (height + 1) / 2);
   counts = gpu::uvec4(scene.primitives.size(), scene.nodes.size(), scene.lights.size(), 0);
   origin = scene.origin;
   scene_features = scene_kernel_features(scene);
@@ -422,6 +477,7 @@ VkPipeline GpuTracer::Impl::resolve_pipeline(std::uint32_t layers) {
     pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                   .spirv = resolve_spv,
                                                   .name = "resolve.comp",
+                                                  .dispatch_base = true,
                                                   .constants = constants});
   return pipeline.get();
 }
@@ -435,6 +491,21 @@ void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline
     vkCmdDispatchBase(command_buffer, rect.x0 / CAMHEAD_TILE_X, rect.y0 / CAMHEAD_TILE_Y, 0,
                       (rect.x1 - rect.x0 + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
                       (rect.y1 - rect.y0 + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y, 1);
+}
+
+void GpuTracer::Impl::dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline,
+                                     std::uint32_t frames, bool region_only) const {
+  vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  const VkDescriptorSet set = descriptors.get();
+  vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
+                          1, &set, 0, nullptr);
+  if (!region_only) {
+    vkCmdDispatch(command_buffer, (width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
+                  (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y, frames);
+    return;
+  }
+  for (const GroupRun &run : video_runs)
+    vkCmdDispatchBase(command_buffer, run.x, run.y, 0, run.count, 1, frames);
 }
 
 void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
@@ -499,7 +570,20 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
     std::memcpy(video_uniform.mapped(), &params, sizeof params);
     frame.image.z = decode_plate ? 1u : 0u;
   }
-  const glm::uvec2 video_groups((video_blocks.x + 7) / 8, (video_blocks.y + 7) / 8);
+  // Outputs in the camera frame's own format take its bytes outside the
+  // region (they are the composite there, bit for bit: frame_renderer_test),
+  // so the video kernels and the resolve need only run over the region; the
+  // layers, which the region leaves stale outside it, are not read.
+  bool region_video = decode_plate && video_outputs > 0 && !frame_region.whole_frame() &&
+                      !selection.composite && !selection.mixed && !selection.real &&
+                      !selection.mask_and_depth && !selection.display;
+  for (std::size_t k = 0; k < video_outputs; ++k)
+    region_video = region_video && same_pixels(video->outputs[k].format, video->plate.format);
+  if (region_video)
+    video_group_runs(frame_region,
+                     glm::uvec2((width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
+                                (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y),
+                     video_runs, video_spans);
 
   // Where the read-back buffer holds what comes back.
   const VkDeviceSize layer_bytes = buffers[BINDING_OUT_AUX].size();
@@ -516,7 +600,7 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
     timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
     record_clear(command_buffer);
     if (decode_plate) {
-      dispatch(command_buffer, video_decode.get(), video_groups);
+      dispatch_video(command_buffer, video_decode.get(), 1, region_video);
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_READ_BIT);
@@ -534,16 +618,16 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   layers |= selection.display ? RESOLVE_DISPLAY : 0u;
   const VkPipeline resolve = resolve_pipeline(layers);
   const auto end_frame = [&](VkCommandBuffer command_buffer) {
-    dispatch(command_buffer, resolve);
+    if (region_video)
+      dispatch_region(command_buffer, resolve);
+    else
+      dispatch(command_buffer, resolve);
     if (video_outputs > 0) {
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_READ_BIT);
-      vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, video_encode.get());
-      const VkDescriptorSet set = descriptors.get();
-      vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(),
-                              0, 1, &set, 0, nullptr);
-      vkCmdDispatch(command_buffer, video_groups.x, video_groups.y, std::uint32_t(video_outputs));
+      dispatch_video(command_buffer, video_encode.get(), std::uint32_t(video_outputs),
+                     region_video);
     }
     vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
@@ -645,9 +729,16 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   }
   for (std::size_t k = 0; k < video_outputs; ++k) {
     const VideoBuffer &out = video->outputs[k];
-    copy_rows(mapped + video_offset + k * video_slot_bytes,
-              base::packed_stride(out.format.pixel, out.format.width), out.bytes.data(),
-              base::row_bytes(out.format), out.format);
+    const std::uint8_t *encoded = mapped + video_offset + k * video_slot_bytes;
+    const std::size_t encoded_stride = base::packed_stride(out.format.pixel, out.format.width);
+    if (region_video) {
+      copy_rows(video->plate.bytes.data(), base::row_bytes(video->plate.format), out.bytes.data(),
+                base::row_bytes(out.format), out.format);
+      copy_rects(encoded, encoded_stride, out.bytes.data(), base::row_bytes(out.format), out.format,
+                 frame_region.rects);
+    } else {
+      copy_rows(encoded, encoded_stride, out.bytes.data(), base::row_bytes(out.format), out.format);
+    }
   }
   timings.unpack_s = seconds_since(unpacking);
   result.timings = timings;

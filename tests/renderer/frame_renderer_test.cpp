@@ -201,10 +201,11 @@ TEST_P(FramePassThrough, OnlyWhatTheVirtualObjectTouchesChanges) {
 }
 
 // The influence region (influence_region.h) changes the cost, not the
-// video: every byte of every output as when every pixel is traced, for an
-// output in the camera's format (which takes the camera's bytes outside the
-// region) and outputs in others (converted everywhere), with a shadow and a
-// mirror in the scene.
+// video: every byte of every output as when every pixel is traced, for
+// outputs in the camera's format (which take the camera's bytes outside the
+// region: 4:2:2, 4:2:0 with its chroma plane, 3-byte pixels, padded rows) and
+// in another (converted everywhere), alone and beside a YUYV output, with a
+// shadow and a mirror in the scene.
 TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
   const int w = 96, h = 64;
   Scene scene = scene_with_ball(w, h, {-0.6f, 0.1f, -2.5f});
@@ -220,35 +221,42 @@ TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
   auto renderer = make_renderer(GetParam(), scene);
   if (!renderer)
     GTEST_SKIP() << "no Vulkan device";
-  const VideoFormat in = format(PixelFormat::yuyv, w, h);
-  const std::vector<std::uint8_t> plate = noise_frame(in, 11);
-  for (const PixelFormat pixel : {PixelFormat::yuyv, PixelFormat::nv12, PixelFormat::xrgb8888}) {
-    const auto frame = [&](bool region, bool alone) {
-      // Alone: the output in the camera's format is the only one.
-      std::vector<VideoFormat> formats = {format(pixel, w, h)};
-      if (!alone)
-        formats.push_back(format(PixelFormat::yuyv, w, h));
-      std::vector<std::vector<std::uint8_t>> bytes;
-      std::vector<VideoBuffer> targets;
-      for (const VideoFormat &f : formats)
-        bytes.emplace_back(base::frame_bytes(f), 0xAB);
-      for (std::size_t i = 0; i < formats.size(); ++i)
-        targets.push_back({formats[i], bytes[i]});
-      FrameRequest request;
-      request.camera = scene_camera(scene);
-      request.rays_per_pixel = 4;
-      request.influence_region = region;
-      const FrameReport report = renderer->render(request, {in, plate}, targets);
-      EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
-      if (region)
-        EXPECT_LT(report.traced_pixels, report.frame_pixels);
-      else
-        EXPECT_EQ(report.traced_pixels, report.frame_pixels);
-      return bytes;
-    };
-    for (const bool alone : {true, false})
-      EXPECT_TRUE(frame(true, alone) == frame(false, alone))
-          << base::pixel_format_name(pixel) << (alone ? " alone" : " beside yuyv");
+  VideoFormat padded = format(PixelFormat::yuyv, w, h);
+  padded.stride = 2 * w + 24;
+  for (const VideoFormat &in : {format(PixelFormat::yuyv, w, h), format(PixelFormat::nv12, w, h),
+                                format(PixelFormat::rgb24, w, h, base::ColorRange::full), padded}) {
+    const std::vector<std::uint8_t> plate = noise_frame(in, 11);
+    VideoFormat converted = format(PixelFormat::xrgb8888, w, h, base::ColorRange::full);
+    if (in.pixel == PixelFormat::yuyv)
+      converted = format(PixelFormat::nv12, w, h); // the camera's own beside it below
+    for (const VideoFormat &out : {in, converted}) {
+      const auto frame = [&](bool region, bool alone) {
+        std::vector<VideoFormat> formats = {out};
+        if (!alone)
+          formats.push_back(format(PixelFormat::yuyv, w, h));
+        std::vector<std::vector<std::uint8_t>> bytes;
+        std::vector<VideoBuffer> targets;
+        for (const VideoFormat &f : formats)
+          bytes.emplace_back(base::frame_bytes(f), 0xAB);
+        for (std::size_t i = 0; i < formats.size(); ++i)
+          targets.push_back({formats[i], bytes[i]});
+        FrameRequest request;
+        request.camera = scene_camera(scene);
+        request.rays_per_pixel = 4;
+        request.influence_region = region;
+        const FrameReport report = renderer->render(request, {in, plate}, targets);
+        EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
+        if (region)
+          EXPECT_LT(report.traced_pixels, report.frame_pixels);
+        else
+          EXPECT_EQ(report.traced_pixels, report.frame_pixels);
+        return bytes;
+      };
+      for (const bool alone : {true, false})
+        EXPECT_TRUE(frame(true, alone) == frame(false, alone))
+            << base::describe(in) << " in, " << base::describe(out) << " out"
+            << (alone ? " alone" : " beside yuyv");
+    }
   }
 }
 
