@@ -70,7 +70,7 @@ float cmj_randfloat(uint i, uint p) {
 vec2 cmj_sample(uint s, uint n, uint p) {
   // One sample: its one cell is the square, and the general case below
   // gives the jitter alone, bit for bit, through six permutations and
-  // divisions that cost a fifth of a live 1-rpp frame on a CPU.
+  // divisions that cost over a tenth of a live 1-rpp frame on a CPU.
   if (n == 1u) {
     return vec2(cmj_randfloat(0u, p * 0x967a889bu), cmj_randfloat(0u, p * 0x368cc8b7u));
   }

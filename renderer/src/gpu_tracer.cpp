@@ -243,6 +243,8 @@ struct GpuTracer::Impl {
   // pilot, over the frame's region: sample_counts (0 outside the region) and
   // the adaptive solution, ordered before the kernels.
   void record_allocation(VkCommandBuffer command_buffer) const;
+  // Binds `pipeline` and the descriptor set every kernel shares.
+  void bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
   // Dispatches `pipeline` over the image's tiles, or over `groups`.
   void dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
                 std::optional<glm::uvec2> groups = std::nullopt) const;
@@ -482,11 +484,15 @@ VkPipeline GpuTracer::Impl::resolve_pipeline(std::uint32_t layers) {
   return pipeline.get();
 }
 
-void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
+void GpuTracer::Impl::bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
   vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   const VkDescriptorSet set = descriptors.get();
   vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
                           1, &set, 0, nullptr);
+}
+
+void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
+  bind(command_buffer, pipeline);
   for (const PixelRect &rect : frame_region.rects)
     vkCmdDispatchBase(command_buffer, rect.x0 / CAMHEAD_TILE_X, rect.y0 / CAMHEAD_TILE_Y, 0,
                       (rect.x1 - rect.x0 + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
@@ -495,10 +501,7 @@ void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline
 
 void GpuTracer::Impl::dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline,
                                      std::uint32_t frames, bool region_only) const {
-  vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-  const VkDescriptorSet set = descriptors.get();
-  vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
-                          1, &set, 0, nullptr);
+  bind(command_buffer, pipeline);
   if (!region_only) {
     vkCmdDispatch(command_buffer, (width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
                   (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y, frames);
@@ -510,10 +513,7 @@ void GpuTracer::Impl::dispatch_video(VkCommandBuffer command_buffer, VkPipeline 
 
 void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
                                std::optional<glm::uvec2> groups) const {
-  vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-  const VkDescriptorSet set = descriptors.get();
-  vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0,
-                          1, &set, 0, nullptr);
+  bind(command_buffer, pipeline);
   const glm::uvec2 count =
       groups.value_or(glm::uvec2((width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
                                  (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y));
