@@ -1,9 +1,11 @@
 #version 450
-// Adaptive allocation, step 3 of 3 (adaptive.glsl): each pixel's share into
-// sample_counts, and the 64-bit total of the shares.
+// Adaptive allocation, step 3 of 5 (adaptive.glsl): each pixel's share into
+// sample_counts, the 64-bit total of the shares, and the pixels with samples
+// left after the pilot counted by bin of their share (sample_queue.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "buffers.glsl"
 #include "adaptive.glsl"
+#include "sample_queue.glsl"
 
 layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
 
@@ -19,6 +21,10 @@ void main() {
     samples = adaptive_share(adaptive_weights[i], i, solution.x, solution.y,
                              float(frame.tracing.y), frame.adaptive.y);
     sample_counts[i] = samples;
+    uint pilot = frame.tracing.y;
+    if (samples > pilot) {
+      atomicAdd(queue_bins[QUEUE_COUNTS + queue_bin(samples - pilot)], 1u);
+    }
   }
   uint t = gl_LocalInvocationIndex;
   tile_samples[t] = samples;

@@ -1,5 +1,5 @@
 #version 450
-// Adaptive allocation, step 2 of 3 (adaptive.glsl): the floor weight from the
+// Adaptive allocation, step 2 of 5 (adaptive.glsl): the floor weight from the
 // tiles' luminance, and the water level lambda by bisection on the histogram.
 // One workgroup; every invocation takes every ADAPTIVE_SOLVE_THREADS-th bin.
 #extension GL_GOOGLE_include_directive : require

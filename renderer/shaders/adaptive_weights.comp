@@ -1,5 +1,5 @@
 #version 450
-// Adaptive allocation, step 1 of 3 (adaptive.glsl): each pixel's weight from
+// Adaptive allocation, step 1 of 5 (adaptive.glsl): each pixel's weight from
 // the pilot, counted into the histogram, and each tile's sum of absolute mean
 // luminance for the floor weight.
 #extension GL_GOOGLE_include_directive : require

@@ -64,6 +64,8 @@ layout(std430, binding = BINDING_ADAPTIVE_WEIGHTS) buffer AdaptiveWeights { floa
 layout(std430, binding = BINDING_ADAPTIVE_HISTOGRAM) buffer AdaptiveHistogram { uint adaptive_histogram[]; };
 layout(std430, binding = BINDING_ADAPTIVE_GROUPS) buffer AdaptiveGroups { float adaptive_groups[]; };
 layout(std430, binding = BINDING_ADAPTIVE_SOLUTION) buffer AdaptiveSolutionBuffer { AdaptiveSolution adaptive_solution; };
+layout(std430, binding = BINDING_SAMPLE_QUEUE) buffer SampleQueue { uint sample_queue[]; };
+layout(std430, binding = BINDING_QUEUE_BINS) buffer QueueBins { uint queue_bins[]; };
 // Only the video kernels declare the video bindings: with them declared in
 // trace.comp too, lavapipe (Mesa 22.3.6) traced the glass ball of
 // light_transport_test 8 % too dark (0.852 against 0.923); the cause is not

@@ -154,11 +154,35 @@ struct FrameParams {
 #define BINDING_VIDEO 19     // uniform VideoFrames
 #define BINDING_VIDEO_IN 20  // uint per 4 bytes: the camera frame as it came, rows packed
 #define BINDING_VIDEO_OUT 21 // uint per 4 bytes: the outputs one after another, rows packed
-#define BINDING_COUNT 22
+// The adaptive second pass's queue (sample_queue.glsl).
+#define BINDING_SAMPLE_QUEUE 22 // uint per pixel: the pixels with samples left, largest share first
+#define BINDING_QUEUE_BINS 23   // uint words at the QUEUE_* offsets below
+#define BINDING_COUNT 24
 
 // Histogram bins of the adaptive weights: 16 per octave over every
 // non-negative float (adaptive.glsl).
 #define ADAPTIVE_BINS 4096u
+
+// The adaptive second pass traces the pixels of a queue ordered by their
+// share, largest first (sample_queue.glsl), so that the lanes that run
+// together have shares alike, where a tile of neighbours has shares from the
+// pilot up to the cap and each lane group runs as long as its largest. The
+// shares fall into QUEUE_BINS bins of equal width; BINDING_QUEUE_BINS holds,
+// as uint words:
+//   [QUEUE_COUNTS + b]: the pixels of bin b, then where the next of them goes
+//   [QUEUE_ENDS + b]: the pixels in bins b and above (the queue's first ones)
+//   [QUEUE_DISPATCH + 4 b]: a VkDispatchIndirectCommand over those pixels,
+//     one workgroup for each of their QUEUE_GROUP_PIXELS in turn, and the
+//     stride by which the workgroups take those (sample_queue.glsl)
+#define QUEUE_BINS 4096u
+#define QUEUE_COUNTS 0u
+#define QUEUE_ENDS QUEUE_BINS
+#define QUEUE_DISPATCH (2u * QUEUE_BINS)
+#define QUEUE_WORDS (6u * QUEUE_BINS)
+#define QUEUE_GROUP_PIXELS (CAMHEAD_TILE_X * CAMHEAD_TILE_Y)
+// A queue's workgroups are laid out in rows of this many (the y count stays
+// far below the 65535 that every device allows).
+#define QUEUE_ROW_GROUPS 1024u
 
 // The water level of the adaptive allocation and the rays it gave out.
 //   solution: x lambda, y floor weight, z expected total samples
@@ -212,7 +236,9 @@ struct VideoFrames {
 // [sampling.x, sampling.y) of the pixel's own second pattern of n_i - k
 // samples (another seed), stopping at n_i - k, and the resolve kernel divides
 // by n_i. The shares are computed on the GPU between the passes by
-// adaptive_weights.comp, adaptive_solve.comp and adaptive_shares.comp.
+// adaptive_weights.comp, adaptive_solve.comp and adaptive_shares.comp, and
+// adaptive_queue_bins.comp and adaptive_queue_fill.comp order the pixels
+// that have samples left into the queue that the second pass traces.
 
 // Workgroup shape of both kernels (pixels).
 #define CAMHEAD_TILE_X 8

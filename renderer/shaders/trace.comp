@@ -3,16 +3,35 @@
 #extension GL_GOOGLE_include_directive : require
 #include "buffers.glsl"
 #include "kernel.glsl"
+#include "sample_queue.glsl"
 
 layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
 
+// The adaptive second pass takes its pixels from the queue, one a lane
+// (sample_queue.glsl); every other pass, the pixel under the invocation.
+layout(constant_id = 1) const bool FROM_QUEUE = false;
+
 void main() {
-  int i = pixel_index();
-  if (i < 0) {
-    return;
+  uint x;
+  uint y;
+  int i;
+  if (FROM_QUEUE) {
+    i = queue_pixel(frame.sampling.x);
+    if (i < 0) {
+      return;
+    }
+    x = uint(i) % frame.image.x;
+    y = uint(i) / frame.image.x;
+  } else {
+    i = pixel_index();
+    if (i < 0) {
+      return;
+    }
+    x = gl_GlobalInvocationID.x;
+    y = gl_GlobalInvocationID.y;
   }
-  // An adaptive second pass dispatches every pixel for samples up to the
-  // cap; a pixel whose share is done skips the accumulators' round trip.
+  // In the adaptive second pass, a pixel whose share is done skips the
+  // accumulators' round trip (bins wider than one share hold some).
   if (frame.tracing.y != 0u && sample_counts[i] - frame.tracing.y <= frame.sampling.x) {
     return;
   }
@@ -21,8 +40,7 @@ void main() {
   vec4 acc_aux = accum_aux[i];
   bool has_plate = frame.image.z != 0u;
   vec4 camera = has_plate ? plate[i] : vec4(0.0f);
-  trace_pixel(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y, camera, has_plate, acc_mixed,
-              acc_real, acc_aux);
+  trace_pixel(x, y, camera, has_plate, acc_mixed, acc_real, acc_aux);
   accum_mixed[i] = acc_mixed;
   accum_real[i] = acc_real;
   accum_aux[i] = acc_aux;

@@ -16,6 +16,8 @@
 #include <span>
 #include <vector>
 
+#include "adaptive_queue_bins_spv.h"
+#include "adaptive_queue_fill_spv.h"
 #include "adaptive_shares_spv.h"
 #include "adaptive_solve_spv.h"
 #include "adaptive_weights_spv.h"
@@ -99,6 +101,12 @@ std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
   if ((frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u)
     features |= KERNEL_SKIP_EMPTY_PIXELS;
   return features;
+}
+
+// The bin of a second-pass share of `samples` in a frame of `pilot` samples
+// and `cap` (sample_queue.glsl, queue_bin: the same integer arithmetic).
+std::uint32_t queue_bin(std::uint32_t samples, std::uint32_t pilot, std::uint32_t cap) {
+  return samples / ((cap - pilot) / QUEUE_BINS + 1u);
 }
 
 template <typename T> std::span<const std::byte> bytes_of(const std::vector<T> &values) {
@@ -230,19 +238,25 @@ struct GpuTracer::Impl {
   // Records commands into a command buffer.
   using Recorder = std::function<void(VkCommandBuffer)>;
   // Adds samples [0, end) of `frame` to the accumulators in batches sized by
-  // `sizer`, one submission each; `prologue` records commands into the first
-  // submission, before its batch, and `epilogue` into the last, after it
-  // (both submitted also when `end` is 0). `report` gets the samples done.
+  // `sizer`, one submission each, each batch recorded by `trace` once
+  // frame.sampling holds its samples; `prologue` records commands into the
+  // first submission, before its batch, and `epilogue` into the last, after
+  // it (both submitted also when `end` is 0). `report` gets the samples done.
   // Returns the number of submissions.
   int trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
-                    const Recorder &prologue, const Recorder &epilogue,
+                    const Recorder &trace, const Recorder &prologue, const Recorder &epilogue,
                     const std::function<void(std::uint32_t)> &report);
   // Records the accumulators' clear, ordered before the kernels.
   void record_clear(VkCommandBuffer command_buffer) const;
-  // Records adaptive_weights, _solve and _shares (adaptive.glsl) after the
-  // pilot, over the frame's region: sample_counts (0 outside the region) and
-  // the adaptive solution, ordered before the kernels.
+  // Records adaptive_weights, _solve and _shares (adaptive.glsl) and
+  // adaptive_queue_bins and _fill (sample_queue.glsl) after the pilot, over
+  // the frame's region: sample_counts (0 outside the region), the adaptive
+  // solution and the second pass's queue, ordered before the kernels and
+  // the indirect dispatches.
   void record_allocation(VkCommandBuffer command_buffer) const;
+  // Records a second-pass batch of `frame` (adaptive, tracing.y = the pilot):
+  // the trace kernel over the queue's pixels that have samples in it.
+  void record_queue_batch(VkCommandBuffer command_buffer, const gpu::FrameParams &frame);
   // Binds `pipeline` and the descriptor set every kernel shares.
   void bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
   // Dispatches `pipeline` over the image's tiles, or over `groups`.
@@ -255,8 +269,9 @@ struct GpuTracer::Impl {
   // `frames` layers of workgroups (one per output).
   void dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline, std::uint32_t frames,
                       bool region_only) const;
-  // The trace kernel built for the loaded scene and `frame`, built on first use.
-  VkPipeline trace_pipeline(const gpu::FrameParams &frame);
+  // The trace kernel built for the loaded scene and `frame`, over the pixels
+  // of the image or of the queue (trace.comp, FROM_QUEUE), built on first use.
+  VkPipeline trace_pipeline(const gpu::FrameParams &frame, bool from_queue = false);
   // The resolve kernel writing `layers` (RESOLVE_*), built on first use.
   VkPipeline resolve_pipeline(std::uint32_t layers);
 
@@ -266,13 +281,16 @@ struct GpuTracer::Impl {
   vk::Device device;
   vk::DescriptorSet descriptors;
   vk::UniquePipelineLayout pipeline_layout;
-  // trace.comp by KERNEL_FEATURES (layout.h): a scene uses one or two.
-  std::map<std::uint32_t, vk::UniquePipeline> trace_pipelines;
+  // trace.comp by KERNEL_FEATURES (layout.h) and FROM_QUEUE: a scene uses
+  // one or two of the first, and its adaptive frames the second.
+  std::map<std::pair<std::uint32_t, bool>, vk::UniquePipeline> trace_pipelines;
   // resolve.comp by RESOLVE_LAYERS (layout.h).
   std::map<std::uint32_t, vk::UniquePipeline> resolve_pipelines;
   vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
   vk::UniquePipeline adaptive_shares;
+  vk::UniquePipeline adaptive_queue_bins;
+  vk::UniquePipeline adaptive_queue_fill;
   vk::UniquePipeline video_decode;
   vk::UniquePipeline video_encode;
   vk::CommandRunner commands;
@@ -319,6 +337,13 @@ GpuTracer::Impl::Impl(const std::string &wanted)
                                                          .spirv = adaptive_shares_spv,
                                                          .name = "adaptive_shares.comp",
                                                          .dispatch_base = true})),
+      adaptive_queue_bins(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                             .spirv = adaptive_queue_bins_spv,
+                                                             .name = "adaptive_queue_bins.comp"})),
+      adaptive_queue_fill(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
+                                                             .spirv = adaptive_queue_fill_spv,
+                                                             .name = "adaptive_queue_fill.comp",
+                                                             .dispatch_base = true})),
       video_decode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                       .spirv = video_decode_spv,
                                                       .name = "video_decode.comp",
@@ -417,6 +442,12 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
           "adaptive histogram");
   scratch(BINDING_ADAPTIVE_GROUPS, tiles * sizeof(float), "adaptive tile sums");
   scratch(BINDING_ADAPTIVE_SOLUTION, sizeof(gpu::AdaptiveSolution), "adaptive solution");
+  scratch(BINDING_SAMPLE_QUEUE, pixels * sizeof(std::uint32_t), "adaptive sample queue");
+  buffers[BINDING_QUEUE_BINS] = vk::Buffer(device, {.size = QUEUE_WORDS * sizeof(std::uint32_t),
+                                                    .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                             VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                    .name = "adaptive queue bins"});
   for (const int binding : kOutputs)
     buffers[binding] = vk::Buffer(
         device, {.size = layer_bytes,
@@ -460,15 +491,16 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   loaded = true;
 }
 
-VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame) {
+VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame, bool from_queue) {
   const std::uint32_t features = scene_features | frame_kernel_features(frame);
-  vk::UniquePipeline &pipeline = trace_pipelines[features];
+  vk::UniquePipeline &pipeline = trace_pipelines[{features, from_queue}];
+  const std::array<std::uint32_t, 2> constants = {features, from_queue ? VK_TRUE : VK_FALSE};
   if (pipeline.get() == VK_NULL_HANDLE)
     pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                   .spirv = trace_spv,
                                                   .name = "trace.comp",
                                                   .dispatch_base = true,
-                                                  .constants = std::span(&features, 1)});
+                                                  .constants = constants});
   return pipeline.get();
 }
 
@@ -659,6 +691,10 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     timestamps.write(command_buffer, 1, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
   };
+  // A uniform frame's or a pilot's batch: every pixel of the region.
+  const auto trace_region = [&](VkCommandBuffer command_buffer) {
+    dispatch_region(command_buffer, trace_pipeline(frame));
+  };
   const auto report = [&](double done) {
     if (progress)
       progress(static_cast<int>(done), static_cast<int>(total));
@@ -667,14 +703,14 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   FrameTimings timings;
   if (adaptive == nullptr) {
     frame.tracing.y = 0u;
-    timings.submissions = trace_batches(frame, total, uniform_sizer, begin_frame, end_frame,
-                                        [&](std::uint32_t done) { report(done); });
+    timings.submissions = trace_batches(frame, total, uniform_sizer, trace_region, begin_frame,
+                                        end_frame, [&](std::uint32_t done) { report(done); });
   } else {
     // adaptive.h: a pilot, each pixel's share from what it saw, the shares.
     const std::uint32_t pilot = adaptive_pilot(*adaptive, total);
     frame.tracing.y = 0u;
     frame.sampling.z = pilot;
-    timings.submissions = trace_batches(frame, pilot, uniform_sizer, begin_frame, {},
+    timings.submissions = trace_batches(frame, pilot, uniform_sizer, trace_region, begin_frame, {},
                                         [&](std::uint32_t done) { report(done); });
     frame.tracing.y = pilot;
     frame.sampling.z = total;
@@ -682,10 +718,11 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
     if (wanted_region != nullptr)
       frame.adaptive.z = float(frame_region.pixels());
     // Only the cap is known here, not the largest share (that would take a
-    // read-back): pixels whose share is done skip the later samples.
+    // read-back); a batch past the largest share dispatches no workgroup.
     const std::uint32_t cap = std::uint32_t(frame.adaptive.y);
     timings.submissions += trace_batches(
         frame, cap - pilot, second_pass_sizer,
+        [&](VkCommandBuffer command_buffer) { record_queue_batch(command_buffer, frame); },
         [&](VkCommandBuffer command_buffer) { record_allocation(command_buffer); }, end_frame,
         [&](std::uint32_t done) {
           report(pilot + double(done) * (total - pilot) / (cap - pilot));
@@ -765,6 +802,8 @@ void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
   // Tiles and pixels outside the region keep these zeros.
   vkCmdFillBuffer(command_buffer, buffers[BINDING_ADAPTIVE_GROUPS].get(), 0, VK_WHOLE_SIZE, 0);
   vkCmdFillBuffer(command_buffer, buffers[BINDING_SAMPLE_COUNTS].get(), 0, VK_WHOLE_SIZE, 0);
+  vkCmdFillBuffer(command_buffer, buffers[BINDING_QUEUE_BINS].get(), 0,
+                  QUEUE_BINS * sizeof(std::uint32_t), 0); // QUEUE_COUNTS
   vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
@@ -774,11 +813,31 @@ void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
   compute_to_compute();
   dispatch_region(command_buffer, adaptive_shares.get());
   compute_to_compute();
+  dispatch(command_buffer, adaptive_queue_bins.get(), glm::uvec2(1, 1));
+  compute_to_compute();
+  dispatch_region(command_buffer, adaptive_queue_fill.get());
+  // The queue and its dispatches, for every batch of the second pass.
+  vk::memory_barrier(
+      command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
   timestamps.write(command_buffer, 3, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
 }
 
+void GpuTracer::Impl::record_queue_batch(VkCommandBuffer command_buffer,
+                                         const gpu::FrameParams &frame) {
+  bind(command_buffer, trace_pipeline(frame, true));
+  if (device.quirks().indirect_dispatch_keeps_base)
+    vkCmdDispatchBase(command_buffer, 0, 0, 0, 0, 0, 0);
+  const std::uint32_t bin =
+      queue_bin(frame.sampling.x + 1u, frame.tracing.y, std::uint32_t(frame.adaptive.y));
+  vkCmdDispatchIndirect(command_buffer, buffers[BINDING_QUEUE_BINS].get(),
+                        (QUEUE_DISPATCH + 4u * bin) * sizeof(std::uint32_t));
+}
+
 int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
-                                   const Recorder &prologue, const Recorder &epilogue,
+                                   const Recorder &trace, const Recorder &prologue,
+                                   const Recorder &epilogue,
                                    const std::function<void(std::uint32_t)> &report) {
   // One uniform buffer suffices because each batch is waited for before the
   // next one rewrites it.
@@ -794,7 +853,7 @@ int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, B
     if (done == 0 && prologue)
       prologue(command_buffer);
     if (batch > 0) {
-      dispatch_region(command_buffer, trace_pipeline(frame));
+      trace(command_buffer);
       // Orders this batch's accumulation before the next batch or the resolve.
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,

@@ -85,6 +85,11 @@ struct DriverQuirks {
   // VK_PHYSICAL_DEVICE_TYPE_CPU; they are the fallback, never the default
   // choice while a real GPU is present.
   bool software_device = false;
+  // Mesa lavapipe (22.3) adds the base of the command buffer's last
+  // vkCmdDispatchBase to a later vkCmdDispatchIndirect, which has none
+  // (lvp_execute.c: handle_dispatch_indirect leaves grid_base as it was).
+  // An empty vkCmdDispatchBase at base 0 before it resets that.
+  bool indirect_dispatch_keeps_base = false;
 };
 
 struct PhysicalDevice {

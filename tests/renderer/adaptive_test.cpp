@@ -1,8 +1,10 @@
 // Adaptive ray budget per pixel (renderer/include/camhead/renderer/adaptive.h):
 // the allocation, the two executors' agreement, and the quality claim.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -112,8 +114,11 @@ TEST_P(Adaptive, SharesAddUpToTheBudget) {
   }
   // How much of a SIMD machine the shares keep busy: a group of lanes runs
   // as long as its largest share (8 lanes: a row of a tile on lavapipe with
-  // AVX2; 32: 8x4 pixels, an NVIDIA warp of the 8x8 workgroup).
+  // AVX2; 32: 8x4 pixels, an NVIDIA warp of the 8x8 workgroup), and in the
+  // order of the GPU's second pass, by share (sample_queue.glsl).
   const int width = r.composite.width, height = r.composite.height;
+  std::vector<std::uint32_t> by_share = r.sample_counts;
+  std::sort(by_share.begin(), by_share.end(), std::greater<>());
   for (const auto &[gx, gy] : {std::pair{8, 1}, std::pair{8, 4}}) {
     double busy = 0.0;
     for (int y0 = 0; y0 < height; y0 += gy)
@@ -124,8 +129,12 @@ TEST_P(Adaptive, SharesAddUpToTheBudget) {
             most = std::max(most, r.sample_counts[std::size_t(y) * width + x]);
         busy += double(most) * gx * gy;
       }
-    std::printf("%s: %d-lane groups (%dx%d px) busy %.0f%% of the time\n", GetParam().c_str(),
-                gx * gy, gx, gy, 100.0 * double(sum(r.sample_counts)) / busy);
+    double queue_busy = 0.0;
+    for (std::size_t first = 0; first < by_share.size(); first += std::size_t(gx * gy))
+      queue_busy += double(by_share[first]) * gx * gy; // the group's largest
+    std::printf("%s: %d-lane groups busy %.0f%% of the time in %dx%d tiles, %.0f%% by share\n",
+                GetParam().c_str(), gx * gy, 100.0 * double(sum(r.sample_counts)) / busy, gx, gy,
+                100.0 * double(sum(r.sample_counts)) / queue_busy);
   }
   std::printf("%s: mean share in focus (CoC < 0.5 px) %.1f over %d px, defocused (> 2 px) %.1f "
               "over %d px, largest %u\n",
@@ -175,6 +184,92 @@ TEST_P(Adaptive, GpuAgreesWithCpuReferenceBelowSamplingNoise) {
   // differently: a share on the edge of a rounding step may differ by one.
   EXPECT_GT(double(same), 0.99 * double(gpu.sample_counts.size()));
   EXPECT_LT(difference, noise);
+}
+
+// A wall and a ball, both virtual, filling the view, under an area light:
+// every camera ray meets a virtual surface, so each pixel's mask is the
+// fraction of its share that was traced. The ball's soft shadow and the
+// defocus spread the shares from the pilot to the cap.
+renderer::Scene virtual_wall_in_soft_shadow() {
+  renderer::Scene scene;
+  scene.source = "virtual_wall_in_soft_shadow";
+  scene.render.width = 48;
+  scene.render.height = 32;
+  scene.camera.position = {0.0f, 0.0f, 0.0f};
+  scene.camera.look_at = {0.0f, 0.0f, -1.0f};
+  scene.camera.f_number = 2.0f;
+  scene.camera.focus_distance_m = 2.0f;
+  scene.materials = {{"white", renderer::MaterialType::diffuse, glm::vec3(0.8f), 1.5f}};
+  renderer::Object wall;
+  wall.name = "wall";
+  wall.type = renderer::ShapeType::plane;
+  wall.center = {0.0f, 0.0f, -3.0f};
+  wall.size = {20.0f, 1.0f, 20.0f};
+  wall.rotation_deg = {90.0f, 0.0f, 0.0f}; // facing the camera
+  renderer::Object ball;
+  ball.name = "ball";
+  ball.type = renderer::ShapeType::sphere;
+  ball.center = {0.2f, 0.1f, -2.2f};
+  ball.radius = 0.3f;
+  scene.objects = {wall, ball};
+  renderer::Light panel;
+  panel.name = "panel";
+  panel.type = renderer::LightType::area;
+  panel.position = {0.0f, 1.5f, -1.2f};
+  panel.normal = glm::normalize(glm::vec3(0.0f, -1.0f, -0.5f));
+  panel.size = {0.8f, 0.8f};
+  panel.power_W = 200.0f;
+  scene.lights = {panel};
+  return scene;
+}
+
+// The second pass takes its pixels from a queue ordered by share
+// (sample_queue.glsl), in batches that start wherever the batch sizer puts
+// them. Each pixel must be traced for exactly its share: none left out of
+// the queue or cut short at a batch or bin boundary, none traced twice. The
+// mask of a pixel all of whose rays meet virtual surfaces counts that,
+// whatever the image: mask x share = the samples traced. Bins of one share
+// (cap - pilot < QUEUE_BINS) and of three (a mean of 160, a cap 64 times it);
+// the whole frame, and a region of two rectangles away from its corner
+// (whose dispatches set a base that the queue's must not inherit).
+TEST(AdaptiveSecondPass, TracesEachPixelsShareExactlyOnce) {
+  CAMHEAD_REQUIRE_VULKAN();
+  const renderer::Scene scene = virtual_wall_in_soft_shadow();
+  const renderer::CompiledScene compiled = renderer::compile_scene(scene);
+  renderer::GpuTracer tracer;
+  tracer.load(compiled);
+  renderer::InfluenceRegion part{.width = 48, .height = 32, .rects = {}};
+  part.rects = {{.x0 = 8, .y0 = 8, .x1 = 40, .y1 = 16}, {.x0 = 16, .y0 = 16, .x1 = 48, .y1 = 32}};
+  for (const auto &[rpp, max_factor] : {std::pair{12, 16.0f}, std::pair{160, 64.0f}})
+    for (const renderer::InfluenceRegion *region :
+         std::array<const renderer::InfluenceRegion *, 2>{nullptr, &part}) {
+      AdaptiveSampling settings;
+      settings.max_factor = max_factor;
+      const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, rpp);
+      // Twice: the first frame's batches start at one sample, the second's
+      // are as large as the first measured.
+      for (int repeat = 0; repeat < 2; ++repeat) {
+        const renderer::RenderResult r = tracer.render_adaptive(frame, settings, {}, {}, region);
+        ASSERT_EQ(r.sample_counts.size(), r.mask.pixel_count());
+        std::vector<std::uint32_t> distinct = r.sample_counts;
+        std::sort(distinct.begin(), distinct.end());
+        distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+        std::printf("%d rpp, cap %.0fx: %zu distinct shares from %u to %u\n", rpp, max_factor,
+                    distinct.size(), distinct.front(), distinct.back());
+        // Else the queue would not be put to the test.
+        EXPECT_GT(distinct.size(), 20u);
+        EXPECT_GT(distinct.back(), 3u * std::uint32_t(rpp));
+        int wrong = 0;
+        for (std::size_t i = 0; i < r.sample_counts.size(); ++i) {
+          const double share = r.sample_counts[i];
+          const double traced = double(r.mask.data[i]) * share;
+          if (std::abs(traced - share) >= 0.5 && ++wrong <= 5)
+            ADD_FAILURE() << "pixel " << i % 48 << "," << i / 48 << ": " << traced
+                          << " samples traced of a share of " << share;
+        }
+        EXPECT_EQ(wrong, 0);
+      }
+    }
 }
 
 // The quality claim at small scale: relative RMSE against a converged
