@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Issue 11's GPU figures in one run, sized for a lent GPU machine's 15
+# minutes: the demo scene against
+# the paper's frame rates at 25 and 49 rpp, and 1920x1080 at 49-rpp quality
+# (adaptive 9 rpp has the error of uniform 49, RESULTS "Speed versus
+# accuracy"), each over every pixel and over the influence region, with the
+# device's own timestamps beside the host's. Prints Markdown; every line
+# also goes to OUT_DIR/gpu_check.md.
+#
+#   bench/gpu_check.sh [BUILD_DIR] [OUT_DIR]
+#
+# The machine needs the Vulkan loader and a driver, nothing else: build
+# here, then carry BUILD_DIR/camhead (bench/RESULTS.md, "Frame rate on an
+# NVIDIA H100", says how it was done for the H100 rows). FRAMES and WARMUP
+# (default 21 and 3) set the frames timed per setting; FRAMES=3 WARMUP=1
+# checks the script on lavapipe in a few minutes of 720x576 only
+# (QUICK=1).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir=${1:-build}
+out_dir=${2:-.}
+camhead=$build_dir/camhead
+frames=${FRAMES:-21}
+warmup=${WARMUP:-3}
+quick=${QUICK:-0}
+mkdir -p "$out_dir"
+log=$out_dir/gpu_check.md
+: >"$log"
+
+say() { echo "$@" | tee -a "$log"; }
+bench() {
+  say
+  say "    camhead bench $*"
+  say
+  "$camhead" bench --frames "$frames" --warmup "$warmup" "$@" 2>&1 | tee -a "$log"
+}
+
+say "# Issue 11 on a GPU, $(date -u +%Y-%m-%d) (each table names its device)"
+
+# The paper: 59 / 12 / 7 fps at 1 / 25 / 49 rpp, 720x576 (method.md 4).
+bench --scene scenes/ar_demo.json --rpp 1,25,49 --influence-region
+bench --scene scenes/ar_demo.json --rpp 9,25 --adaptive --influence-region
+bench --scene tests/assets/reference/ar_basic.json --rpp 1,25,49 --influence-region
+if [ "$quick" = 1 ]; then
+  exit 0
+fi
+# 1080p at 49-rpp quality: the goal is 60 fps (16.7 ms a frame).
+for scene in tests/assets/reference/ar_basic.json scenes/ar_demo.json; do
+  bench --scene "$scene" --width 1920 --height 1080 --rpp 9 --adaptive --influence-region
+  bench --scene "$scene" --width 1920 --height 1080 --rpp 49 --influence-region
+done
+# Device time against host time for the adaptive frame (allocation included).
+bench --scene scenes/ar_demo.json --width 1920 --height 1080 --rpp 9 --adaptive
