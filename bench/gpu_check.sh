@@ -1,20 +1,18 @@
 #!/usr/bin/env bash
 # Issue 11's GPU figures in one run, sized for a lent GPU machine's 15
-# minutes: the demo scene against
-# the paper's frame rates at 25 and 49 rpp, and 1920x1080 at 49-rpp quality
-# (adaptive 9 rpp has the error of uniform 49, RESULTS "Speed versus
-# accuracy"), each over every pixel and over the influence region, with the
-# device's own timestamps beside the host's. Prints Markdown; every line
-# also goes to OUT_DIR/gpu_check.md.
+# minutes: the demo scene against the paper's frame rates at 25 and 49 rpp,
+# and 1920x1080 at 49-rpp quality (adaptive 9 rpp has the error of uniform
+# 49: RESULTS, "Speed versus accuracy"), each over every pixel and over the
+# influence region, and last the device's own time of an adaptive 1080p
+# frame beside the host's. Prints Markdown; every line also goes to
+# OUT_DIR/gpu_check.md.
 #
 #   bench/gpu_check.sh [BUILD_DIR] [OUT_DIR]
 #
-# The machine needs the Vulkan loader and a driver, nothing else: build
-# here, then carry BUILD_DIR/camhead (bench/RESULTS.md, "Frame rate on an
-# NVIDIA H100", says how it was done for the H100 rows). FRAMES and WARMUP
-# (default 21 and 3) set the frames timed per setting; FRAMES=3 WARMUP=1
-# checks the script on lavapipe in a few minutes of 720x576 only
-# (QUICK=1).
+# The machine needs a Vulkan driver and loader, nothing else: build here and
+# carry BUILD_DIR/camhead (RESULTS, "Frame rate on an NVIDIA H100"). FRAMES
+# and WARMUP (21 and 3) set the frames timed per setting. On lavapipe,
+# QUICK=1 FRAMES=1 WARMUP=0 checks the script in two minutes (720x576 only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${1:-build}

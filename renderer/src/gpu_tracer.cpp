@@ -274,6 +274,11 @@ struct GpuTracer::Impl {
   VkPipeline trace_pipeline(const gpu::FrameParams &frame, bool from_queue = false);
   // The resolve kernel writing `layers` (RESOLVE_*), built on first use.
   VkPipeline resolve_pipeline(std::uint32_t layers);
+  // `spirv` with specialization constant i = constants[i], to be dispatched
+  // with a base, built on first use (a lookup allocates nothing).
+  using Constants = std::array<std::uint32_t, 2>;
+  VkPipeline specialized(std::span<const std::uint32_t> spirv, const char *name,
+                         const Constants &constants);
 
   // Declaration order is destruction order in reverse: everything made from
   // the device goes before it, and the device before the instance.
@@ -281,11 +286,9 @@ struct GpuTracer::Impl {
   vk::Device device;
   vk::DescriptorSet descriptors;
   vk::UniquePipelineLayout pipeline_layout;
-  // trace.comp by KERNEL_FEATURES (layout.h) and FROM_QUEUE: a scene uses
-  // one or two of the first, and its adaptive frames the second.
-  std::map<std::pair<std::uint32_t, bool>, vk::UniquePipeline> trace_pipelines;
-  // resolve.comp by RESOLVE_LAYERS (layout.h).
-  std::map<std::uint32_t, vk::UniquePipeline> resolve_pipelines;
+  // trace.comp by KERNEL_FEATURES (layout.h) and FROM_QUEUE, and
+  // resolve.comp by RESOLVE_LAYERS: by the kernel's code and its constants.
+  std::map<std::pair<const std::uint32_t *, Constants>, vk::UniquePipeline> specialized_pipelines;
   vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
   vk::UniquePipeline adaptive_shares;
@@ -491,29 +494,26 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   loaded = true;
 }
 
-VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame, bool from_queue) {
-  const std::uint32_t features = scene_features | frame_kernel_features(frame);
-  vk::UniquePipeline &pipeline = trace_pipelines[{features, from_queue}];
-  const std::array<std::uint32_t, 2> constants = {features, from_queue ? VK_TRUE : VK_FALSE};
+VkPipeline GpuTracer::Impl::specialized(std::span<const std::uint32_t> spirv, const char *name,
+                                        const Constants &constants) {
+  vk::UniquePipeline &pipeline = specialized_pipelines[{spirv.data(), constants}];
   if (pipeline.get() == VK_NULL_HANDLE)
     pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                  .spirv = trace_spv,
-                                                  .name = "trace.comp",
+                                                  .spirv = spirv,
+                                                  .name = name,
                                                   .dispatch_base = true,
                                                   .constants = constants});
   return pipeline.get();
 }
 
+VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame, bool from_queue) {
+  return specialized(
+      trace_spv, "trace.comp",
+      {scene_features | frame_kernel_features(frame), from_queue ? VK_TRUE : VK_FALSE});
+}
+
 VkPipeline GpuTracer::Impl::resolve_pipeline(std::uint32_t layers) {
-  vk::UniquePipeline &pipeline = resolve_pipelines[layers];
-  const std::array<std::uint32_t, 2> constants = {KERNEL_ALL, layers};
-  if (pipeline.get() == VK_NULL_HANDLE)
-    pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                  .spirv = resolve_spv,
-                                                  .name = "resolve.comp",
-                                                  .dispatch_base = true,
-                                                  .constants = constants});
-  return pipeline.get();
+  return specialized(resolve_spv, "resolve.comp", {KERNEL_ALL, layers});
 }
 
 void GpuTracer::Impl::bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
