@@ -172,8 +172,8 @@ struct FrameParams {
 //   [QUEUE_COUNTS + b]: the pixels of bin b, then where the next of them goes
 //   [QUEUE_ENDS + b]: the pixels in bins b and above (the queue's first ones)
 //   [QUEUE_DISPATCH + 4 b]: a VkDispatchIndirectCommand over those pixels,
-//     one workgroup for each of their QUEUE_GROUP_PIXELS in turn, and the
-//     stride by which the workgroups take those (sample_queue.glsl)
+//     a workgroup per QUEUE_GROUP_PIXELS of them, then the stride by which
+//     its workgroups take them (sample_queue.glsl)
 #define QUEUE_BINS 4096u
 #define QUEUE_COUNTS 0u
 #define QUEUE_ENDS QUEUE_BINS

@@ -827,11 +827,9 @@ void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
 void GpuTracer::Impl::record_queue_batch(VkCommandBuffer command_buffer,
                                          const gpu::FrameParams &frame) {
   bind(command_buffer, trace_pipeline(frame, true));
-  if (device.quirks().indirect_dispatch_keeps_base)
-    vkCmdDispatchBase(command_buffer, 0, 0, 0, 0, 0, 0);
   const std::uint32_t bin =
       queue_bin(frame.sampling.x + 1u, frame.tracing.y, std::uint32_t(frame.adaptive.y));
-  vkCmdDispatchIndirect(command_buffer, buffers[BINDING_QUEUE_BINS].get(),
+  vk::dispatch_indirect(device, command_buffer, buffers[BINDING_QUEUE_BINS].get(),
                         (QUEUE_DISPATCH + 4u * bin) * sizeof(std::uint32_t));
 }
 

@@ -88,7 +88,8 @@ struct DriverQuirks {
   // Mesa lavapipe (22.3) adds the base of the command buffer's last
   // vkCmdDispatchBase to a later vkCmdDispatchIndirect, which has none
   // (lvp_execute.c: handle_dispatch_indirect leaves grid_base as it was).
-  // An empty vkCmdDispatchBase at base 0 before it resets that.
+  // An empty vkCmdDispatchBase at base 0 before it resets that
+  // (vk::dispatch_indirect).
   bool indirect_dispatch_keeps_base = false;
 };
 
@@ -313,5 +314,11 @@ struct ComputePipelineCreateInfo {
 void memory_barrier(VkCommandBuffer command_buffer, VkPipelineStageFlags src_stage,
                     VkAccessFlags src_access, VkPipelineStageFlags dst_stage,
                     VkAccessFlags dst_access);
+
+// vkCmdDispatchIndirect of the bound pipeline with the VkDispatchIndirectCommand
+// at `offset` in `buffer`, on every driver as the specification says
+// (DriverQuirks::indirect_dispatch_keeps_base).
+void dispatch_indirect(const Device &device, VkCommandBuffer command_buffer, VkBuffer buffer,
+                       VkDeviceSize offset);
 
 } // namespace camhead::renderer::vk

@@ -325,4 +325,11 @@ void memory_barrier(VkCommandBuffer command_buffer, VkPipelineStageFlags src_sta
                        nullptr);
 }
 
+void dispatch_indirect(const Device &device, VkCommandBuffer command_buffer, VkBuffer buffer,
+                       VkDeviceSize offset) {
+  if (device.quirks().indirect_dispatch_keeps_base)
+    vkCmdDispatchBase(command_buffer, 0, 0, 0, 0, 0, 0); // no workgroups; the base back at 0
+  vkCmdDispatchIndirect(command_buffer, buffer, offset);
+}
+
 } // namespace camhead::renderer::vk

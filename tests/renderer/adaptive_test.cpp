@@ -238,8 +238,10 @@ TEST(AdaptiveSecondPass, TracesEachPixelsShareExactlyOnce) {
   const renderer::CompiledScene compiled = renderer::compile_scene(scene);
   renderer::GpuTracer tracer;
   tracer.load(compiled);
-  renderer::InfluenceRegion part{.width = 48, .height = 32, .rects = {}};
-  part.rects = {{.x0 = 8, .y0 = 8, .x1 = 40, .y1 = 16}, {.x0 = 16, .y0 = 16, .x1 = 48, .y1 = 32}};
+  const renderer::InfluenceRegion part{
+      .width = 48,
+      .height = 32,
+      .rects = {{.x0 = 8, .y0 = 8, .x1 = 40, .y1 = 16}, {.x0 = 16, .y0 = 16, .x1 = 48, .y1 = 32}}};
   for (const auto &[rpp, max_factor] : {std::pair{12, 16.0f}, std::pair{160, 64.0f}})
     for (const renderer::InfluenceRegion *region :
          std::array<const renderer::InfluenceRegion *, 2>{nullptr, &part}) {
