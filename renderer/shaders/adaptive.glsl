@@ -13,7 +13,7 @@
 // total is the budget in expectation (to within sqrt(pixels) / 2 samples), and
 // no sort is needed.
 //
-// Expects: accum_aux[] (the pilot's aux layer, layout.h), frame (FrameParams
+// Expects: accum_aux_at() (the pilot's aux layer, layout.h), frame (FrameParams
 // with tracing.y = k pilot samples, sampling.z = the mean budget per pixel,
 // sampling.w = the seed, adaptive = the settings).
 
@@ -75,7 +75,7 @@ float adaptive_weight(int x, int y) {
       if (nx < 0 || ny < 0 || nx >= width || ny >= height) {
         continue;
       }
-      vec4 a = accum_aux[ny * width + nx];
+      vec4 a = accum_aux_at(ny * width + nx);
       largest = max(largest, adaptive_moments(a, n).y);
       sum += a.z;
       squares += a.w;
@@ -84,7 +84,7 @@ float adaptive_weight(int x, int y) {
   }
   float pooled_mean = sum / count;
   float pooled = max(0.0f, squares / count - pooled_mean * pooled_mean);
-  vec4 own = accum_aux[y * width + x];
+  vec4 own = accum_aux_at(y * width + x);
   float mean = adaptive_moments(own, n).x;
   float inverse_depth = own.y > 0.0f ? own.y / own.x : 0.0f; // a miss is at infinity
   float coc_px = 0.0f;

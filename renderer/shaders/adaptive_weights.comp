@@ -22,7 +22,7 @@ void main() {
     uint bin = adaptive_bin(w);
     atomicAdd(adaptive_histogram[2u * bin], 1u);
     atomicAdd(adaptive_histogram[2u * bin + 1u], adaptive_bin_offset(w));
-    luminance = abs(adaptive_moments(accum_aux[i], float(frame.tracing.y)).x);
+    luminance = abs(adaptive_moments(accum_aux_at(i), float(frame.tracing.y)).x);
   }
   uint t = gl_LocalInvocationIndex;
   tile_luminance[t] = luminance;

@@ -10,49 +10,70 @@
 
 layout(constant_id = 0) const uint KERNEL_FEATURES = KERNEL_ALL; // layout.h
 
-// The scene's geometry, read at every step of every traversal, is read
-// through texel buffers rather than storage buffers: lavapipe (Mesa 22.3)
-// loads a storage buffer at an index that differs between lanes one lane at
-// a time, in a loop with a branch per lane and component (lp_bld_nir_soa.c,
-// emit_load_mem), where a texel fetch is one gather (bench/RESULTS.md,
-// "Where lavapipe's time goes"). Integer texels keep the bits of the
-// integers that .w holds exactly.
+// The scene (geometry, materials, lights) is read through texel buffers
+// rather than storage buffers: lavapipe (Mesa 22.3) loads a storage buffer
+// at an index that differs between lanes one lane and one component at a
+// time, in a loop that inserts each word into the vector through the stack
+// (lp_bld_nir_soa.c, emit_load_mem). A texel fetch is a gather. On an AMD
+// Zen 3 every insert also stalls on store forwarding; the loop took half of
+// a frame there (bench/RESULTS.md, "Where lavapipe's time goes"). Integer
+// texels keep the bits of the integers that .w holds exactly.
 layout(binding = BINDING_PRIMITIVES) uniform usamplerBuffer primitive_texels;
 layout(binding = BINDING_NODES) uniform usamplerBuffer node_texels;
+layout(binding = BINDING_MATERIALS) uniform usamplerBuffer material_texels;
+layout(binding = BINDING_LIGHTS) uniform usamplerBuffer light_texels;
+
+vec4 texel_at(usamplerBuffer texels, uint texel) {
+  return uintBitsToFloat(texelFetch(texels, int(texel)));
+}
 
 Primitive primitive_at(uint index) {
-  int texel = int(index * PRIMITIVE_TEXELS);
-  Primitive prim;
-  prim.p0 = uintBitsToFloat(texelFetch(primitive_texels, texel));
-  prim.p1 = uintBitsToFloat(texelFetch(primitive_texels, texel + 1));
-  prim.p2 = uintBitsToFloat(texelFetch(primitive_texels, texel + 2));
-  return prim;
+  uint texel = index * PRIMITIVE_TEXELS;
+  return Primitive(texel_at(primitive_texels, texel), texel_at(primitive_texels, texel + 1u),
+                   texel_at(primitive_texels, texel + 2u));
 }
 
 BvhNode node_at(uint index) {
-  int texel = int(index * NODE_TEXELS);
-  BvhNode node;
-  node.bmin = uintBitsToFloat(texelFetch(node_texels, texel));
-  node.bmax = uintBitsToFloat(texelFetch(node_texels, texel + 1));
-  return node;
+  uint texel = index * NODE_TEXELS;
+  return BvhNode(texel_at(node_texels, texel), texel_at(node_texels, texel + 1u));
 }
-layout(std430, binding = BINDING_MATERIALS) readonly buffer Materials { Material materials[]; };
-layout(std430, binding = BINDING_LIGHTS) readonly buffer Lights { Light lights[]; };
+
+Material material_at(uint index) {
+  uint texel = index * MATERIAL_TEXELS;
+  return Material(texel_at(material_texels, texel), texel_at(material_texels, texel + 1u));
+}
+
+Light light_at(uint index) {
+  uint texel = index * LIGHT_TEXELS;
+  return Light(texel_at(light_texels, texel), texel_at(light_texels, texel + 1u),
+               texel_at(light_texels, texel + 2u), texel_at(light_texels, texel + 3u),
+               texel_at(light_texels, texel + 4u));
+}
+
 layout(std140, binding = BINDING_FRAME) uniform Frame { FrameParams frame; };
-layout(std430, binding = BINDING_ACCUM_MIXED) buffer AccumMixed { vec4 accum_mixed[]; };
-layout(std430, binding = BINDING_ACCUM_REAL) buffer AccumReal { vec4 accum_real[]; };
-layout(std430, binding = BINDING_ACCUM_AUX) buffer AccumAux { vec4 accum_aux[]; };
+
+// The per-pixel layers that kernels read are storage texel buffers for the
+// same reason: imageLoad is a gather on lavapipe, where a storage buffer's
+// vec4 is four loops over the lanes. Each invocation reads and writes only
+// its own pixel's texel, or reads texels an earlier dispatch wrote.
+layout(binding = BINDING_ACCUM_MIXED, rgba32f) uniform restrict imageBuffer accum_mixed;
+layout(binding = BINDING_ACCUM_REAL, rgba32f) uniform restrict imageBuffer accum_real;
+layout(binding = BINDING_ACCUM_AUX, rgba32f) uniform restrict imageBuffer accum_aux;
+// adaptive.glsl's reader, which C++ also has (renderer/src/adaptive.cpp).
+vec4 accum_aux_at(uint index) {
+  return imageLoad(accum_aux, int(index));
+}
 // The live frame's kernels write the plate (video_decode.comp) and read the
 // composite (video_encode.comp); the others only read one and write the other.
 #ifdef CAMHEAD_WRITES_PLATE
-layout(std430, binding = BINDING_PLATE) writeonly buffer Plate { vec4 plate[]; };
+layout(binding = BINDING_PLATE, rgba32f) uniform restrict writeonly imageBuffer plate;
 #else
-layout(std430, binding = BINDING_PLATE) readonly buffer Plate { vec4 plate[]; };
+layout(binding = BINDING_PLATE, rgba32f) uniform restrict readonly imageBuffer plate;
 #endif
 #ifdef CAMHEAD_READS_COMPOSITE
-layout(std430, binding = BINDING_OUT_COMPOSITE) readonly buffer OutComposite { vec4 out_composite[]; };
+layout(binding = BINDING_OUT_COMPOSITE, rgba32f) uniform restrict readonly imageBuffer out_composite;
 #else
-layout(std430, binding = BINDING_OUT_COMPOSITE) writeonly buffer OutComposite { vec4 out_composite[]; };
+layout(binding = BINDING_OUT_COMPOSITE, rgba32f) uniform restrict writeonly imageBuffer out_composite;
 #endif
 layout(std430, binding = BINDING_OUT_MIXED) writeonly buffer OutMixed { vec4 out_mixed[]; };
 layout(std430, binding = BINDING_OUT_REAL) writeonly buffer OutReal { vec4 out_real[]; };

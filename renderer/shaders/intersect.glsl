@@ -276,7 +276,7 @@ vec3 area_lights_along(Ray ray, float t_max) {
   }
   uint li = 0u;
   do {
-    Light light = lights[li];
+    Light light = light_at(li);
     if (floatBitsToUint(light.position.w) != LIGHT_AREA) {
       continue;
     }

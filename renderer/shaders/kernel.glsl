@@ -8,7 +8,7 @@
 // INOUT(T) / OUT(T) for reference parameters, and no names that would hide a
 // glm function inside a C++ class.
 //
-// Expects: primitive_at(), node_at(), materials[], lights[], frame (FrameParams).
+// Expects: primitive_at(), node_at(), material_at(), light_at(), frame (FrameParams).
 //
 // Loops test their condition at the bottom (do-while, behind a test for
 // none at all). lavapipe runs every branch masked and ends a loop only when
@@ -107,7 +107,7 @@ void direct_light(vec3 p, vec3 n, vec3 brdf_weight, uint surface_dim, uint s, ui
   }
   uint li = 0u;
   do {
-    Light light = lights[li];
+    Light light = light_at(li);
     uint type = floatBitsToUint(light.position.w);
     vec3 wi;
     float dist;
@@ -218,7 +218,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
     bool add_mixed = !real_only;
     bool add_real = real_only || coupled;
 
-    Material material = materials[missed ? 0u : prim_material(surface_prim)];
+    Material material = material_at(missed ? 0u : prim_material(surface_prim));
     uint type = floatBitsToUint(material.params.w);
     vec3 emitted = surface > 1u ? area_lights_along(ray, hit.t) : vec3(0.0f);
     if (missed) {

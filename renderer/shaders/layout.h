@@ -48,6 +48,7 @@ struct Material {
   vec4 color;
   vec4 params;
 };
+#define MATERIAL_TEXELS 2u // 16-byte texels per Material (BINDING_MATERIALS)
 
 #define LIGHT_POINT 0u
 #define LIGHT_AREA 1u
@@ -66,6 +67,7 @@ struct Light {
   vec4 axis_v;
   vec4 normal;
 };
+#define LIGHT_TEXELS 5u // 16-byte texels per Light (BINDING_LIGHTS)
 
 // Per-frame parameters (std140 uniform block; vec4 and uvec4 only).
 //

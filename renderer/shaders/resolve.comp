@@ -23,11 +23,12 @@ void main() {
     return;
   }
   bool has_plate = frame.image.z != 0u;
-  vec4 camera = has_plate ? plate[i] : vec4(0.0f);
+  vec4 camera = has_plate ? imageLoad(plate, i) : vec4(0.0f);
   uint samples = frame.tracing.y != 0u ? sample_counts[i] : frame.sampling.z;
-  Resolved r = resolve_pixel(accum_mixed[i], accum_real[i], accum_aux[i], camera, has_plate, samples);
+  Resolved r = resolve_pixel(imageLoad(accum_mixed, i), imageLoad(accum_real, i),
+                             imageLoad(accum_aux, i), camera, has_plate, samples);
   if ((RESOLVE_LAYERS & RESOLVE_COMPOSITE) != 0u) {
-    out_composite[i] = vec4(r.composite, 1.0f);
+    imageStore(out_composite, i, vec4(r.composite, 1.0f));
   }
   if ((RESOLVE_LAYERS & RESOLVE_MIXED) != 0u) {
     out_mixed[i] = vec4(r.mixed, 1.0f);

@@ -35,13 +35,13 @@ void main() {
   if (frame.tracing.y != 0u && sample_counts[i] - frame.tracing.y <= frame.sampling.x) {
     return;
   }
-  vec4 acc_mixed = accum_mixed[i];
-  vec4 acc_real = accum_real[i];
-  vec4 acc_aux = accum_aux[i];
+  vec4 acc_mixed = imageLoad(accum_mixed, i);
+  vec4 acc_real = imageLoad(accum_real, i);
+  vec4 acc_aux = imageLoad(accum_aux, i);
   bool has_plate = frame.image.z != 0u;
-  vec4 camera = has_plate ? plate[i] : vec4(0.0f);
+  vec4 camera = has_plate ? imageLoad(plate, i) : vec4(0.0f);
   trace_pixel(x, y, camera, has_plate, acc_mixed, acc_real, acc_aux);
-  accum_mixed[i] = acc_mixed;
-  accum_real[i] = acc_real;
-  accum_aux[i] = acc_aux;
+  imageStore(accum_mixed, i, acc_mixed);
+  imageStore(accum_real, i, acc_real);
+  imageStore(accum_aux, i, acc_aux);
 }

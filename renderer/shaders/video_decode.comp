@@ -51,7 +51,7 @@ void main() {
                           float(byte_in(base, p + 2u)));
         rgb = video_rgb_codes_to_linear(f.format.x == VIDEO_BGR24 ? codes.zyx : codes);
       }
-      plate[y * width + x] = vec4(rgb, 0.0f);
+      imageStore(plate, int(y * width + x), vec4(rgb, 0.0f));
     }
   }
 }

@@ -33,7 +33,7 @@ void main() {
 
   vec3 px[8]; // row-major: (dx, dy) at dy * 4 + dx
   for (uint i = 0u; i < 8u; ++i) {
-    px[i] = vec3(out_composite[(y0 + i / 4u) * width + x0 + i % 4u]);
+    px[i] = vec3(imageLoad(out_composite, int((y0 + i / 4u) * width + x0 + i % 4u)));
   }
 
   if (f.format.x == VIDEO_YUYV) {

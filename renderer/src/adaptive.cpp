@@ -30,6 +30,8 @@ using uint = std::uint32_t;
 struct AdaptiveKernel {
   const vec4 *accum_aux = nullptr;
   FrameParams frame{};
+  // The GLSL kernels read the layer through a texel buffer (buffers.glsl).
+  [[nodiscard]] vec4 accum_aux_at(uint index) const { return accum_aux[index]; }
 
 #include "adaptive.glsl"
 };

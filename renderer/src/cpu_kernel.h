@@ -44,9 +44,11 @@ struct CpuKernel {
   // Every feature, chosen at run time (layout.h).
   static constexpr uint KERNEL_FEATURES = KERNEL_ALL;
 
-  // The GLSL kernel reads the geometry through texel buffers (buffers.glsl).
+  // The GLSL kernel reads the scene through texel buffers (buffers.glsl).
   [[nodiscard]] Primitive primitive_at(uint index) const { return primitives[index]; }
   [[nodiscard]] BvhNode node_at(uint index) const { return nodes[index]; }
+  [[nodiscard]] Material material_at(uint index) const { return materials[index]; }
+  [[nodiscard]] Light light_at(uint index) const { return lights[index]; }
 
 #include "kernel.glsl"
 };

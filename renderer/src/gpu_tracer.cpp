@@ -72,7 +72,34 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   types[BINDING_VIDEO] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   types[BINDING_PRIMITIVES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER; // buffers.glsl says why
   types[BINDING_NODES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  types[BINDING_MATERIALS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  types[BINDING_LIGHTS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  for (const int binding : {BINDING_ACCUM_MIXED, BINDING_ACCUM_REAL, BINDING_ACCUM_AUX,
+                            BINDING_PLATE, BINDING_OUT_COMPOSITE})
+    types[std::size_t(binding)] = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER; // read per pixel
   return types;
+}
+
+// How a buffer at `binding` is created: its usage for that descriptor type
+// and, for a texel buffer, the format of its view (16-byte texels; the
+// scene's structures as integers, layout.h: PRIMITIVE_TEXELS and the others).
+vk::BufferCreateInfo binding_buffer(int binding, VkDeviceSize size, VkBufferUsageFlags transfers,
+                                    const char *name) {
+  vk::BufferCreateInfo create{.size = size, .usage = transfers, .name = name};
+  switch (binding_types()[std::size_t(binding)]) {
+  case VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER:
+    create.usage |= VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+    create.texel_format = VK_FORMAT_R32G32B32A32_UINT;
+    break;
+  case VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER:
+    create.usage |= VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
+    create.texel_format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    break;
+  default:
+    create.usage |= VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    break;
+  }
+  return create;
 }
 
 // The features of kernel.glsl that `scene` can reach (layout.h, KERNEL_*):
@@ -378,14 +405,14 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
                    " pixels, the image " + std::to_string(pixels));
   const VkDeviceSize layer_bytes = pixels * sizeof(gpu::vec4);
   const VkPhysicalDeviceLimits &limits = device.limits();
-  if (layer_bytes > limits.maxStorageBufferRange ||
+  if (layer_bytes > limits.maxStorageBufferRange || pixels > limits.maxTexelBufferElements ||
       std::uint32_t(scene.width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X >
           limits.maxComputeWorkGroupCount[0] ||
       std::uint32_t(scene.height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y >
           limits.maxComputeWorkGroupCount[1])
     throw GpuError("image " + std::to_string(scene.width) + "x" + std::to_string(scene.height) +
-                   " exceeds the storage buffer or dispatch limits of device '" + device.name() +
-                   "'");
+                   " exceeds the storage buffer, texel buffer or dispatch limits of device '" +
+                   device.name() + "'");
 
   loaded = false; // until every buffer below exists
   vk::Uploader uploader(device);
@@ -396,19 +423,12 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   const auto upload = [&](int binding, std::span<const std::byte> data, std::size_t element,
                           const char *name) {
     const VkDeviceSize size = std::max<VkDeviceSize>(data.size(), element);
-    vk::BufferCreateInfo create{.size = size,
-                                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                .name = name};
-    if (binding_types()[std::size_t(binding)] == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
-      // 16-byte texels (layout.h: PRIMITIVE_TEXELS, NODE_TEXELS).
-      if (size / 16 > limits.maxTexelBufferElements)
-        throw GpuError(std::string("the scene's ") + name + " take " + std::to_string(size / 16) +
-                       " texels; device '" + device.name() + "' allows " +
-                       std::to_string(limits.maxTexelBufferElements) + " in a texel buffer");
-      create.usage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-      create.texel_format = VK_FORMAT_R32G32B32A32_UINT;
-    }
+    const vk::BufferCreateInfo create =
+        binding_buffer(binding, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, name);
+    if (create.texel_format != VK_FORMAT_UNDEFINED && size / 16 > limits.maxTexelBufferElements)
+      throw GpuError(std::string("the scene's ") + name + " take " + std::to_string(size / 16) +
+                     " texels; device '" + device.name() + "' allows " +
+                     std::to_string(limits.maxTexelBufferElements) + " in a texel buffer");
     buffers[binding] = vk::Buffer(device, create);
     uploader.upload(buffers[binding], data);
   };
@@ -425,11 +445,10 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   uploader.flush(commands);
 
   for (const int binding : kAccumulators)
-    buffers[binding] = vk::Buffer(device, {.size = layer_bytes,
-                                           .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                           .name = "accumulator"});
+    buffers[binding] = vk::Buffer(
+        device, binding_buffer(binding, layer_bytes,
+                               VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                               "accumulator"));
   const auto scratch = [&](int binding, VkDeviceSize size, const char *name) {
     buffers[binding] = vk::Buffer(device, {.size = size,
                                            .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -452,10 +471,9 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
                                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                                     .name = "adaptive queue bins"});
   for (const int binding : kOutputs)
-    buffers[binding] = vk::Buffer(
-        device, {.size = layer_bytes,
-                 .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                 .name = "output layer"});
+    buffers[binding] =
+        vk::Buffer(device, binding_buffer(binding, layer_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                          "output layer"));
   buffers[BINDING_OUT_DISPLAY] = vk::Buffer(
       device, {.size = pixels * sizeof(std::uint32_t),
                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
