@@ -93,7 +93,8 @@ layout(std430, binding = BINDING_QUEUE_BINS) buffer QueueBins { uint queue_bins[
 // known, and the tracer has no use for them.
 #if defined(CAMHEAD_WRITES_PLATE) || defined(CAMHEAD_READS_COMPOSITE)
 layout(std140, binding = BINDING_VIDEO) uniform Video { VideoFrames video; };
-layout(std430, binding = BINDING_VIDEO_IN) readonly buffer VideoIn { uint video_in[]; };
+// The camera frame's words, one fetch each (a texel buffer as above).
+layout(binding = BINDING_VIDEO_IN) uniform usamplerBuffer video_in_words;
 layout(std430, binding = BINDING_VIDEO_OUT) writeonly buffer VideoOut { uint video_out[]; };
 #endif
 

@@ -194,7 +194,8 @@ struct AdaptiveSolution {
   uvec4 rays;
 };
 
-// Video frame formats (base/video_format.h), VideoParams.format.x.
+// Video frame formats (base/video_format.h), VideoParams.format.x and the
+// video kernels' VIDEO_FORMAT.
 #define VIDEO_YUYV 0u
 #define VIDEO_NV12 1u
 #define VIDEO_RGB24 2u

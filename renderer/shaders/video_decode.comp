@@ -9,8 +9,14 @@
 
 layout(local_size_x = VIDEO_LOCAL_SIZE, local_size_y = VIDEO_LOCAL_SIZE) in;
 
+// The camera frame's format (VIDEO_*, layout.h), one pipeline per format:
+// lavapipe runs both sides of every branch, so a run-time switch would
+// decode each pixel in all five.
+layout(constant_id = 1) const uint VIDEO_FORMAT = VIDEO_YUYV;
+
 uint byte_in(uint first_word, uint offset) {
-  return (video_in[first_word + offset / 4u] >> (8u * (offset % 4u))) & 0xffu;
+  uint word = texelFetch(video_in_words, int(first_word + offset / 4u)).x;
+  return (word >> (8u * (offset % 4u))) & 0xffu;
 }
 
 vec3 ycbcr(VideoParams f, uint y, uint cb, uint cr) {
@@ -34,14 +40,14 @@ void main() {
     for (uint dx = 0u; dx < 4u; ++dx) {
       uint x = x0 + dx;
       vec3 rgb;
-      if (f.format.x == VIDEO_YUYV) {
+      if (VIDEO_FORMAT == VIDEO_YUYV) {
         uint pair = row + 4u * (x / 2u);
         rgb = ycbcr(f, byte_in(base, pair + 2u * (x % 2u)), byte_in(base, pair + 1u),
                     byte_in(base, pair + 3u));
-      } else if (f.format.x == VIDEO_NV12) {
+      } else if (VIDEO_FORMAT == VIDEO_NV12) {
         uint chroma = stride * f.size.y + (y / 2u) * stride + 2u * (x / 2u);
         rgb = ycbcr(f, byte_in(base, row + x), byte_in(base, chroma), byte_in(base, chroma + 1u));
-      } else if (f.format.x == VIDEO_XRGB8888) {
+      } else if (VIDEO_FORMAT == VIDEO_XRGB8888) {
         uint p = row + 4u * x; // B G R X
         rgb = video_rgb_codes_to_linear(vec3(float(byte_in(base, p + 2u)),
                                              float(byte_in(base, p + 1u)), float(byte_in(base, p))));
@@ -49,7 +55,7 @@ void main() {
         uint p = row + 3u * x;
         vec3 codes = vec3(float(byte_in(base, p)), float(byte_in(base, p + 1u)),
                           float(byte_in(base, p + 2u)));
-        rgb = video_rgb_codes_to_linear(f.format.x == VIDEO_BGR24 ? codes.zyx : codes);
+        rgb = video_rgb_codes_to_linear(VIDEO_FORMAT == VIDEO_BGR24 ? codes.zyx : codes);
       }
       imageStore(plate, int(y * width + x), vec4(rgb, 0.0f));
     }

@@ -10,6 +10,11 @@
 
 layout(local_size_x = VIDEO_LOCAL_SIZE, local_size_y = VIDEO_LOCAL_SIZE) in;
 
+// The output's format (VIDEO_*, layout.h), one pipeline per format and a
+// dispatch per output: lavapipe runs both sides of every branch, so a
+// run-time switch would encode each block in all five.
+layout(constant_id = 1) const uint VIDEO_FORMAT = VIDEO_YUYV;
+
 uint pack4(uint a, uint b, uint c, uint d) {
   return a | (b << 8u) | (c << 16u) | (d << 24u);
 }
@@ -36,7 +41,7 @@ void main() {
     px[i] = vec3(imageLoad(out_composite, int((y0 + i / 4u) * width + x0 + i % 4u)));
   }
 
-  if (f.format.x == VIDEO_YUYV) {
+  if (VIDEO_FORMAT == VIDEO_YUYV) {
     for (uint dy = 0u; dy < 2u; ++dy) {
       for (uint pair = 0u; pair < 2u; ++pair) {
         vec3 a = video_linear_to_ypbpr(px[dy * 4u + 2u * pair], matrix);
@@ -48,7 +53,7 @@ void main() {
                   video_round_code(video_code_ycbcr(b, range).x), video_round_code(chroma.z));
       }
     }
-  } else if (f.format.x == VIDEO_NV12) {
+  } else if (VIDEO_FORMAT == VIDEO_NV12) {
     vec3 v[8];
     for (uint i = 0u; i < 8u; ++i) {
       v[i] = video_linear_to_ypbpr(px[i], matrix);
@@ -70,7 +75,7 @@ void main() {
     }
     video_out[base + (stride * f.size.y + (y0 / 2u) * stride + x0) / 4u] =
         pack4(c[0], c[1], c[2], c[3]);
-  } else if (f.format.x == VIDEO_XRGB8888) {
+  } else if (VIDEO_FORMAT == VIDEO_XRGB8888) {
     for (uint i = 0u; i < 8u; ++i) {
       vec3 codes = video_linear_to_rgb_codes(px[i]);
       video_out[base + ((y0 + i / 4u) * stride + 4u * (x0 + i % 4u)) / 4u] =
@@ -78,7 +83,7 @@ void main() {
                 255u);
     }
   } else {
-    bool bgr = f.format.x == VIDEO_BGR24;
+    bool bgr = VIDEO_FORMAT == VIDEO_BGR24;
     for (uint dy = 0u; dy < 2u; ++dy) {
       uint b[12];
       for (uint dx = 0u; dx < 4u; ++dx) {

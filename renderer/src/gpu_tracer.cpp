@@ -74,6 +74,7 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   types[BINDING_NODES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_MATERIALS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_LIGHTS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  types[BINDING_VIDEO_IN] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   for (const int binding : {BINDING_ACCUM_MIXED, BINDING_ACCUM_REAL, BINDING_ACCUM_AUX,
                             BINDING_PLATE, BINDING_OUT_COMPOSITE})
     types[std::size_t(binding)] = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER; // read per pixel
@@ -81,15 +82,17 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
 }
 
 // How a buffer at `binding` is created: its usage for that descriptor type
-// and, for a texel buffer, the format of its view (16-byte texels; the
-// scene's structures as integers, layout.h: PRIMITIVE_TEXELS and the others).
+// and, for a texel buffer, the format of its view: the camera frame's words,
+// or 16-byte texels (the scene's structures as integers, layout.h:
+// PRIMITIVE_TEXELS and the others; the per-pixel layers as floats).
 vk::BufferCreateInfo binding_buffer(int binding, VkDeviceSize size, VkBufferUsageFlags transfers,
                                     const char *name) {
   vk::BufferCreateInfo create{.size = size, .usage = transfers, .name = name};
   switch (binding_types()[std::size_t(binding)]) {
   case VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER:
     create.usage |= VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-    create.texel_format = VK_FORMAT_R32G32B32A32_UINT;
+    create.texel_format =
+        binding == BINDING_VIDEO_IN ? VK_FORMAT_R32_UINT : VK_FORMAT_R32G32B32A32_UINT;
     break;
   case VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER:
     create.usage |= VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
@@ -292,15 +295,20 @@ struct GpuTracer::Impl {
   // Dispatches `pipeline` (made with dispatch_base) over the tiles of the
   // frame's region.
   void dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
-  // Dispatches a video kernel over the whole frame, or over video_runs, with
-  // `frames` layers of workgroups (one per output).
-  void dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline, std::uint32_t frames,
+  // Dispatches a video kernel for video frame `frame` (gl_WorkGroupID.z:
+  // the output; 0 for the camera frame) over the whole frame, or over
+  // video_runs.
+  void dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline, std::uint32_t frame,
                       bool region_only) const;
   // The trace kernel built for the loaded scene and `frame`, over the pixels
   // of the image or of the queue (trace.comp, FROM_QUEUE), built on first use.
   VkPipeline trace_pipeline(const gpu::FrameParams &frame, bool from_queue = false);
   // The resolve kernel writing `layers` (RESOLVE_*), built on first use.
   VkPipeline resolve_pipeline(std::uint32_t layers);
+  // video_decode.comp or video_encode.comp for frames of `format`, built on
+  // first use.
+  VkPipeline video_pipeline(std::span<const std::uint32_t> spirv, const char *name,
+                            base::PixelFormat format);
   // `spirv` with specialization constant i = constants[i], to be dispatched
   // with a base, built on first use (a lookup allocates nothing).
   using Constants = std::array<std::uint32_t, 2>;
@@ -313,16 +321,15 @@ struct GpuTracer::Impl {
   vk::Device device;
   vk::DescriptorSet descriptors;
   vk::UniquePipelineLayout pipeline_layout;
-  // trace.comp by KERNEL_FEATURES (layout.h) and FROM_QUEUE, and
-  // resolve.comp by RESOLVE_LAYERS: by the kernel's code and its constants.
+  // trace.comp by KERNEL_FEATURES (layout.h) and FROM_QUEUE, resolve.comp by
+  // RESOLVE_LAYERS and the video kernels by VIDEO_FORMAT: by the kernel's
+  // code and its constants.
   std::map<std::pair<const std::uint32_t *, Constants>, vk::UniquePipeline> specialized_pipelines;
   vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
   vk::UniquePipeline adaptive_shares;
   vk::UniquePipeline adaptive_queue_bins;
   vk::UniquePipeline adaptive_queue_fill;
-  vk::UniquePipeline video_decode;
-  vk::UniquePipeline video_encode;
   vk::CommandRunner commands;
   vk::Buffer frame_uniform;
   vk::Buffer video_uniform;
@@ -374,14 +381,6 @@ GpuTracer::Impl::Impl(const std::string &wanted)
                                                              .spirv = adaptive_queue_fill_spv,
                                                              .name = "adaptive_queue_fill.comp",
                                                              .dispatch_base = true})),
-      video_decode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                      .spirv = video_decode_spv,
-                                                      .name = "video_decode.comp",
-                                                      .dispatch_base = true})),
-      video_encode(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                      .spirv = video_encode_spv,
-                                                      .name = "video_encode.comp",
-                                                      .dispatch_base = true})),
       commands(device), frame_uniform(device, {.size = sizeof(gpu::FrameParams),
                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                                .memory = vk::MemoryUse::upload,
@@ -480,10 +479,10 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
                .name = "display output"});
   // The camera frame is written by the host straight into memory the kernel
   // reads (no staging copy); the outputs come back through the read-back.
-  buffers[BINDING_VIDEO_IN] = vk::Buffer(device, {.size = max_video_bytes(pixels),
-                                                  .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                                  .memory = vk::MemoryUse::upload,
-                                                  .name = "camera frame"});
+  vk::BufferCreateInfo camera_frame =
+      binding_buffer(BINDING_VIDEO_IN, max_video_bytes(pixels), 0, "camera frame");
+  camera_frame.memory = vk::MemoryUse::upload;
+  buffers[BINDING_VIDEO_IN] = vk::Buffer(device, camera_frame);
   buffers[BINDING_VIDEO_OUT] = vk::Buffer(
       device, {.size = VIDEO_MAX_OUTPUTS * max_video_bytes(pixels),
                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -534,6 +533,11 @@ VkPipeline GpuTracer::Impl::resolve_pipeline(std::uint32_t layers) {
   return specialized(resolve_spv, "resolve.comp", {KERNEL_ALL, layers});
 }
 
+VkPipeline GpuTracer::Impl::video_pipeline(std::span<const std::uint32_t> spirv, const char *name,
+                                           base::PixelFormat format) {
+  return specialized(spirv, name, {KERNEL_ALL, video_format_code(format)});
+}
+
 void GpuTracer::Impl::bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
   vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   const VkDescriptorSet set = descriptors.get();
@@ -550,15 +554,15 @@ void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline
 }
 
 void GpuTracer::Impl::dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline,
-                                     std::uint32_t frames, bool region_only) const {
+                                     std::uint32_t frame, bool region_only) const {
   bind(command_buffer, pipeline);
   if (!region_only) {
-    vkCmdDispatch(command_buffer, (width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
-                  (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y, frames);
+    vkCmdDispatchBase(command_buffer, 0, 0, frame, (width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
+                      (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y, 1);
     return;
   }
   for (const GroupRun &run : video_runs)
-    vkCmdDispatchBase(command_buffer, run.x, run.y, 0, run.count, 1, frames);
+    vkCmdDispatchBase(command_buffer, run.x, run.y, frame, run.count, 1, 1);
 }
 
 void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
@@ -644,13 +648,21 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   const VkDeviceSize solution_offset = counts_offset + counts_bytes;
   const VkDeviceSize video_offset = solution_offset + sizeof(gpu::AdaptiveSolution);
 
+  const VkPipeline decode = decode_plate ? video_pipeline(video_decode_spv, "video_decode.comp",
+                                                          video->plate.format.pixel)
+                                         : VK_NULL_HANDLE;
+  std::array<VkPipeline, VIDEO_MAX_OUTPUTS> encode{};
+  for (std::size_t k = 0; k < video_outputs; ++k)
+    encode[k] =
+        video_pipeline(video_encode_spv, "video_encode.comp", video->outputs[k].format.pixel);
+
   // The frame's first commands: the clear, and the first timestamp.
   const auto begin_frame = [&](VkCommandBuffer command_buffer) {
     timestamps.reset(command_buffer);
     timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
     record_clear(command_buffer);
     if (decode_plate) {
-      dispatch_video(command_buffer, video_decode.get(), 1, region_video);
+      dispatch_video(command_buffer, decode, 0, region_video);
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_READ_BIT);
@@ -676,8 +688,8 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_READ_BIT);
-      dispatch_video(command_buffer, video_encode.get(), std::uint32_t(video_outputs),
-                     region_video);
+      for (std::size_t k = 0; k < video_outputs; ++k)
+        dispatch_video(command_buffer, encode[k], std::uint32_t(k), region_video);
     }
     vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,

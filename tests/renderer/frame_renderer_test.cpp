@@ -4,6 +4,7 @@
 // format, or within one code value where the formats differ (4:2:2 to 4:2:0
 // halves the vertical chroma: a mean of two codes rounds).
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdlib>
 #include <random>
@@ -315,6 +316,41 @@ TEST(FrameExecutors, GpuAndCpuGiveTheSameCodes) {
     EXPECT_LE(worst, 1) << base::pixel_format_name(pixel);
     EXPECT_LT(differ, a.size() / 100) << base::pixel_format_name(pixel) << ": " << differ << " of "
                                       << a.size() << " bytes differ";
+  }
+}
+
+// A frame for several outputs writes each in its own format, exactly as a
+// frame for that output alone (the GPU encodes them one dispatch each).
+TEST(FrameExecutors, EachOutputOfAFrameIsItsOwnFormat) {
+  const int w = 96, h = 64;
+  const Scene scene = scene_with_ball(w, h, {-0.2f, 0.1f, -2.5f});
+  for (const Executor e : {Executor::cpu, Executor::gpu}) {
+    auto renderer = make_renderer(e, scene);
+    if (!renderer)
+      continue;
+    const VideoFormat in = format(PixelFormat::yuyv, w, h);
+    const std::vector<std::uint8_t> plate = noise_frame(in, 5);
+    const std::array<PixelFormat, 3> pixels = {PixelFormat::nv12, PixelFormat::xrgb8888,
+                                               PixelFormat::bgr24};
+    std::vector<std::vector<std::uint8_t>> together;
+    std::vector<VideoBuffer> targets;
+    for (const PixelFormat pixel : pixels)
+      together.emplace_back(base::frame_bytes(format(pixel, w, h)), 0xAB);
+    for (std::size_t k = 0; k < pixels.size(); ++k)
+      targets.push_back({format(pixels[k], w, h), together[k]});
+    FrameRequest request;
+    request.camera = scene_camera(scene);
+    request.rays_per_pixel = 4;
+    const FrameReport report = renderer->render(request, {in, plate}, targets);
+    ASSERT_EQ(report.status, FrameStatus::ok) << report.detail;
+    for (std::size_t k = 0; k < pixels.size(); ++k) {
+      std::vector<std::uint8_t> alone(together[k].size(), 0xAB);
+      const VideoBuffer target{targets[k].format, alone};
+      ASSERT_EQ(renderer->render(request, {in, plate}, std::span(&target, 1)).status,
+                FrameStatus::ok);
+      EXPECT_TRUE(together[k] == alone)
+          << (e == Executor::cpu ? "cpu " : "gpu ") << base::pixel_format_name(pixels[k]);
+    }
   }
 }
 
