@@ -14,6 +14,55 @@ std::string describe(const char *call, const char *object, VkDeviceSize size) {
   return std::string(call) + " (" + object + ", " + std::to_string(size) + " bytes)";
 }
 
+// Refuses a layout of `types` that a compute shader of `device` may not see
+// at once (a small GPU allows as few as 4 storage images), naming the limit:
+// past it, creating the pipeline layout is invalid use, not an error code.
+void check_per_stage_limits(const Device &device, std::span<const VkDescriptorType> types) {
+  const VkPhysicalDeviceLimits &limits = device.limits();
+  struct Kind {
+    const char *what;
+    const char *limit;
+    std::uint32_t allowed;
+    std::uint32_t used = 0;
+  };
+  std::array<Kind, 4> kinds = {{
+      {"storage buffers", "maxPerStageDescriptorStorageBuffers",
+       limits.maxPerStageDescriptorStorageBuffers},
+      {"uniform buffers", "maxPerStageDescriptorUniformBuffers",
+       limits.maxPerStageDescriptorUniformBuffers},
+      {"uniform texel buffers", "maxPerStageDescriptorSampledImages",
+       limits.maxPerStageDescriptorSampledImages},
+      {"storage texel buffers", "maxPerStageDescriptorStorageImages",
+       limits.maxPerStageDescriptorStorageImages},
+  }};
+  for (const VkDescriptorType type : types)
+    switch (type) {
+    case VK_DESCRIPTOR_TYPE_STORAGE_BUFFER:
+      ++kinds[0].used;
+      break;
+    case VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER:
+      ++kinds[1].used;
+      break;
+    case VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER:
+      ++kinds[2].used;
+      break;
+    case VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER:
+      ++kinds[3].used;
+      break;
+    default:
+      throw GpuError("descriptor type " + std::to_string(int(type)) + " is not one camhead uses");
+    }
+  for (const Kind &kind : kinds)
+    if (kind.used > kind.allowed)
+      throw GpuError("the kernels bind " + std::to_string(kind.used) + " " + kind.what +
+                     "; device '" + device.name() + "' allows " + std::to_string(kind.allowed) +
+                     " (" + kind.limit + ")");
+  if (types.size() > limits.maxPerStageResources)
+    throw GpuError("the kernels bind " + std::to_string(types.size()) + " resources; device '" +
+                   device.name() + "' allows " + std::to_string(limits.maxPerStageResources) +
+                   " (maxPerStageResources)");
+}
+
 } // namespace
 
 // ---------------------------------------------------------------------------
@@ -199,6 +248,7 @@ void Uploader::flush(CommandRunner &commands) {
 
 DescriptorSet::DescriptorSet(const Device &device, std::span<const VkDescriptorType> types)
     : device_(&device), types_(types.begin(), types.end()) {
+  check_per_stage_limits(device, types);
   std::vector<VkDescriptorSetLayoutBinding> bindings;
   std::vector<VkDescriptorPoolSize> pool_sizes;
   for (std::uint32_t binding = 0; binding < types_.size(); ++binding) {
