@@ -16,8 +16,9 @@ layout(constant_id = 0) const uint KERNEL_FEATURES = KERNEL_ALL; // layout.h
 // time, in a loop that inserts each word into the vector through the stack
 // (lp_bld_nir_soa.c, emit_load_mem). A texel fetch is a gather. On an AMD
 // Zen 3 every insert also stalls on store forwarding; the loop took half of
-// a frame there (bench/RESULTS.md, "Where lavapipe's time goes"). Integer
-// texels keep the bits of the integers that .w holds exactly.
+// a frame there (bench/RESULTS.md, "Where lavapipe's time goes" and
+// "lavapipe on the AMD EPYC"). Integer texels keep the bits of the integers
+// that .w holds exactly.
 layout(binding = BINDING_PRIMITIVES) uniform usamplerBuffer primitive_texels;
 layout(binding = BINDING_NODES) uniform usamplerBuffer node_texels;
 layout(binding = BINDING_MATERIALS) uniform usamplerBuffer material_texels;
