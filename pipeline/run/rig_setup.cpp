@@ -91,19 +91,32 @@ private:
   std::size_t used_ = 0;
 };
 
+// The simulated world's renderer, whatever executor the pipeline has: the
+// camera stands in for hardware, not for the pipeline's work. Its frames are
+// whole (every pixel at the camera's samples), which the Vulkan tracer
+// renders faster than the CPU reference even on lavapipe; with the CPU
+// reference compositing, the rig's first half minute went from 5-6 to 15
+// frames a second out (bench/RESULTS.md, "lavapipe on the AMD EPYC").
+// Without a Vulkan device, the CPU reference on `threads`.
+std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Scene &world,
+                                                             int threads) {
+  try {
+    return renderer::make_gpu_frame_renderer(world);
+  } catch (const renderer::GpuError &) {
+    return renderer::make_cpu_frame_renderer(world, threads);
+  }
+}
+
 // The simulated camera's picture: the scene's real objects through the lens
 // at each exposure's middle, rendered by its own frame renderer, with a new
 // noise pattern every frame as a sensor has. The lens is the physical truth
 // where the board's trace gives it (trace_lens.h), else what the lens chain
 // says.
-std::unique_ptr<CameraSource> open_sim_camera(const SimCameraConfig &sim,
-                                              const base::VideoFormat &format,
-                                              const renderer::Scene &scene,
-                                              const renderer::FrameCamera &pose,
-                                              const LensHub &lens, std::optional<TraceLens> truth,
-                                              Executor executor, int threads) {
-  auto world = std::shared_ptr<renderer::FrameRenderer>(
-      make_renderer(executor, real_world_of(scene), threads));
+std::unique_ptr<CameraSource>
+open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
+                const renderer::Scene &scene, const renderer::FrameCamera &pose,
+                const LensHub &lens, std::optional<TraceLens> truth, int threads) {
+  auto world = make_world_renderer(real_world_of(scene), threads);
   hal::camera::SimulatedCameraOptions options;
   options.format = format;
   options.fps = sim.fps;
@@ -176,15 +189,14 @@ std::unique_ptr<renderer::FrameRenderer> make_renderer(Executor executor,
 
 std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Scene &scene,
                                           const renderer::FrameCamera &pose, const LensHub &lens,
-                                          Executor executor, int threads) {
+                                          int threads) {
   const CameraConfig &c = *board.camera;
   base::VideoFormat format;
   format.pixel = c.format;
   format.width = c.width;
   format.height = c.height;
   if (const auto *sim = std::get_if<SimCameraConfig>(&c.kind))
-    return open_sim_camera(*sim, format, scene, pose, lens, TraceLens::of_board(board), executor,
-                           threads);
+    return open_sim_camera(*sim, format, scene, pose, lens, TraceLens::of_board(board), threads);
   if (const auto *v4l2 = std::get_if<V4l2CameraConfig>(&c.kind))
     return hal::camera::open_v4l2_camera({.device = v4l2->device,
                                           .format = c.format,

@@ -31,11 +31,12 @@ namespace camhead::pipeline {
 [[nodiscard]] std::unique_ptr<renderer::FrameRenderer>
 make_renderer(Executor executor, const renderer::Scene &scene, int threads);
 
-// The board's camera. The simulated one renders the scene's real objects on
-// `executor` through the lens at each exposure (trace_lens.h, or `lens`).
+// The board's camera. The simulated one renders the scene's real objects
+// through the lens at each exposure (trace_lens.h, or `lens`) with Vulkan,
+// or without a Vulkan device on `threads` of the CPU reference.
 [[nodiscard]] std::unique_ptr<hal::camera::CameraSource>
 open_camera(const Board &board, const renderer::Scene &scene, const renderer::FrameCamera &pose,
-            const LensHub &lens, Executor executor, int threads);
+            const LensHub &lens, int threads);
 
 // The camera's rate, 25 where it does not say.
 [[nodiscard]] double camera_fps(const hal::camera::CameraSource &camera);

@@ -132,7 +132,7 @@ Pipeline::Pipeline(const RunOptions &options)
       executor_(choose_executor(options.executor.value_or(board_.render.executor))),
       scene_(load_run_scene(board_)), pose_(base_camera(board_, scene_)),
       renderer_(make_renderer(executor_, scene_, options.threads)), lens_(board_),
-      camera_(open_camera(board_, scene_, pose_, lens_, executor_, options.threads)),
+      camera_(open_camera(board_, scene_, pose_, lens_, options.threads)),
       fps_(camera_fps(*camera_)), executor_name_(renderer_->executor()) {
   const std::vector<OutputSpec> specs = output_specs(options);
   for (const OutputSpec &spec : specs)
