@@ -97,14 +97,16 @@ private:
 // renders faster than the CPU reference even on lavapipe; with the CPU
 // reference compositing, the rig's first half minute went from 5-6 to 15
 // frames a second out (bench/RESULTS.md, "lavapipe on the AMD EPYC").
-// Without a Vulkan device, the CPU reference on `threads`.
+// Without a Vulkan device, or for a frame the Vulkan one does not take (a
+// width that is not a multiple of 4), the CPU reference on `threads`.
 std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Scene &world,
                                                              int threads) {
   try {
     return renderer::make_gpu_frame_renderer(world);
   } catch (const renderer::GpuError &) {
-    return renderer::make_cpu_frame_renderer(world, threads);
+  } catch (const std::invalid_argument &) {
   }
+  return renderer::make_cpu_frame_renderer(world, threads);
 }
 
 // The simulated camera's picture: the scene's real objects through the lens
