@@ -185,6 +185,11 @@ struct FrameParams {
 // A queue's workgroups are laid out in rows of this many (the y count stays
 // far below the 65535 that every device allows).
 #define QUEUE_ROW_GROUPS 1024u
+// The bin of a second-pass share of `samples` in a frame of `pilot` samples
+// a pixel and a cap of `cap`: bins of equal width cover the shares 1 ..
+// cap - pilot, one share to a bin up to QUEUE_BINS - 1 of them. The kernels
+// and the host (choosing a batch's indirect dispatch) use the same.
+#define QUEUE_BIN(samples, pilot, cap) ((samples) / (((cap) - (pilot)) / QUEUE_BINS + 1u))
 
 // The water level of the adaptive allocation and the rays it gave out.
 //   solution: x lambda, y floor weight, z expected total samples

@@ -3,16 +3,13 @@
 // pixel an invocation of a second-pass batch traces.
 //
 // Expects: frame (FrameParams of the second pass: tracing.y the pilot,
-// adaptive.y the cap), queue_bins[], sample_queue[]. The host computes the
-// same bin to choose a batch's indirect dispatch (gpu_tracer.cpp, queue_bin).
+// adaptive.y the cap), queue_bins[], sample_queue[].
 #ifndef CAMHEAD_SAMPLE_QUEUE_GLSL
 #define CAMHEAD_SAMPLE_QUEUE_GLSL
 
-// Second-pass shares run from 1 to cap - pilot; bins of equal width cover
-// them, one share to a bin up to QUEUE_BINS - 1 of them.
+// The bin of this frame's second-pass share `second_pass_samples` (layout.h).
 uint queue_bin(uint second_pass_samples) {
-  uint width = (uint(frame.adaptive.y) - frame.tracing.y) / QUEUE_BINS + 1u;
-  return second_pass_samples / width;
+  return QUEUE_BIN(second_pass_samples, frame.tracing.y, uint(frame.adaptive.y));
 }
 
 uint greatest_common_divisor(uint a, uint b) {

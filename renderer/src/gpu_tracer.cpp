@@ -133,12 +133,6 @@ std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
   return features;
 }
 
-// The bin of a second-pass share of `samples` in a frame of `pilot` samples
-// and `cap` (sample_queue.glsl, queue_bin: the same integer arithmetic).
-std::uint32_t queue_bin(std::uint32_t samples, std::uint32_t pilot, std::uint32_t cap) {
-  return samples / ((cap - pilot) / QUEUE_BINS + 1u);
-}
-
 template <typename T> std::span<const std::byte> bytes_of(const std::vector<T> &values) {
   return std::as_bytes(std::span(values));
 }
@@ -422,13 +416,8 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   const auto upload = [&](int binding, std::span<const std::byte> data, std::size_t element,
                           const char *name) {
     const VkDeviceSize size = std::max<VkDeviceSize>(data.size(), element);
-    const vk::BufferCreateInfo create =
-        binding_buffer(binding, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, name);
-    if (create.texel_format != VK_FORMAT_UNDEFINED && size / 16 > limits.maxTexelBufferElements)
-      throw GpuError(std::string("the scene's ") + name + " take " + std::to_string(size / 16) +
-                     " texels; device '" + device.name() + "' allows " +
-                     std::to_string(limits.maxTexelBufferElements) + " in a texel buffer");
-    buffers[binding] = vk::Buffer(device, create);
+    buffers[binding] =
+        vk::Buffer(device, binding_buffer(binding, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, name));
     uploader.upload(buffers[binding], data);
   };
   upload(BINDING_PRIMITIVES, bytes_of(scene.primitives), sizeof(gpu::Primitive), "primitives");
@@ -858,7 +847,7 @@ void GpuTracer::Impl::record_queue_batch(VkCommandBuffer command_buffer,
                                          const gpu::FrameParams &frame) {
   bind(command_buffer, trace_pipeline(frame, true));
   const std::uint32_t bin =
-      queue_bin(frame.sampling.x + 1u, frame.tracing.y, std::uint32_t(frame.adaptive.y));
+      QUEUE_BIN(frame.sampling.x + 1u, frame.tracing.y, std::uint32_t(frame.adaptive.y));
   vk::dispatch_indirect(device, command_buffer, buffers[BINDING_QUEUE_BINS].get(),
                         (QUEUE_DISPATCH + 4u * bin) * sizeof(std::uint32_t));
 }

@@ -189,7 +189,8 @@ struct BufferCreateInfo {
   MemoryUse memory = MemoryUse::device_local;
   const char *name = "buffer"; // for error messages
   // Set for a texel buffer (usage includes a texel buffer bit): the buffer
-  // gets a view of its whole range in this format.
+  // gets a view of its whole range in this format. More texels than the
+  // device's maxTexelBufferElements throw GpuError, naming the buffer.
   VkFormat texel_format = VK_FORMAT_UNDEFINED;
 };
 

@@ -63,6 +63,19 @@ void check_per_stage_limits(const Device &device, std::span<const VkDescriptorTy
                    " (maxPerStageResources)");
 }
 
+// Bytes per texel of the texel-buffer views camhead makes.
+VkDeviceSize texel_bytes(VkFormat format) {
+  switch (format) {
+  case VK_FORMAT_R32_UINT:
+    return 4;
+  case VK_FORMAT_R32G32B32A32_UINT:
+  case VK_FORMAT_R32G32B32A32_SFLOAT:
+    return 16;
+  default:
+    throw GpuError("texel format " + std::to_string(int(format)) + " is not one camhead uses");
+  }
+}
+
 } // namespace
 
 // ---------------------------------------------------------------------------
@@ -71,6 +84,14 @@ void check_per_stage_limits(const Device &device, std::span<const VkDescriptorTy
 Buffer::Buffer(const Device &device, const BufferCreateInfo &info) : size_(info.size) {
   if (info.size == 0)
     throw GpuError(std::string("zero-size Vulkan buffer '") + info.name + "'");
+  if (info.texel_format != VK_FORMAT_UNDEFINED) {
+    const VkDeviceSize texels = info.size / texel_bytes(info.texel_format);
+    if (texels > device.limits().maxTexelBufferElements)
+      throw GpuError(std::string("the ") + info.name + " take " + std::to_string(texels) +
+                     " texels; device '" + device.name() + "' allows " +
+                     std::to_string(device.limits().maxTexelBufferElements) +
+                     " in a texel buffer (maxTexelBufferElements)");
+  }
 
   VkBufferCreateInfo create{};
   create.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
