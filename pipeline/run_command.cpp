@@ -11,6 +11,7 @@
 
 #include "board.h"
 #include "camhead/lens_control/lens_profile.h"
+#include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "commands.h"
 #include "run/run_loop.h"
@@ -82,6 +83,12 @@ int run(const RunArgs &args) {
   } catch (const lens_control::ProfileError &e) {
     std::fprintf(stderr, "lens profile error: %s\n", e.what());
     status = 2;
+  } catch (const renderer::GpuError &e) {
+    std::fprintf(stderr,
+                 "camhead run: Vulkan error: %s\n(--executor cpu renders with the CPU reference "
+                 "instead)\n",
+                 e.what());
+    status = 3;
   } catch (const std::exception &e) {
     std::fprintf(stderr, "camhead run: %s\n", e.what());
     status = 3;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -98,14 +99,22 @@ private:
 // reference compositing, the rig's first half minute went from 5-6 to 15
 // frames a second out (bench/RESULTS.md, "lavapipe on the AMD EPYC").
 // Without a Vulkan device, or for a frame the Vulkan one does not take (a
-// width that is not a multiple of 4), the CPU reference on `threads`.
+// width that is not a multiple of 4), the CPU reference on `threads`, and
+// the user is told why: it makes the rig's first loop slower.
 std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Scene &world,
                                                              int threads) {
+  std::string why;
   try {
     return renderer::make_gpu_frame_renderer(world);
-  } catch (const renderer::GpuError &) {
-  } catch (const std::invalid_argument &) {
+  } catch (const renderer::GpuError &e) {
+    why = e.what();
+  } catch (const std::invalid_argument &e) {
+    why = e.what();
   }
+  std::fprintf(stderr,
+               "camhead run: the simulated camera renders its world on the CPU reference, not "
+               "Vulkan: %s\n",
+               why.c_str());
   return renderer::make_cpu_frame_renderer(world, threads);
 }
 

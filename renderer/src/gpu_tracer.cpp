@@ -125,6 +125,33 @@ std::uint32_t scene_kernel_features(const CompiledScene &scene) {
 }
 
 // ... and those `frame` asks for.
+// Refuses an image whose per-pixel layers or dispatch grid `device` cannot
+// hold, naming the limit; past one, the buffers or dispatches would be
+// invalid use rather than an error Vulkan reports.
+void check_image_limits(const vk::Device &device, int width, int height) {
+  const VkPhysicalDeviceLimits &limits = device.limits();
+  const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+  const auto refuse = [&](const std::string &what, std::uint64_t allowed, const char *limit) {
+    throw GpuError("image " + std::to_string(width) + "x" + std::to_string(height) + " " + what +
+                   "; device '" + device.name() + "' allows " + std::to_string(allowed) + " (" +
+                   limit + ")");
+  };
+  if (pixels > limits.maxTexelBufferElements)
+    refuse("has " + std::to_string(pixels) + " pixels, a texel each in its layers",
+           limits.maxTexelBufferElements, "maxTexelBufferElements");
+  if (pixels * sizeof(gpu::vec4) > limits.maxStorageBufferRange)
+    refuse("takes " + std::to_string(pixels * sizeof(gpu::vec4)) + " bytes a layer",
+           limits.maxStorageBufferRange, "maxStorageBufferRange");
+  const std::uint32_t tiles_x = std::uint32_t(width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X;
+  const std::uint32_t tiles_y = std::uint32_t(height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y;
+  if (tiles_x > limits.maxComputeWorkGroupCount[0])
+    refuse("is " + std::to_string(tiles_x) + " workgroups wide", limits.maxComputeWorkGroupCount[0],
+           "maxComputeWorkGroupCount[0]");
+  if (tiles_y > limits.maxComputeWorkGroupCount[1])
+    refuse("is " + std::to_string(tiles_y) + " workgroups high", limits.maxComputeWorkGroupCount[1],
+           "maxComputeWorkGroupCount[1]");
+}
+
 std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
   std::uint32_t features =
       frame.tracing.z == SAMPLER_SOBOL ? KERNEL_CAMERA_SOBOL : KERNEL_CAMERA_CMJ;
@@ -396,16 +423,8 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   if (!scene.plate.empty() && scene.plate.size() != pixels)
     throw GpuError("GpuTracer::load: plate has " + std::to_string(scene.plate.size()) +
                    " pixels, the image " + std::to_string(pixels));
+  check_image_limits(device, scene.width, scene.height);
   const VkDeviceSize layer_bytes = pixels * sizeof(gpu::vec4);
-  const VkPhysicalDeviceLimits &limits = device.limits();
-  if (layer_bytes > limits.maxStorageBufferRange || pixels > limits.maxTexelBufferElements ||
-      std::uint32_t(scene.width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X >
-          limits.maxComputeWorkGroupCount[0] ||
-      std::uint32_t(scene.height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y >
-          limits.maxComputeWorkGroupCount[1])
-    throw GpuError("image " + std::to_string(scene.width) + "x" + std::to_string(scene.height) +
-                   " exceeds the storage buffer, texel buffer or dispatch limits of device '" +
-                   device.name() + "'");
 
   loaded = false; // until every buffer below exists
   vk::Uploader uploader(device);
