@@ -133,8 +133,9 @@ void add_run_command(CLI::App &app) {
                   "exposure-middle and output times, the lens state, rays per pixel, drops\n"
                   "and each stage's time");
   cmd->add_option("--executor", args->executor,
-                  "auto (the board's default: a hardware GPU if there is one, else the CPU\n"
-                  "reference), cpu, or gpu (the Vulkan tracer, lavapipe included)")
+                  "auto (the board's default: a hardware GPU if there is one that takes the\n"
+                  "scene, else the CPU reference), cpu, or gpu (the Vulkan tracer, lavapipe\n"
+                  "included)")
       ->check(CLI::IsMember({"auto", "cpu", "gpu"}));
   cmd->add_option("--threads", args->threads, "CPU executor threads (0: one per core)")
       ->check(CLI::Range(0, 256));

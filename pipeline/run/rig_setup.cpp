@@ -178,23 +178,32 @@ renderer::FrameCamera base_camera(const Board &board, const renderer::Scene &sce
   return camera;
 }
 
-Executor choose_executor(Executor wanted) {
-  if (wanted != Executor::automatic)
-    return wanted;
+namespace {
+
+bool has_hardware_gpu() {
   try {
     for (const renderer::GpuDeviceInfo &device : renderer::list_gpu_devices())
       if (device.type == "discrete" || device.type == "integrated")
-        return Executor::gpu;
+        return true;
   } catch (const std::exception &) {
-    // No Vulkan at all: the CPU it is.
+    // No Vulkan at all.
   }
-  return Executor::cpu;
+  return false;
 }
 
-std::unique_ptr<renderer::FrameRenderer> make_renderer(Executor executor,
+} // namespace
+
+std::unique_ptr<renderer::FrameRenderer> make_renderer(Executor wanted,
                                                        const renderer::Scene &scene, int threads) {
-  if (executor == Executor::gpu)
+  if (wanted == Executor::gpu)
     return renderer::make_gpu_frame_renderer(scene);
+  if (wanted == Executor::automatic && has_hardware_gpu()) {
+    try {
+      return renderer::make_gpu_frame_renderer(scene);
+    } catch (const renderer::GpuError &e) {
+      std::fprintf(stderr, "camhead run: the CPU reference renders, not Vulkan: %s\n", e.what());
+    }
+  }
   return renderer::make_cpu_frame_renderer(scene, threads);
 }
 

@@ -23,13 +23,13 @@ namespace camhead::pipeline {
 // The scene's camera moved to the board's pose, on the camera's sensor.
 [[nodiscard]] renderer::FrameCamera base_camera(const Board &board, const renderer::Scene &scene);
 
-// `automatic` resolved: a hardware GPU where there is one; without one the
-// CPU reference, 2-5x faster than lavapipe on the same cores
-// (bench/RESULTS.md).
-[[nodiscard]] Executor choose_executor(Executor wanted);
-
+// The live frame's renderer. `automatic` is a hardware GPU where there is
+// one that takes the scene, else the CPU reference: on the same cores it
+// renders a live frame over the influence region faster than lavapipe
+// (bench/RESULTS.md, "The live frame"). A GPU asked for by name that cannot
+// take the scene is an error (GpuError); `automatic` says why it fell back.
 [[nodiscard]] std::unique_ptr<renderer::FrameRenderer>
-make_renderer(Executor executor, const renderer::Scene &scene, int threads);
+make_renderer(Executor wanted, const renderer::Scene &scene, int threads);
 
 // The board's camera. The simulated one renders the scene's real objects
 // through the lens at each exposure (trace_lens.h, or `lens`) with Vulkan,

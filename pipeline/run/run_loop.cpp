@@ -84,7 +84,6 @@ private:
 
   const RunOptions &options_;
   const Board &board_;
-  const Executor executor_;
   const renderer::Scene scene_;
   const renderer::FrameCamera pose_;
   std::unique_ptr<renderer::FrameRenderer> renderer_;
@@ -128,11 +127,11 @@ const Board &checked_board(const RunOptions &options) {
 // Everything that can fail is opened here, before the first frame, and the
 // outputs last (a file output is only created once the rest stands).
 Pipeline::Pipeline(const RunOptions &options)
-    : options_(options), board_(checked_board(options)),
-      executor_(choose_executor(options.executor.value_or(board_.render.executor))),
-      scene_(load_run_scene(board_)), pose_(base_camera(board_, scene_)),
-      renderer_(make_renderer(executor_, scene_, options.threads)), lens_(board_),
-      camera_(open_camera(board_, scene_, pose_, lens_, options.threads)),
+    : options_(options), board_(checked_board(options)), scene_(load_run_scene(board_)),
+      pose_(base_camera(board_, scene_)),
+      renderer_(make_renderer(options.executor.value_or(board_.render.executor), scene_,
+                              options.threads)),
+      lens_(board_), camera_(open_camera(board_, scene_, pose_, lens_, options.threads)),
       fps_(camera_fps(*camera_)), executor_name_(renderer_->executor()) {
   const std::vector<OutputSpec> specs = output_specs(options);
   for (const OutputSpec &spec : specs)

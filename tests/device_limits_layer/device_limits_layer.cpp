@@ -3,7 +3,8 @@
 //
 //   CAMHEAD_TEST_DEVICE_LIMITS=maxPerStageDescriptorStorageImages=4
 //
-// so that what camhead does on a smaller GPU than the one at hand (refuse,
+// and, with CAMHEAD_TEST_DEVICE_TYPE=integrated, reported as a hardware
+// GPU. So what camhead does on a smaller GPU than the one at hand (refuse,
 // naming the limit, or fall back) is tested through the real driver and the
 // real loader, not through a fake device. Only the properties a program
 // reads change; the driver is not told, so a program that ignores a lowered
@@ -18,6 +19,7 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -103,29 +105,49 @@ std::vector<std::pair<std::uint32_t VkPhysicalDeviceLimits::*, std::uint32_t>> l
   return lowered;
 }
 
-void lower(VkPhysicalDeviceLimits &limits) {
+// CAMHEAD_TEST_DEVICE_TYPE=integrated|discrete: lavapipe passed off as a
+// hardware GPU, for what camhead chooses on a machine with one.
+std::optional<VkPhysicalDeviceType> device_type() {
+  const char *type = std::getenv("CAMHEAD_TEST_DEVICE_TYPE");
+  if (type == nullptr)
+    return std::nullopt;
+  if (std::strcmp(type, "integrated") == 0)
+    return VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU;
+  if (std::strcmp(type, "discrete") == 0)
+    return VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU;
+  std::fprintf(stderr,
+               "VK_LAYER_CAMHEAD_device_limits: CAMHEAD_TEST_DEVICE_TYPE: '%s' is not "
+               "integrated or discrete\n",
+               type);
+  std::abort();
+}
+
+void lower(VkPhysicalDeviceProperties &properties) {
   static const auto lowered = lowered_limits();
+  static const auto type = device_type();
   for (const auto &[field, value] : lowered)
-    if (value < limits.*field)
-      limits.*field = value;
+    if (value < properties.limits.*field)
+      properties.limits.*field = value;
+  if (type)
+    properties.deviceType = *type;
 }
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties(VkPhysicalDevice physical,
                                                        VkPhysicalDeviceProperties *properties) {
   next_of(key_of(physical)).properties(physical, properties);
-  lower(properties->limits);
+  lower(*properties);
 }
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties2(VkPhysicalDevice physical,
                                                         VkPhysicalDeviceProperties2 *properties) {
   next_of(key_of(physical)).properties2(physical, properties);
-  lower(properties->properties.limits);
+  lower(properties->properties);
 }
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties2KHR(
     VkPhysicalDevice physical, VkPhysicalDeviceProperties2 *properties) {
   next_of(key_of(physical)).properties2_khr(physical, properties);
-  lower(properties->properties.limits);
+  lower(properties->properties);
 }
 
 template <typename Info, typename Structure> Info *link_info(const void *next, Structure type) {
