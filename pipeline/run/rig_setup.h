@@ -25,9 +25,10 @@ namespace camhead::pipeline {
 
 // The live frame's renderer. `automatic` is a hardware GPU where there is
 // one that takes the scene, else the CPU reference: on the same cores it
-// renders a live frame over the influence region faster than lavapipe
-// (bench/RESULTS.md, "The live frame"). A GPU asked for by name that cannot
-// take the scene is an error (GpuError); `automatic` says why it fell back.
+// renders a live frame over the influence region as fast as lavapipe,
+// without lavapipe's kernel compiles at start (bench/RESULTS.md, "The live
+// frame on lavapipe, again"). A GPU asked for by name that cannot take the
+// scene is an error (GpuError); `automatic` says why it fell back.
 [[nodiscard]] std::unique_ptr<renderer::FrameRenderer>
 make_renderer(Executor wanted, const renderer::Scene &scene, int threads);
 

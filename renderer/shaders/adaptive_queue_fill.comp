@@ -10,7 +10,8 @@
 layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
 
 void main() {
-  int i = pixel_index();
+  uvec2 p;
+  int i = pixel_index(p);
   if (i < 0) {
     return;
   }

@@ -13,7 +13,11 @@ const uint kTilePixels = CAMHEAD_TILE_X * CAMHEAD_TILE_Y;
 shared uint tile_samples[kTilePixels];
 
 void main() {
-  uvec2 p = gl_GlobalInvocationID.xy;
+  uvec3 id;
+  if (!grid_invocation(GROUP_LIST_TILES, uvec2(CAMHEAD_TILE_X, CAMHEAD_TILE_Y), id)) {
+    return; // the whole workgroup
+  }
+  uvec2 p = id.xy;
   uint samples = 0u;
   if (p.x < frame.image.x && p.y < frame.image.y) {
     uint i = p.y * frame.image.x + p.x;

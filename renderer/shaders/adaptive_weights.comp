@@ -12,9 +12,13 @@ const uint kTilePixels = CAMHEAD_TILE_X * CAMHEAD_TILE_Y;
 shared float tile_luminance[kTilePixels];
 
 void main() {
-  uvec2 p = gl_GlobalInvocationID.xy;
+  uvec3 id;
+  if (!grid_invocation(GROUP_LIST_TILES, uvec2(CAMHEAD_TILE_X, CAMHEAD_TILE_Y), id)) {
+    return; // the whole workgroup
+  }
+  uvec2 p = id.xy;
   float luminance = 0.0f;
-  // No early return: every invocation reaches the barriers below.
+  // No other early return: every invocation reaches the barriers below.
   if (p.x < frame.image.x && p.y < frame.image.y) {
     uint i = p.y * frame.image.x + p.x;
     float w = adaptive_weight(int(p.x), int(p.y));
@@ -34,8 +38,8 @@ void main() {
     barrier();
   }
   if (t == 0u) {
-    // By the tile's place in the image: a region's dispatches cover part of it.
+    // By the tile's place in the image: a region's dispatch covers part of it.
     uint tiles_x = (frame.image.x + CAMHEAD_TILE_X - 1u) / CAMHEAD_TILE_X;
-    adaptive_groups[gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x] = tile_luminance[0];
+    adaptive_groups[(p.y / CAMHEAD_TILE_Y) * tiles_x + p.x / CAMHEAD_TILE_X] = tile_luminance[0];
   }
 }

@@ -99,9 +99,53 @@ layout(binding = BINDING_VIDEO_IN) uniform usamplerBuffer video_in_words;
 layout(std430, binding = BINDING_VIDEO_OUT) writeonly buffer VideoOut { uint video_out[]; };
 #endif
 
-// Index of this invocation's pixel, or -1 outside the image.
-int pixel_index() {
-  uvec2 p = gl_GlobalInvocationID.xy;
+// Over an influence region smaller than the frame, a kernel runs over a list
+// of the workgroups of the frame's grid that the region touches (GROUP_LIST),
+// in one dispatch, rather than one dispatch per rectangle of the region (often
+// a single row of tiles): llvmpipe wakes its threads and waits for them at
+// every dispatch, and a GPU's front end takes each in turn
+// (bench/RESULTS.md, "The live frame on lavapipe, again"). The buffer holds
+// two lists (layout.h, GROUP_LIST_*): each its length, then each group's
+// place, y << 16 | x.
+layout(constant_id = 2) const bool GROUP_LIST = false;
+layout(binding = BINDING_GROUP_LIST) uniform usamplerBuffer group_list;
+
+// This invocation's place in the frame's grid of invocations: what
+// gl_GlobalInvocationID is in a dispatch over the whole frame. `list`: where
+// the kernel's list starts (GROUP_LIST only); `size`: its local size (this
+// file comes before the kernel declares it, so gl_WorkGroupSize is not yet
+// the kernel's here). False for a workgroup past the list's end, which has
+// nothing to do.
+bool grid_invocation(uint list, uvec2 size, out uvec3 id) {
+  if (!GROUP_LIST) {
+    id = gl_GlobalInvocationID;
+    return true;
+  }
+  uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if (group >= texelFetch(group_list, int(list)).x) {
+    return false;
+  }
+  uint place = texelFetch(group_list, int(list + 1u + group)).x;
+  id = uvec3(uvec2(place & 0xffffu, place >> 16) * size + gl_LocalInvocationID.xy,
+             gl_GlobalInvocationID.z);
+  return true;
+}
+
+// Where the video kernels' list starts: after the tile list's longest.
+uint group_list_video() {
+  uint tiles_x = (frame.image.x + CAMHEAD_TILE_X - 1u) / CAMHEAD_TILE_X;
+  uint tiles_y = (frame.image.y + CAMHEAD_TILE_Y - 1u) / CAMHEAD_TILE_Y;
+  return GROUP_LIST_VIDEO(tiles_x * tiles_y);
+}
+
+// This invocation's pixel (of an 8x8-tile kernel, the tile list) and its
+// index, or -1 outside the image.
+int pixel_index(out uvec2 p) {
+  uvec3 id;
+  if (!grid_invocation(GROUP_LIST_TILES, uvec2(CAMHEAD_TILE_X, CAMHEAD_TILE_Y), id)) {
+    return -1;
+  }
+  p = id.xy;
   if (p.x >= frame.image.x || p.y >= frame.image.y) {
     return -1;
   }

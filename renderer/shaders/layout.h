@@ -159,7 +159,14 @@ struct FrameParams {
 // The adaptive second pass's queue (sample_queue.glsl).
 #define BINDING_SAMPLE_QUEUE 22 // uint per pixel: the pixels with samples left, largest share first
 #define BINDING_QUEUE_BINS 23   // uint words at the QUEUE_* offsets below
-#define BINDING_COUNT 24
+// The workgroups a frame's kernels run over where its influence region is a
+// part of the frame (buffers.glsl, grid_invocation): the tile list at
+// GROUP_LIST_TILES, the video kernels' at GROUP_LIST_VIDEO(the frame's tile
+// count), each its length, then y << 16 | x a group.
+#define BINDING_GROUP_LIST 24
+#define GROUP_LIST_TILES 0u
+#define GROUP_LIST_VIDEO(tiles) (1u + (tiles))
+#define BINDING_COUNT 25
 
 // Histogram bins of the adaptive weights: 16 per octave over every
 // non-negative float (adaptive.glsl).
@@ -232,8 +239,11 @@ struct VideoFrames {
 };
 
 // The trace kernel adds the samples [sampling.x, sampling.y) of every pixel to
-// the accumulators (the host clears them before the first batch); the resolve
-// kernel divides by sampling.z and composites. The resolve reads neither
+// the accumulators; the first batch (sampling.x = 0, tracing.y = 0) writes
+// them instead, so the host clears them only for frames whose kernels read
+// pixels that no batch traced, as zeros (outside a smaller influence region:
+// a resolve of the whole frame, or adaptive weights at the region's edge).
+// The resolve kernel divides by sampling.z and composites. The resolve reads neither
 // sampling.x nor sampling.y, so it runs in the last batch's submission, on
 // the same frame parameters.
 //

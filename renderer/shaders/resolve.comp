@@ -18,7 +18,8 @@ vec3 linear_to_srgb(vec3 v) {
 }
 
 void main() {
-  int i = pixel_index();
+  uvec2 p;
+  int i = pixel_index(p);
   if (i < 0) {
     return;
   }

@@ -23,21 +23,26 @@ void main() {
     x = uint(i) % frame.image.x;
     y = uint(i) / frame.image.x;
   } else {
-    i = pixel_index();
+    uvec2 p;
+    i = pixel_index(p);
     if (i < 0) {
       return;
     }
-    x = gl_GlobalInvocationID.x;
-    y = gl_GlobalInvocationID.y;
+    x = p.x;
+    y = p.y;
   }
   // In the adaptive second pass, a pixel whose share is done skips the
   // accumulators' round trip (bins wider than one share hold some).
   if (frame.tracing.y != 0u && sample_counts[i] - frame.tracing.y <= frame.sampling.x) {
     return;
   }
-  vec4 acc_mixed = imageLoad(accum_mixed, i);
-  vec4 acc_real = imageLoad(accum_real, i);
-  vec4 acc_aux = imageLoad(accum_aux, i);
+  // A frame's first batch writes the accumulators instead of adding to what
+  // they hold, so the host need not clear three whole layers before it
+  // (layout.h, "The trace kernel adds").
+  bool first_batch = frame.sampling.x == 0u && frame.tracing.y == 0u;
+  vec4 acc_mixed = first_batch ? vec4(0.0f) : imageLoad(accum_mixed, i);
+  vec4 acc_real = first_batch ? vec4(0.0f) : imageLoad(accum_real, i);
+  vec4 acc_aux = first_batch ? vec4(0.0f) : imageLoad(accum_aux, i);
   bool has_plate = frame.image.z != 0u;
   vec4 camera = has_plate ? imageLoad(plate, i) : vec4(0.0f);
   trace_pixel(x, y, camera, has_plate, acc_mixed, acc_real, acc_aux);

@@ -25,10 +25,14 @@ vec3 ycbcr(VideoParams f, uint y, uint cb, uint cr) {
 }
 
 void main() {
+  uvec3 id;
+  if (!grid_invocation(group_list_video(), uvec2(VIDEO_LOCAL_SIZE), id)) {
+    return;
+  }
   VideoParams f = video.frames[0];
   uint width = f.size.x;
-  uint x0 = 4u * gl_GlobalInvocationID.x;
-  uint y0 = 2u * gl_GlobalInvocationID.y;
+  uint x0 = 4u * id.x;
+  uint y0 = 2u * id.y;
   if (x0 >= width || y0 >= f.size.y) {
     return;
   }

@@ -20,14 +20,18 @@ uint pack4(uint a, uint b, uint c, uint d) {
 }
 
 void main() {
-  uint z = gl_GlobalInvocationID.z;
+  uvec3 id;
+  if (!grid_invocation(group_list_video(), uvec2(VIDEO_LOCAL_SIZE), id)) {
+    return;
+  }
+  uint z = id.z;
   if (z >= video.count.x) {
     return;
   }
   VideoParams f = video.frames[1u + z];
   uint width = f.size.x;
-  uint x0 = 4u * gl_GlobalInvocationID.x;
-  uint y0 = 2u * gl_GlobalInvocationID.y;
+  uint x0 = 4u * id.x;
+  uint y0 = 2u * id.y;
   if (x0 >= width || y0 >= f.size.y) {
     return;
   }

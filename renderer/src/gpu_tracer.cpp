@@ -75,6 +75,7 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   types[BINDING_MATERIALS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_LIGHTS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_VIDEO_IN] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  types[BINDING_GROUP_LIST] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   for (const int binding : {BINDING_ACCUM_MIXED, BINDING_ACCUM_REAL, BINDING_ACCUM_AUX,
                             BINDING_PLATE, BINDING_OUT_COMPOSITE})
     types[std::size_t(binding)] = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER; // read per pixel
@@ -91,8 +92,9 @@ vk::BufferCreateInfo binding_buffer(int binding, VkDeviceSize size, VkBufferUsag
   switch (binding_types()[std::size_t(binding)]) {
   case VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER:
     create.usage |= VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-    create.texel_format =
-        binding == BINDING_VIDEO_IN ? VK_FORMAT_R32_UINT : VK_FORMAT_R32G32B32A32_UINT;
+    create.texel_format = binding == BINDING_VIDEO_IN || binding == BINDING_GROUP_LIST
+                              ? VK_FORMAT_R32_UINT
+                              : VK_FORMAT_R32G32B32A32_UINT;
     break;
   case VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER:
     create.usage |= VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
@@ -231,16 +233,31 @@ void copy_rects(const std::uint8_t *from, std::size_t from_stride, std::uint8_t 
     }
 }
 
-// A run of the video kernels' workgroups (VIDEO_GROUP_X x VIDEO_GROUP_Y
-// pixels) along a row of them.
-struct GroupRun {
-  std::uint32_t x = 0, y = 0, count = 0;
-};
+// The 8x8 tiles of a width x height image.
+std::uint32_t tiles_of(std::uint32_t width, std::uint32_t height) {
+  return ((width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X) *
+         ((height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y);
+}
 
-// The video kernels' workgroups that `region` touches, each once, as runs.
-void video_group_runs(const InfluenceRegion &region, glm::uvec2 groups, std::vector<GroupRun> &runs,
-                      std::vector<glm::uvec2> &spans) {
-  runs.clear();
+// A workgroup's place in a group list (layout.h, BINDING_GROUP_LIST).
+std::uint32_t group_place(std::uint32_t x, std::uint32_t y) {
+  return y << 16 | x;
+}
+
+// The 8x8 tiles of `region`, each once, appended to `places`.
+void tile_places(const InfluenceRegion &region, std::vector<std::uint32_t> &places) {
+  for (const PixelRect &rect : region.rects)
+    for (std::uint32_t ty = rect.y0 / CAMHEAD_TILE_Y;
+         ty < (rect.y1 + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y; ++ty)
+      for (std::uint32_t tx = rect.x0 / CAMHEAD_TILE_X;
+           tx < (rect.x1 + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X; ++tx)
+        places.push_back(group_place(tx, ty));
+}
+
+// The video kernels' workgroups (VIDEO_GROUP_X x VIDEO_GROUP_Y pixels) that
+// `region` touches, each once, appended to `places`; `spans` is scratch.
+void video_group_places(const InfluenceRegion &region, glm::uvec2 groups,
+                        std::vector<glm::uvec2> &spans, std::vector<std::uint32_t> &places) {
   for (std::uint32_t gy = 0; gy < groups.y; ++gy) {
     spans.clear();
     const std::uint32_t y0 = gy * VIDEO_GROUP_Y;
@@ -248,11 +265,12 @@ void video_group_runs(const InfluenceRegion &region, glm::uvec2 groups, std::vec
       if (rect.y0 < y0 + VIDEO_GROUP_Y && rect.y1 > y0)
         spans.emplace_back(rect.x0 / VIDEO_GROUP_X, (rect.x1 + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X);
     std::sort(spans.begin(), spans.end(), [](glm::uvec2 a, glm::uvec2 b) { return a.x < b.x; });
-    for (const glm::uvec2 span : spans)
-      if (!runs.empty() && runs.back().y == gy && runs.back().x + runs.back().count >= span.x)
-        runs.back().count = std::max(runs.back().count, span.y - runs.back().x);
-      else
-        runs.push_back({span.x, gy, span.y - span.x});
+    std::uint32_t next = 0; // the row's first group not yet listed
+    for (const glm::uvec2 span : spans) {
+      for (std::uint32_t gx = std::max(span.x, next); gx < span.y; ++gx)
+        places.push_back(group_place(gx, gy));
+      next = std::max(next, span.y);
+    }
   }
 }
 
@@ -304,37 +322,50 @@ struct GpuTracer::Impl {
   // the frame's region: sample_counts (0 outside the region), the adaptive
   // solution and the second pass's queue, ordered before the kernels and
   // the indirect dispatches.
-  void record_allocation(VkCommandBuffer command_buffer) const;
+  void record_allocation(VkCommandBuffer command_buffer);
   // Records a second-pass batch of `frame` (adaptive, tracing.y = the pilot):
   // the trace kernel over the queue's pixels that have samples in it.
   void record_queue_batch(VkCommandBuffer command_buffer, const gpu::FrameParams &frame);
+  // A kernel's code and its first two specialization constants
+  // (KERNEL_FEATURES and the kernel's own); the third, GROUP_LIST, is
+  // chosen where it is dispatched.
+  struct Kernel {
+    std::span<const std::uint32_t> spirv;
+    const char *name = nullptr;
+    std::uint32_t features = KERNEL_ALL;
+    std::uint32_t variant = 0;
+  };
+  // The trace kernel for the loaded scene and `frame`, over the pixels of
+  // the image or of the queue (trace.comp, FROM_QUEUE).
+  Kernel trace_kernel(const gpu::FrameParams &frame, bool from_queue = false) const;
+  // The resolve kernel writing `layers` (RESOLVE_*).
+  static Kernel resolve_kernel(std::uint32_t layers);
+  // video_decode.comp or video_encode.comp for frames of `format`.
+  static Kernel video_kernel(std::span<const std::uint32_t> spirv, const char *name,
+                             base::PixelFormat format);
+  // `kernel` over the frame's grid or, with `group_list`, over a group list
+  // (buffers.glsl, GROUP_LIST), to be dispatched with a base; built on first
+  // use (a lookup allocates nothing).
+  VkPipeline pipeline(const Kernel &kernel, bool group_list = false);
   // Binds `pipeline` and the descriptor set every kernel shares.
   void bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
   // Dispatches `pipeline` over the image's tiles, or over `groups`.
   void dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
                 std::optional<glm::uvec2> groups = std::nullopt) const;
-  // Dispatches `pipeline` (made with dispatch_base) over the tiles of the
-  // frame's region.
-  void dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
+  // Dispatches a tile kernel over the tiles of the frame's region: the
+  // frame's grid where the region is the whole frame, else the tile list.
+  void dispatch_region(VkCommandBuffer command_buffer, const Kernel &kernel);
   // Dispatches a video kernel for video frame `frame` (gl_WorkGroupID.z:
-  // the output; 0 for the camera frame) over the whole frame, or over
-  // video_runs.
-  void dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline, std::uint32_t frame,
-                      bool region_only) const;
-  // The trace kernel built for the loaded scene and `frame`, over the pixels
-  // of the image or of the queue (trace.comp, FROM_QUEUE), built on first use.
-  VkPipeline trace_pipeline(const gpu::FrameParams &frame, bool from_queue = false);
-  // The resolve kernel writing `layers` (RESOLVE_*), built on first use.
-  VkPipeline resolve_pipeline(std::uint32_t layers);
-  // video_decode.comp or video_encode.comp for frames of `format`, built on
-  // first use.
-  VkPipeline video_pipeline(std::span<const std::uint32_t> spirv, const char *name,
-                            base::PixelFormat format);
-  // `spirv` with specialization constant i = constants[i], to be dispatched
-  // with a base, built on first use (a lookup allocates nothing).
-  using Constants = std::array<std::uint32_t, 2>;
-  VkPipeline specialized(std::span<const std::uint32_t> spirv, const char *name,
-                         const Constants &constants);
+  // the output; 0 for the camera frame) over the whole frame, or over the
+  // video groups of the frame's region.
+  void dispatch_video(VkCommandBuffer command_buffer, const Kernel &kernel, std::uint32_t frame,
+                      bool region_only);
+  // Dispatches `count` groups of a group list, `base_z` as gl_WorkGroupID.z.
+  void dispatch_list(VkCommandBuffer command_buffer, std::uint32_t count,
+                     std::uint32_t base_z = 0) const;
+  // Writes the frame region's tile list and, with `video_groups`, the video
+  // kernels' list into the group-list buffer.
+  void write_group_lists(bool video_groups);
 
   // Declaration order is destruction order in reverse: everything made from
   // the device goes before it, and the device before the instance.
@@ -342,15 +373,14 @@ struct GpuTracer::Impl {
   vk::Device device;
   vk::DescriptorSet descriptors;
   vk::UniquePipelineLayout pipeline_layout;
-  // trace.comp by KERNEL_FEATURES (layout.h) and FROM_QUEUE, resolve.comp by
-  // RESOLVE_LAYERS and the video kernels by VIDEO_FORMAT: by the kernel's
-  // code and its constants.
+  // Every kernel but the two below, by its code and its constants: trace.comp
+  // by KERNEL_FEATURES (layout.h) and FROM_QUEUE, resolve.comp by
+  // RESOLVE_LAYERS, the video kernels by VIDEO_FORMAT, and each by
+  // GROUP_LIST.
+  using Constants = std::array<std::uint32_t, 3>;
   std::map<std::pair<const std::uint32_t *, Constants>, vk::UniquePipeline> specialized_pipelines;
-  vk::UniquePipeline adaptive_weights;
   vk::UniquePipeline adaptive_solve;
-  vk::UniquePipeline adaptive_shares;
   vk::UniquePipeline adaptive_queue_bins;
-  vk::UniquePipeline adaptive_queue_fill;
   vk::CommandRunner commands;
   vk::Buffer frame_uniform;
   vk::Buffer video_uniform;
@@ -374,9 +404,12 @@ struct GpuTracer::Impl {
   BatchSizer second_pass_sizer;
   // The current frame's tiles to trace (influence_region.h).
   InfluenceRegion frame_region;
-  // ... and the video kernels' workgroups that cover them (kept for their
-  // capacity: a live frame allocates nothing).
-  std::vector<GroupRun> video_runs;
+  // The lengths of the current frame's group lists (written by
+  // write_group_lists), and its scratch, kept for its capacity: a live frame
+  // allocates nothing.
+  std::uint32_t tile_list_count = 0;
+  std::uint32_t video_list_count = 0;
+  std::vector<std::uint32_t> group_places;
   std::vector<glm::uvec2> video_spans;
 };
 
@@ -384,24 +417,12 @@ GpuTracer::Impl::Impl(const std::string &wanted)
     : device(vk::choose_device(instance.compute_devices(), wanted)),
       descriptors(device, binding_types()),
       pipeline_layout(vk::make_pipeline_layout(device, descriptors.layout())),
-      adaptive_weights(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                          .spirv = adaptive_weights_spv,
-                                                          .name = "adaptive_weights.comp",
-                                                          .dispatch_base = true})),
       adaptive_solve(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                         .spirv = adaptive_solve_spv,
                                                         .name = "adaptive_solve.comp"})),
-      adaptive_shares(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                         .spirv = adaptive_shares_spv,
-                                                         .name = "adaptive_shares.comp",
-                                                         .dispatch_base = true})),
       adaptive_queue_bins(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
                                                              .spirv = adaptive_queue_bins_spv,
                                                              .name = "adaptive_queue_bins.comp"})),
-      adaptive_queue_fill(vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                             .spirv = adaptive_queue_fill_spv,
-                                                             .name = "adaptive_queue_fill.comp",
-                                                             .dispatch_base = true})),
       commands(device), frame_uniform(device, {.size = sizeof(gpu::FrameParams),
                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                                .memory = vk::MemoryUse::upload,
@@ -463,8 +484,7 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
                                                     VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                            .name = name});
   };
-  const std::size_t tiles = std::size_t((scene.width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X) *
-                            std::size_t((scene.height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y);
+  const std::uint32_t tiles = tiles_of(std::uint32_t(scene.width), std::uint32_t(scene.height));
   scratch(BINDING_SAMPLE_COUNTS, pixels * sizeof(std::uint32_t), "sample counts");
   scratch(BINDING_ADAPTIVE_WEIGHTS, pixels * sizeof(float), "adaptive weights");
   scratch(BINDING_ADAPTIVE_HISTOGRAM, 2 * ADAPTIVE_BINS * sizeof(std::uint32_t),
@@ -491,6 +511,15 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
       binding_buffer(BINDING_VIDEO_IN, max_video_bytes(pixels), 0, "camera frame");
   camera_frame.memory = vk::MemoryUse::upload;
   buffers[BINDING_VIDEO_IN] = vk::Buffer(device, camera_frame);
+  // Written by the host for each frame with a region, like the camera frame.
+  const std::uint32_t video_groups =
+      ((std::uint32_t(scene.width) + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X) *
+      ((std::uint32_t(scene.height) + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y);
+  vk::BufferCreateInfo group_lists = binding_buffer(
+      BINDING_GROUP_LIST, (GROUP_LIST_VIDEO(tiles) + 1 + video_groups) * sizeof(std::uint32_t), 0,
+      "group lists");
+  group_lists.memory = vk::MemoryUse::upload;
+  buffers[BINDING_GROUP_LIST] = vk::Buffer(device, group_lists);
   buffers[BINDING_VIDEO_OUT] = vk::Buffer(
       device, {.size = VIDEO_MAX_OUTPUTS * max_video_bytes(pixels),
                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -513,37 +542,37 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   scene_features = scene_kernel_features(scene);
   // Built now rather than in the first frame: the kernel for the usual
   // frame (CMJ samples, every pixel traced).
-  static_cast<void>(trace_pipeline(gpu::FrameParams{}));
+  static_cast<void>(pipeline(trace_kernel(gpu::FrameParams{})));
   uniform_sizer = {};
   second_pass_sizer = {};
   loaded = true;
 }
 
-VkPipeline GpuTracer::Impl::specialized(std::span<const std::uint32_t> spirv, const char *name,
-                                        const Constants &constants) {
-  vk::UniquePipeline &pipeline = specialized_pipelines[{spirv.data(), constants}];
+VkPipeline GpuTracer::Impl::pipeline(const Kernel &kernel, bool group_list) {
+  const Constants constants = {kernel.features, kernel.variant, group_list ? VK_TRUE : VK_FALSE};
+  vk::UniquePipeline &pipeline = specialized_pipelines[{kernel.spirv.data(), constants}];
   if (pipeline.get() == VK_NULL_HANDLE)
     pipeline = vk::make_compute_pipeline(device, {.layout = pipeline_layout.get(),
-                                                  .spirv = spirv,
-                                                  .name = name,
+                                                  .spirv = kernel.spirv,
+                                                  .name = kernel.name,
                                                   .dispatch_base = true,
                                                   .constants = constants});
   return pipeline.get();
 }
 
-VkPipeline GpuTracer::Impl::trace_pipeline(const gpu::FrameParams &frame, bool from_queue) {
-  return specialized(
-      trace_spv, "trace.comp",
-      {scene_features | frame_kernel_features(frame), from_queue ? VK_TRUE : VK_FALSE});
+GpuTracer::Impl::Kernel GpuTracer::Impl::trace_kernel(const gpu::FrameParams &frame,
+                                                      bool from_queue) const {
+  return {trace_spv, "trace.comp", scene_features | frame_kernel_features(frame),
+          from_queue ? VK_TRUE : VK_FALSE};
 }
 
-VkPipeline GpuTracer::Impl::resolve_pipeline(std::uint32_t layers) {
-  return specialized(resolve_spv, "resolve.comp", {KERNEL_ALL, layers});
+GpuTracer::Impl::Kernel GpuTracer::Impl::resolve_kernel(std::uint32_t layers) {
+  return {resolve_spv, "resolve.comp", KERNEL_ALL, layers};
 }
 
-VkPipeline GpuTracer::Impl::video_pipeline(std::span<const std::uint32_t> spirv, const char *name,
-                                           base::PixelFormat format) {
-  return specialized(spirv, name, {KERNEL_ALL, video_format_code(format)});
+GpuTracer::Impl::Kernel GpuTracer::Impl::video_kernel(std::span<const std::uint32_t> spirv,
+                                                      const char *name, base::PixelFormat format) {
+  return {spirv, name, KERNEL_ALL, video_format_code(format)};
 }
 
 void GpuTracer::Impl::bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
@@ -553,24 +582,57 @@ void GpuTracer::Impl::bind(VkCommandBuffer command_buffer, VkPipeline pipeline) 
                           1, &set, 0, nullptr);
 }
 
-void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, VkPipeline pipeline) const {
-  bind(command_buffer, pipeline);
-  for (const PixelRect &rect : frame_region.rects)
-    vkCmdDispatchBase(command_buffer, rect.x0 / CAMHEAD_TILE_X, rect.y0 / CAMHEAD_TILE_Y, 0,
-                      (rect.x1 - rect.x0 + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X,
-                      (rect.y1 - rect.y0 + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y, 1);
+void GpuTracer::Impl::write_group_lists(bool video_groups) {
+  auto *words = static_cast<std::uint32_t *>(buffers[BINDING_GROUP_LIST].mapped());
+  const auto write = [&](std::uint32_t offset) {
+    words[offset] = std::uint32_t(group_places.size());
+    std::copy(group_places.begin(), group_places.end(), words + offset + 1);
+    return std::uint32_t(group_places.size());
+  };
+  group_places.clear();
+  tile_places(frame_region, group_places);
+  tile_list_count = write(GROUP_LIST_TILES);
+
+  video_list_count = 0;
+  if (video_groups) {
+    group_places.clear();
+    video_group_places(frame_region,
+                       glm::uvec2((width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
+                                  (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y),
+                       video_spans, group_places);
+    video_list_count = write(GROUP_LIST_VIDEO(tiles_of(width, height)));
+  }
 }
 
-void GpuTracer::Impl::dispatch_video(VkCommandBuffer command_buffer, VkPipeline pipeline,
-                                     std::uint32_t frame, bool region_only) const {
-  bind(command_buffer, pipeline);
+void GpuTracer::Impl::dispatch_list(VkCommandBuffer command_buffer, std::uint32_t count,
+                                    std::uint32_t base_z) const {
+  if (count == 0)
+    return;
+  // Rows of the fewest groups a device must allow in x; the kernels skip
+  // the last row's groups past the list's end.
+  constexpr std::uint32_t kRow = 65535;
+  const std::uint32_t row = std::min(count, kRow);
+  vkCmdDispatchBase(command_buffer, 0, 0, base_z, row, (count + row - 1) / row, 1);
+}
+
+void GpuTracer::Impl::dispatch_region(VkCommandBuffer command_buffer, const Kernel &kernel) {
+  if (frame_region.whole_frame()) {
+    dispatch(command_buffer, pipeline(kernel));
+    return;
+  }
+  bind(command_buffer, pipeline(kernel, true));
+  dispatch_list(command_buffer, tile_list_count);
+}
+
+void GpuTracer::Impl::dispatch_video(VkCommandBuffer command_buffer, const Kernel &kernel,
+                                     std::uint32_t frame, bool region_only) {
+  bind(command_buffer, pipeline(kernel, region_only));
   if (!region_only) {
     vkCmdDispatchBase(command_buffer, 0, 0, frame, (width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
                       (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y, 1);
     return;
   }
-  for (const GroupRun &run : video_runs)
-    vkCmdDispatchBase(command_buffer, run.x, run.y, frame, run.count, 1, 1);
+  dispatch_list(command_buffer, video_list_count, frame);
 }
 
 void GpuTracer::Impl::dispatch(VkCommandBuffer command_buffer, VkPipeline pipeline,
@@ -641,11 +703,15 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
                       !selection.mask_and_depth && !selection.display;
   for (std::size_t k = 0; k < video_outputs; ++k)
     region_video = region_video && same_pixels(video->outputs[k].format, video->plate.format);
-  if (region_video)
-    video_group_runs(frame_region,
-                     glm::uvec2((width + VIDEO_GROUP_X - 1) / VIDEO_GROUP_X,
-                                (height + VIDEO_GROUP_Y - 1) / VIDEO_GROUP_Y),
-                     video_runs, video_spans);
+  if (!frame_region.whole_frame())
+    write_group_lists(region_video);
+
+  // The first batch writes every pixel it traces (trace.comp). Over a
+  // smaller region, two kernels read others, which must be zeros: a resolve
+  // of the whole frame, and the adaptive weights (a pixel's 3x3
+  // neighbourhood reaches past the region's edge).
+  const bool reads_untraced_pixels =
+      !frame_region.whole_frame() && (!region_video || adaptive != nullptr);
 
   // Where the read-back buffer holds what comes back.
   const VkDeviceSize layer_bytes = buffers[BINDING_OUT_AUX].size();
@@ -656,19 +722,19 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   const VkDeviceSize solution_offset = counts_offset + counts_bytes;
   const VkDeviceSize video_offset = solution_offset + sizeof(gpu::AdaptiveSolution);
 
-  const VkPipeline decode = decode_plate ? video_pipeline(video_decode_spv, "video_decode.comp",
-                                                          video->plate.format.pixel)
-                                         : VK_NULL_HANDLE;
-  std::array<VkPipeline, VIDEO_MAX_OUTPUTS> encode{};
+  const Kernel decode =
+      decode_plate ? video_kernel(video_decode_spv, "video_decode.comp", video->plate.format.pixel)
+                   : Kernel{};
+  std::array<Kernel, VIDEO_MAX_OUTPUTS> encode{};
   for (std::size_t k = 0; k < video_outputs; ++k)
-    encode[k] =
-        video_pipeline(video_encode_spv, "video_encode.comp", video->outputs[k].format.pixel);
+    encode[k] = video_kernel(video_encode_spv, "video_encode.comp", video->outputs[k].format.pixel);
 
   // The frame's first commands: the clear, and the first timestamp.
   const auto begin_frame = [&](VkCommandBuffer command_buffer) {
     timestamps.reset(command_buffer);
     timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
-    record_clear(command_buffer);
+    if (reads_untraced_pixels)
+      record_clear(command_buffer);
     if (decode_plate) {
       dispatch_video(command_buffer, decode, 0, region_video);
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -686,12 +752,12 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   layers |= selection.real ? RESOLVE_REAL : 0u;
   layers |= selection.mask_and_depth ? RESOLVE_MASK_AND_DEPTH : 0u;
   layers |= selection.display ? RESOLVE_DISPLAY : 0u;
-  const VkPipeline resolve = resolve_pipeline(layers);
+  const Kernel resolve = resolve_kernel(layers);
   const auto end_frame = [&](VkCommandBuffer command_buffer) {
     if (region_video)
       dispatch_region(command_buffer, resolve);
     else
-      dispatch(command_buffer, resolve);
+      dispatch(command_buffer, pipeline(resolve));
     if (video_outputs > 0) {
       vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -731,7 +797,7 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   };
   // A uniform frame's or a pilot's batch: every pixel of the region.
   const auto trace_region = [&](VkCommandBuffer command_buffer) {
-    dispatch_region(command_buffer, trace_pipeline(frame));
+    dispatch_region(command_buffer, trace_kernel(frame));
   };
   const auto report = [&](double done) {
     if (progress)
@@ -829,7 +895,7 @@ void GpuTracer::Impl::record_clear(VkCommandBuffer command_buffer) const {
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
-void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
+void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) {
   const auto compute_to_compute = [&] {
     vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -845,15 +911,15 @@ void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
   vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  dispatch_region(command_buffer, adaptive_weights.get());
+  dispatch_region(command_buffer, {adaptive_weights_spv, "adaptive_weights.comp"});
   compute_to_compute();
   dispatch(command_buffer, adaptive_solve.get(), glm::uvec2(1, 1));
   compute_to_compute();
-  dispatch_region(command_buffer, adaptive_shares.get());
+  dispatch_region(command_buffer, {adaptive_shares_spv, "adaptive_shares.comp"});
   compute_to_compute();
   dispatch(command_buffer, adaptive_queue_bins.get(), glm::uvec2(1, 1));
   compute_to_compute();
-  dispatch_region(command_buffer, adaptive_queue_fill.get());
+  dispatch_region(command_buffer, {adaptive_queue_fill_spv, "adaptive_queue_fill.comp"});
   // The queue and its dispatches, for every batch of the second pass.
   vk::memory_barrier(
       command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -864,7 +930,7 @@ void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) const {
 
 void GpuTracer::Impl::record_queue_batch(VkCommandBuffer command_buffer,
                                          const gpu::FrameParams &frame) {
-  bind(command_buffer, trace_pipeline(frame, true));
+  bind(command_buffer, pipeline(trace_kernel(frame, true)));
   const std::uint32_t bin =
       QUEUE_BIN(frame.sampling.x + 1u, frame.tracing.y, std::uint32_t(frame.adaptive.y));
   vk::dispatch_indirect(device, command_buffer, buffers[BINDING_QUEUE_BINS].get(),
