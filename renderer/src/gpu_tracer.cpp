@@ -127,6 +127,14 @@ std::uint32_t scene_kernel_features(const CompiledScene &scene) {
 }
 
 // ... and those `frame` asks for.
+std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
+  std::uint32_t features =
+      frame.tracing.z == SAMPLER_SOBOL ? KERNEL_CAMERA_SOBOL : KERNEL_CAMERA_CMJ;
+  if ((frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u)
+    features |= KERNEL_SKIP_EMPTY_PIXELS;
+  return features;
+}
+
 // Refuses an image whose per-pixel layers or dispatch grid `device` cannot
 // hold, naming the limit; past one, the buffers or dispatches would be
 // invalid use rather than an error Vulkan reports.
@@ -152,14 +160,6 @@ void check_image_limits(const vk::Device &device, int width, int height) {
   if (tiles_y > limits.maxComputeWorkGroupCount[1])
     refuse("is " + std::to_string(tiles_y) + " workgroups high", limits.maxComputeWorkGroupCount[1],
            "maxComputeWorkGroupCount[1]");
-}
-
-std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
-  std::uint32_t features =
-      frame.tracing.z == SAMPLER_SOBOL ? KERNEL_CAMERA_SOBOL : KERNEL_CAMERA_CMJ;
-  if ((frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u)
-    features |= KERNEL_SKIP_EMPTY_PIXELS;
-  return features;
 }
 
 template <typename T> std::span<const std::byte> bytes_of(const std::vector<T> &values) {
@@ -541,8 +541,9 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   origin = scene.origin;
   scene_features = scene_kernel_features(scene);
   // Built now rather than in the first frame: the kernel for the usual
-  // frame (CMJ samples, every pixel traced).
-  static_cast<void>(pipeline(trace_kernel(gpu::FrameParams{})));
+  // frame (CMJ samples, over an influence region: the default of stills and
+  // live frames).
+  static_cast<void>(pipeline(trace_kernel(gpu::FrameParams{}), true));
   uniform_sizer = {};
   second_pass_sizer = {};
   loaded = true;
@@ -608,9 +609,11 @@ void GpuTracer::Impl::dispatch_list(VkCommandBuffer command_buffer, std::uint32_
                                     std::uint32_t base_z) const {
   if (count == 0)
     return;
-  // Rows of the fewest groups a device must allow in x; the kernels skip
-  // the last row's groups past the list's end.
-  constexpr std::uint32_t kRow = 65535;
+  // In rows, whose last the kernels cut at the list's end. A GPU schedules
+  // workgroups alike whatever the grid's shape, so any row up to the 65535
+  // groups every device allows in x would do; a short one puts more than
+  // one row, and the cut, under the everyday tests' small frames.
+  constexpr std::uint32_t kRow = 64;
   const std::uint32_t row = std::min(count, kRow);
   vkCmdDispatchBase(command_buffer, 0, 0, base_z, row, (count + row - 1) / row, 1);
 }
