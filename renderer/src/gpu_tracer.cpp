@@ -613,7 +613,7 @@ void GpuTracer::Impl::dispatch_list(VkCommandBuffer command_buffer, std::uint32_
   // workgroups alike whatever the grid's shape, so any row up to the 65535
   // groups every device allows in x would do; a short one puts more than
   // one row, and the cut, under the everyday tests' small frames.
-  constexpr std::uint32_t kRow = 64;
+  constexpr std::uint32_t kRow = 16;
   const std::uint32_t row = std::min(count, kRow);
   vkCmdDispatchBase(command_buffer, 0, 0, base_z, row, (count + row - 1) / row, 1);
 }

@@ -206,9 +206,11 @@ TEST_P(FramePassThrough, OnlyWhatTheVirtualObjectTouchesChanges) {
 // outputs in the camera's format (which take the camera's bytes outside the
 // region: 4:2:2, 4:2:0 with its chroma plane, 3-byte pixels, padded rows) and
 // in another (converted everywhere), alone and beside a YUYV output, with a
-// shadow and a mirror in the scene.
+// shadow and a mirror in the scene. The frame is large enough for the
+// region's video groups to take more than one row of their list
+// (gpu_tracer.cpp, dispatch_list).
 TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
-  const int w = 96, h = 64;
+  const int w = 160, h = 96;
   Scene scene = scene_with_ball(w, h, {-0.6f, 0.1f, -2.5f});
   Light light;
   light.type = LightType::area;
@@ -227,6 +229,7 @@ TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
   for (const VideoFormat &in : {format(PixelFormat::yuyv, w, h), format(PixelFormat::nv12, w, h),
                                 format(PixelFormat::rgb24, w, h, base::ColorRange::full), padded}) {
     const std::vector<std::uint8_t> plate = noise_frame(in, 11);
+    const std::vector<std::uint8_t> other_plate = noise_frame(in, 12);
     VideoFormat converted = format(PixelFormat::xrgb8888, w, h, base::ColorRange::full);
     if (in.pixel == PixelFormat::yuyv)
       converted = format(PixelFormat::nv12, w, h); // the camera's own beside it below
@@ -244,6 +247,11 @@ TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
         FrameRequest request;
         request.camera = scene_camera(scene);
         request.rays_per_pixel = 4;
+        // A frame of another camera image first, every pixel: what a frame
+        // over the region failed to compute or convert would show its bytes,
+        // not those of an identical frame before it.
+        request.influence_region = false;
+        EXPECT_EQ(renderer->render(request, {in, other_plate}, targets).status, FrameStatus::ok);
         request.influence_region = region;
         const FrameReport report = renderer->render(request, {in, plate}, targets);
         EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
