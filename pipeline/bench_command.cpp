@@ -38,8 +38,9 @@ struct BenchArgs {
   bool all_layers = false;
   bool adaptive = false;
   bool skip_empty = false;
-  double frame_ms = 0.0; // > 0: follow this frame-time target instead of --rpp
-  bool region = false;   // compare the influence region with every pixel
+  double frame_ms = 0.0;      // > 0: follow this frame-time target instead of --rpp
+  bool region = false;        // compare the influence region with every pixel
+  bool every_feature = false; // the trace kernel with every feature (set_kernel_specialization)
 };
 
 double paper_fps(int rpp) {
@@ -194,10 +195,12 @@ int run_bench(const BenchArgs &args) {
     scene.render.width = args.width;
     scene.render.height = args.height;
     GpuTracer tracer(args.device);
+    tracer.set_kernel_specialization(!args.every_feature);
     const CompiledScene compiled = compile_scene(scene);
     tracer.load(compiled);
-    std::printf("scene %s, %dx%d, device %s\n", args.scene.c_str(), args.width, args.height,
-                tracer.device_name().c_str());
+    std::printf("scene %s, %dx%d, device %s, trace kernel %s\n", args.scene.c_str(), args.width,
+                args.height, tracer.device_name().c_str(),
+                args.every_feature ? "with every feature" : "for the scene's features");
     if (args.frame_ms > 0.0)
       return run_frame_target(args, tracer, scene);
     if (args.region)
@@ -299,6 +302,10 @@ void add_bench_command(CLI::App &app) {
                 "Trace one sample where no ray of a pixel can meet the scene (always on in\n"
                 "the CPU reference; on the GPU a measurement, see bench/RESULTS.md)");
   cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
+  cmd->add_flag("--every-kernel-feature", args->every_feature,
+                "Build the trace kernel with every primitive, material, light and sampler,\n"
+                "not only those of the scene and frame: the same image; measures what\n"
+                "building the kernel for the scene saves");
   cmd->add_flag("--influence-region", args->region,
                 "Time each rpp over every pixel and over the influence region alone (where\n"
                 "the virtual objects, their shadows and reflections can change the frame)");

@@ -399,6 +399,7 @@ struct GpuTracer::Impl {
   gpu::uvec4 counts{};                       // primitives, nodes, lights
   glm::vec3 origin{0.0f};                    // CompiledScene::origin of the loaded scene
   std::uint32_t scene_features = KERNEL_ALL; // scene_kernel_features of the loaded scene
+  bool specialize = true;                    // set_kernel_specialization
   // Batch sizes, one per kind of pass, for the loaded scene.
   BatchSizer uniform_sizer;
   BatchSizer second_pass_sizer;
@@ -563,7 +564,8 @@ VkPipeline GpuTracer::Impl::pipeline(const Kernel &kernel, bool group_list) {
 
 GpuTracer::Impl::Kernel GpuTracer::Impl::trace_kernel(const gpu::FrameParams &frame,
                                                       bool from_queue) const {
-  return {trace_spv, "trace.comp", scene_features | frame_kernel_features(frame),
+  return {trace_spv, "trace.comp",
+          specialize ? scene_features | frame_kernel_features(frame) : KERNEL_ALL,
           from_queue ? VK_TRUE : VK_FALSE};
 }
 
@@ -990,6 +992,10 @@ std::string GpuTracer::device_name() const {
 
 void GpuTracer::load(const CompiledScene &scene) {
   impl_->load(scene);
+}
+
+void GpuTracer::set_kernel_specialization(bool on) {
+  impl_->specialize = on;
 }
 
 RenderResult GpuTracer::render(const gpu::FrameParams &frame, const ProgressFn &progress,

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -19,7 +18,6 @@
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/influence_region.h"
-#include "camhead/renderer/scene_loader.h"
 #include "test_scenes.h"
 #include "test_support.h"
 
@@ -32,17 +30,6 @@ using renderer::CompiledScene;
 using renderer::Image;
 using renderer::InfluenceRegion;
 using renderer::Scene;
-
-// A plate of noise: every pixel differs from its neighbours and from what
-// the proxy renders, so a pixel composited from a wrong I_m - I_r shows.
-Image noise_plate(int width, int height, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> value(0.0f, 1.0f);
-  Image plate(width, height, 3);
-  for (float &v : plate.data)
-    v = value(rng);
-  return plate;
-}
 
 // The first pixel where two composites differ in any bit, or -1.
 long first_difference(const Image &a, const Image &b) {
@@ -70,118 +57,8 @@ Comparison compare_cpu(const Scene &scene, int rpp) {
   return {first_difference(full.composite, part.composite), region.fraction()};
 }
 
-Scene with_noise_plate(Scene scene, std::uint32_t seed) {
-  scene.plate = noise_plate(scene.render.width, scene.render.height, seed);
-  return scene;
-}
-
-std::vector<Scene> reference_scenes() {
-  std::vector<Scene> scenes;
-  for (const char *name : {"ar_basic.json", "boxes.json"})
-    scenes.push_back(test::downscaled(renderer::load_scene(test::reference_dir() / name), 4));
-  scenes.push_back(
-      test::downscaled(renderer::load_scene(test::source_dir() / "scenes/ar_demo.json"), 4));
-  scenes.push_back(
-      test::downscaled(renderer::load_scene(test::source_dir() / "scenes/sim_rig.json"), 4));
-  for (Scene &s : scenes)
-    if (!s.plate)
-      s = with_noise_plate(std::move(s), 7);
-  return scenes;
-}
-
-// A random scene: a ground most of the time, real and virtual spheres and
-// boxes of every material, one to three lights of any kind, the camera
-// anywhere within 10 m looking roughly at the objects, a pinhole or a lens
-// from f/1 to f/16 focused anywhere from 0.3 m to 20 m.
-Scene random_scene(std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  const auto uniform = [&](float lo, float hi) {
-    return std::uniform_real_distribution<float>(lo, hi)(rng);
-  };
-  const auto chance = [&](float p) { return uniform(0.0f, 1.0f) < p; };
-  const auto pick = [&](int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng); };
-  const auto point = [&](float r) {
-    return glm::vec3(uniform(-r, r), uniform(-r, r), uniform(-r, r));
-  };
-
-  Scene scene = test::empty_scene("random", 0.0f, 1.0f, 48, 36);
-  scene.source = "random scene " + std::to_string(seed);
-  scene.render.seed = seed;
-  scene.render.max_bounces = pick(4);
-  scene.render.pixel_filter_width_px = chance(0.5f) ? 1.0f : uniform(0.5f, 2.5f);
-  scene.render.world_color = glm::vec3(uniform(0.0f, 0.3f));
-  using renderer::MaterialType;
-  scene.materials = {{"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f},
-                     {"red", MaterialType::diffuse, glm::vec3(0.8f, 0.1f, 0.1f), 1.5f},
-                     {"mirror", MaterialType::mirror, glm::vec3(0.9f), 1.5f},
-                     {"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f},
-                     {"lamp", MaterialType::emission, glm::vec3(2.0f), 1.5f}};
-  const auto material = [&] {
-    const float u = uniform(0.0f, 1.0f);
-    return u < 0.55f ? pick(2) : u < 0.75f ? 2 : u < 0.92f ? 3 : 4;
-  };
-  const auto object = [&](bool real, int index) {
-    const std::string name = (real ? "real " : "virtual ") + std::to_string(index);
-    const glm::vec3 centre = point(2.0f) + glm::vec3(0.0f, 2.0f, 0.0f);
-    renderer::Object o =
-        chance(0.5f)
-            ? test::sphere("", centre, uniform(0.05f, 0.8f), material(), real)
-            : test::box("", centre,
-                        glm::vec3(uniform(0.05f, 1.5f), uniform(0.05f, 1.5f), uniform(0.05f, 1.5f)),
-                        material(), real, point(90.0f));
-    o.name = name;
-    return o;
-  };
-  if (chance(0.8f))
-    scene.objects.push_back(test::plane("ground", glm::vec3(0.0f), uniform(4.0f, 30.0f),
-                                        chance(0.85f) ? pick(2) : 2, true));
-  for (int i = 0, n = pick(4); i < n; ++i)
-    scene.objects.push_back(object(true, i));
-  for (int i = 0, n = 1 + pick(3); i < n; ++i)
-    scene.objects.push_back(object(false, i));
-
-  for (int i = 0, n = 1 + pick(3); i < n; ++i) {
-    renderer::Light light;
-    light.name = "light " + std::to_string(i);
-    light.color = glm::vec3(uniform(0.5f, 1.0f), uniform(0.5f, 1.0f), uniform(0.5f, 1.0f));
-    switch (pick(3)) {
-    case 0:
-      light.type = renderer::LightType::point;
-      light.position = point(4.0f) + glm::vec3(0.0f, 4.0f, 0.0f);
-      light.power_W = uniform(20.0f, 500.0f);
-      break;
-    case 1:
-      light.type = renderer::LightType::area;
-      light.position = point(4.0f) + glm::vec3(0.0f, 4.0f, 0.0f);
-      light.normal = glm::normalize(point(1.0f) - light.position);
-      light.size = glm::vec2(uniform(0.1f, 3.0f), uniform(0.1f, 3.0f));
-      light.power_W = uniform(20.0f, 500.0f);
-      break;
-    default:
-      light.type = renderer::LightType::sun;
-      light.direction = glm::normalize(point(1.0f) - glm::vec3(0.0f, 1.5f, 0.0f));
-      light.irradiance_W_m2 = uniform(0.5f, 5.0f);
-      break;
-    }
-    scene.lights.push_back(light);
-  }
-
-  renderer::CameraDesc &camera = scene.camera;
-  camera.position = point(6.0f) + glm::vec3(0.0f, 3.0f, 0.0f);
-  if (chance(0.1f)) // up close to, or inside, something
-    camera.position = scene.objects.back().center + point(0.3f);
-  camera.look_at = glm::vec3(0.0f, 1.0f, 0.0f) + point(1.5f);
-  camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
-  if (std::abs(glm::normalize(camera.look_at - camera.position).y) > 0.98f)
-    camera.up = glm::vec3(1.0f, 0.0f, 0.0f);
-  camera.focal_length_mm = uniform(12.0f, 135.0f);
-  camera.f_number = chance(0.25f) ? 0.0f : uniform(1.0f, 16.0f);
-  camera.focus_distance_m = uniform(0.3f, 20.0f);
-  return with_noise_plate(std::move(scene), seed);
-}
-
 TEST(InfluenceRegion, ReferenceScenesCompositeBitForBit) {
-  for (const Scene &scene : reference_scenes()) {
+  for (const Scene &scene : test::small_reference_scenes()) {
     const Comparison c = compare_cpu(scene, 4);
     std::printf("%s %dx%d: %.1f %% of the pixels traced\n", scene.source.filename().c_str(),
                 scene.render.width, scene.render.height, 100.0 * c.fraction);
@@ -195,7 +72,7 @@ TEST(InfluenceRegion, RandomScenesCompositeBitForBit) {
   int partial = 0;
   double fraction = 0.0;
   for (std::uint32_t seed = 1; seed <= kScenes; ++seed) {
-    const Scene scene = random_scene(seed);
+    const Scene scene = test::random_scene(seed);
     const Comparison c = compare_cpu(scene, 2);
     fraction += c.fraction;
     partial += c.fraction < 1.0 ? 1 : 0;
@@ -237,7 +114,7 @@ TEST(InfluenceRegion, BlurAndFilterReachBitForBit) {
       scene.objects.push_back(
           test::sphere("ball", glm::vec3(x, y, -c.depth_m), c.radius * c.depth_m, 0, false));
     }
-    scene = with_noise_plate(std::move(scene), 5);
+    scene = test::with_noise_plate(std::move(scene), 5);
     const Comparison result = compare_cpu(scene, 16);
     std::printf("%s: %.1f %% traced\n", c.name, 100.0 * result.fraction);
     EXPECT_LT(result.fraction, 1.0) << c.name;
@@ -279,7 +156,7 @@ TEST(InfluenceRegion, SphereAndShadowBoundsBitForBit) {
     }
     if (kind != none)
       scene.lights.push_back(light);
-    scene = with_noise_plate(std::move(scene), 13);
+    scene = test::with_noise_plate(std::move(scene), 13);
     const Comparison c = compare_cpu(scene, 8);
     std::printf("15 balls over a floor, %s: %.1f %% traced\n", name, 100.0 * c.fraction);
     EXPECT_LT(c.fraction, 0.75) << name;
@@ -299,7 +176,7 @@ TEST(InfluenceRegion, SmallObjectSmallRegionGrowingWithBlur) {
     sun.type = renderer::LightType::sun;
     sun.irradiance_W_m2 = 1.0f;
     scene.lights.push_back(sun);
-    scene = with_noise_plate(std::move(scene), 3);
+    scene = test::with_noise_plate(std::move(scene), 3);
     const CompiledScene compiled = renderer::compile_scene(scene);
     return renderer::influence_region(compiled, renderer::make_frame_params(scene, 1)).fraction();
   };
@@ -314,7 +191,7 @@ TEST(InfluenceRegion, SmallObjectSmallRegionGrowingWithBlur) {
 
 // Without a plate the composite is I_m, which every pixel needs.
 TEST(InfluenceRegion, NoPlateTracesTheWholeFrame) {
-  Scene scene = random_scene(11);
+  Scene scene = test::random_scene(11);
   scene.plate.reset();
   const CompiledScene compiled = renderer::compile_scene(scene);
   EXPECT_TRUE(
@@ -324,9 +201,9 @@ TEST(InfluenceRegion, NoPlateTracesTheWholeFrame) {
 TEST(InfluenceRegion, GpuCompositeBitForBit) {
   CAMHEAD_REQUIRE_VULKAN();
   renderer::GpuTracer tracer;
-  std::vector<Scene> scenes = reference_scenes();
+  std::vector<Scene> scenes = test::small_reference_scenes();
   for (std::uint32_t seed = 1; seed <= 40; ++seed)
-    scenes.push_back(random_scene(seed));
+    scenes.push_back(test::random_scene(seed));
   // A virtual glass ball before a real lamp, as light_transport_test's, at
   // many batches of samples.
   Scene glass = test::empty_scene("glass ball", 0.0f, 1.0f, 32, 32);
@@ -337,7 +214,7 @@ TEST(InfluenceRegion, GpuCompositeBitForBit) {
   glass.objects = {
       test::sphere("ball", glm::vec3(0.0f, 0.0f, -4.0f), 0.3f, 0, false),
       test::box("lamp", glm::vec3(0.0f, 0.0f, -8.0f), glm::vec3(100.0f, 100.0f, 0.1f), 1, true)};
-  scenes.push_back(with_noise_plate(std::move(glass), 9));
+  scenes.push_back(test::with_noise_plate(std::move(glass), 9));
   for (const Scene &scene : scenes) {
     const CompiledScene compiled = renderer::compile_scene(scene);
     tracer.load(compiled);
@@ -357,7 +234,7 @@ TEST(InfluenceRegion, GpuCompositeBitForBit) {
 // the composite is the camera image exactly, and both executors give the
 // same shares.
 TEST(InfluenceRegion, AdaptiveSharesTheRegionsBudget) {
-  const Scene scene = reference_scenes().front();
+  const Scene scene = test::small_reference_scenes().front();
   const CompiledScene compiled = renderer::compile_scene(scene);
   const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, 16);
   const InfluenceRegion region = renderer::influence_region(compiled, frame);

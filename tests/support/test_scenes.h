@@ -1,6 +1,8 @@
-// Small scenes built in code for the physics tests.
+// Scenes for the tests: small ones built in code for the physics tests,
+// random ones, and the reference scenes made small.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -45,5 +47,21 @@ namespace camhead::test {
 // D^2/16) convolved with the pixel box filter twice over, a triangle of
 // half-width 1 px (variance 1/6): D = 4 sqrt(var - 1/6).
 [[nodiscard]] double measured_blur_diameter(const std::vector<double> &profile);
+
+// A plate of noise: every pixel differs from its neighbours and from what
+// the proxy renders, so a pixel composited from a wrong I_m - I_r shows.
+[[nodiscard]] renderer::Image noise_plate(int width, int height, std::uint32_t seed);
+// `scene` with a noise plate of its size.
+[[nodiscard]] renderer::Scene with_noise_plate(renderer::Scene scene, std::uint32_t seed);
+
+// A random scene: a ground most of the time, real and virtual spheres and
+// boxes of every material, one to three lights of any kind, the camera
+// anywhere within 10 m looking roughly at the objects, a pinhole or a lens
+// from f/1 to f/16 focused anywhere from 0.3 m to 20 m; 48 x 36 pixels.
+[[nodiscard]] renderer::Scene random_scene(std::uint32_t seed);
+
+// The reference scenes ar_basic and boxes, the demo and the simulated rig's
+// scene at a quarter of their size, each with its plate or a noise plate.
+[[nodiscard]] std::vector<renderer::Scene> small_reference_scenes();
 
 } // namespace camhead::test

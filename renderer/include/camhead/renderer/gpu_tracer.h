@@ -46,6 +46,14 @@ public:
   // Uploads geometry, materials, lights and plate. Must precede render().
   void load(const CompiledScene &scene);
 
+  // The trace kernel is built for the features the loaded scene and the
+  // frame use (layout.h, KERNEL_*), the driver dropping the code of the
+  // others; `on` = false builds it with every feature, as the CPU reference
+  // has them. The images are the same bit for bit
+  // (tests/renderer/kernel_specialization_test.cpp); only the time differs,
+  // which `camhead bench --every-kernel-feature` measures.
+  void set_kernel_specialization(bool on);
+
   // Traces frame.sampling.z samples per pixel in batches, calling `progress`
   // after each, resolves the layers and the composite on the GPU and reads
   // them back. Every call takes an optional influence `region`
