@@ -3,9 +3,9 @@
 # minutes: the demo scene against the paper's frame rates at 25 and 49 rpp,
 # and 1920x1080 at 49-rpp quality (adaptive 9 rpp has the error of uniform
 # 49: RESULTS, "Speed versus accuracy"), each over every pixel and over the
-# influence region, and last the device's own time of an adaptive 1080p
-# frame beside the host's. Prints Markdown; every line also goes to
-# OUT_DIR/gpu_check.md.
+# influence region; then the device's own time of an adaptive 1080p frame
+# beside the host's, and last the trace kernel with every feature. Prints
+# Markdown; every line also goes to OUT_DIR/gpu_check.md.
 #
 #   bench/gpu_check.sh [BUILD_DIR] [OUT_DIR]
 #
@@ -49,3 +49,8 @@ for scene in tests/assets/reference/ar_basic.json scenes/ar_demo.json; do
 done
 # Device time against host time for the adaptive frame (allocation included).
 bench --scene scenes/ar_demo.json --width 1920 --height 1080 --rpp 9 --adaptive
+# What building the trace kernel for the scene saves on a GPU: against the
+# every-pixel 25-rpp rows above (RESULTS, "The kernel built for the scene").
+for scene in tests/assets/reference/ar_basic.json scenes/ar_demo.json; do
+  bench --scene "$scene" --rpp 25 --every-kernel-feature
+done

@@ -6,7 +6,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 #include <limits>
+#include <string>
+#include <system_error>
+#include <vector>
 
 #include "camhead/base/config_json.h"
 #include "data_dir.h"
@@ -355,7 +359,22 @@ std::filesystem::path resolve_board(std::string_view name_or_path) {
                      "no camhead data folder found (one holding board/sim.json); searched:\n" +
                          describe_data_dir_search() +
                          "set CAMHEAD_DATA_DIR, or give the board file's path");
-  return dir / "board" / (s + ".json");
+  const std::filesystem::path folder = dir / "board", file = folder / (s + ".json");
+  std::error_code error;
+  if (std::filesystem::exists(file, error) || !std::filesystem::is_directory(folder, error))
+    return file; // found; or load_board names the file it cannot open
+  // A misspelt name: say which names there are.
+  std::vector<std::string> names;
+  for (const auto &entry : std::filesystem::directory_iterator(folder, error))
+    if (entry.path().extension() == ".json")
+      names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  std::string known;
+  for (const std::string &name : names)
+    known += (known.empty() ? "" : ", ") + name;
+  throw BoardError(s, "(board name)",
+                   "no board of that name in " + folder.string() + " (there: " + known +
+                       "); give a board file's path for your own");
 }
 
 Board parse_board(std::string_view json_text, const std::filesystem::path &file) {

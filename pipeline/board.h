@@ -192,7 +192,8 @@ struct Board {
 
 // "sim" and the other names in board/ resolve to board/<name>.json in the
 // data folder (data_dir.h); anything with a '/' or a '.' is a path. Throws
-// BoardError when a name is given and no data folder is found.
+// BoardError when a name is given and no data folder is found, or when its
+// board/ has no such name (the error lists the names it has).
 [[nodiscard]] std::filesystem::path resolve_board(std::string_view name_or_path);
 
 // Loads and validates a board file. Throws BoardError.

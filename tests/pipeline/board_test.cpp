@@ -68,6 +68,17 @@ TEST(Board, BareNamesResolveToTheBoardFolderAndPathsStayPaths) {
   EXPECT_EQ(resolve_board("./mine.json"), std::filesystem::path("./mine.json"));
 }
 
+TEST(Board, AnUnknownNameListsTheBoardsThereAre) {
+  try {
+    static_cast<void>(resolve_board("simm"));
+    ADD_FAILURE() << "no error for an unknown board name";
+  } catch (const BoardError &e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("simm: (board name): no board of that name in ", 0), 0u) << message;
+    EXPECT_NE(message.find("(there: example-rig, sim, sim-devices)"), std::string::npos) << message;
+  }
+}
+
 TEST(Board, ErrorsNameTheFileAndTheField) {
   const std::string file = "/rigs/test.json: ";
   EXPECT_EQ(error_of("{"), file + "(JSON): " + error_of("{").substr(file.size() + 8));
