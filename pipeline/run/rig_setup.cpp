@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -118,6 +119,44 @@ std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Sce
   return renderer::make_cpu_frame_renderer(world, threads);
 }
 
+// Tells the user why the simulated camera starts slowly, if it does: it
+// renders its world anew for each lens state (WorldPictures) until it has
+// every state of its looped trace, and meanwhile delivers fewer frames than
+// its rate, which the run counts as camera drops. And when the loop's
+// frames cannot all be kept, or never repeat, it says so and why.
+void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &format,
+                         const std::optional<TraceLens> &truth) {
+  if (!truth || !truth->loop_period_s())
+    return;
+  const double period_s = *truth->loop_period_s();
+  const double frames = period_s * sim.fps;
+  const long states = std::lround(frames);
+  if (sim.cache_mb == 0 || states < 1)
+    return;
+  if (std::abs(frames - double(states)) > 1e-6) {
+    std::fprintf(stderr,
+                 "camhead run: the simulated camera renders its world for every frame: its "
+                 "lens loop (%.3f s) is not a whole number of its frames (%.3f at %g fps), so "
+                 "its frames meet the loop at new instants each time round\n",
+                 period_s, frames, sim.fps);
+    return;
+  }
+  const std::size_t picture = base::frame_bytes(format);
+  const std::size_t capacity = std::size_t(sim.cache_mb) << 20;
+  const long kept = long(std::min<std::size_t>(std::size_t(states), capacity / picture));
+  std::fprintf(stderr,
+               "camhead run: the simulated camera renders its world anew for each of the %ld "
+               "lens states of its %.1f s loop, then replays them; until then, where a picture "
+               "takes longer than a frame to render, it delivers fewer than %g frames a second "
+               "(counted as camera drops)\n",
+               states, period_s, sim.fps);
+  if (kept < states)
+    std::fprintf(stderr,
+                 "camhead run: the simulated camera keeps %ld of them in camera.cache_mb = %u "
+                 "and renders the rest every loop; %zu would keep them all\n",
+                 kept, sim.cache_mb, (std::size_t(states) * picture + (1u << 20) - 1) >> 20);
+}
+
 // The simulated camera's picture: the scene's real objects through the lens
 // at each exposure's middle, rendered by its own frame renderer, with a new
 // noise pattern every frame as a sensor has. The lens is the physical truth
@@ -128,6 +167,7 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
                 const renderer::Scene &scene, const renderer::FrameCamera &pose,
                 const LensHub &lens, std::optional<TraceLens> truth, int threads) {
   auto world = make_world_renderer(real_world_of(scene), threads);
+  explain_world_cache(sim, format, truth);
   hal::camera::SimulatedCameraOptions options;
   options.format = format;
   options.fps = sim.fps;

@@ -30,9 +30,15 @@ std::optional<TraceLens> TraceLens::of_board(const Board &board) {
 TraceLens::TraceLens(const hl::LensTrace &trace, lens_control::LensProfile profile,
                      const TraceSourceConfig &config)
     : profile_(std::move(profile)), speed_(config.speed),
+      loop_period_s_(period_of(trace, config.loop)),
       focus_(trace, &hl::EncoderReading::focus, period_of(trace, config.loop)),
       iris_(trace, &hl::EncoderReading::iris, period_of(trace, config.loop)),
-      zoom_(trace, &hl::EncoderReading::zoom, period_of(trace, config.loop)) {}
+      zoom_(trace, &hl::EncoderReading::zoom, period_of(trace, config.loop)) {
+  if (loop_period_s_ && *loop_period_s_ > 0.0)
+    *loop_period_s_ /= speed_;
+  else
+    loop_period_s_.reset();
+}
 
 lens_control::LensState TraceLens::state_at(std::int64_t t_ns) const {
   // The replay's clock, started at CLOCK_MONOTONIC 0: trace time is the

@@ -32,12 +32,17 @@ public:
   // profile.
   [[nodiscard]] lens_control::LensState state_at(std::int64_t t_ns) const;
 
+  // How often the lens repeats, in seconds of real time, when the trace
+  // loops; else empty.
+  [[nodiscard]] std::optional<double> loop_period_s() const { return loop_period_s_; }
+
 private:
   TraceLens(const hal::lens::LensTrace &trace, lens_control::LensProfile profile,
             const TraceSourceConfig &config);
 
   lens_control::LensProfile profile_;
   double speed_;
+  std::optional<double> loop_period_s_;
   TraceCurve focus_, iris_, zoom_;
 };
 
