@@ -13,7 +13,7 @@ shift || true
 packages=(
   build-essential cmake ninja-build pkg-config git clang-format
   libvulkan-dev mesa-vulkan-drivers glslang-tools vulkan-tools
-  libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
+  libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev libpng-dev
   libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
   libgpiod-dev libusb-1.0-0-dev
   libgtest-dev libgmock-dev libbenchmark-dev

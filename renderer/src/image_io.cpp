@@ -1,10 +1,12 @@
-// OpenEXR through tinyexr and PNG through stb, both compiled into this file
-// only, so that the renderer links nothing but Vulkan dynamically. Files are
-// read into memory first so that every failure, including open errors, is
-// reported the same way (ImageError naming the file).
+// OpenEXR through tinyexr, PNG through libpng (base/png_reader.h) and
+// stb_image_write, all static or compiled into this file only, so that the
+// renderer links nothing but Vulkan dynamically. Files are read into memory
+// first so that every failure, including open errors, is reported the same
+// way (ImageError naming the file).
 #include "camhead/renderer/image_io.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <climits>
 #include <cmath>
@@ -21,7 +23,7 @@
 
 #include "camhead/base/input_file.h"
 #include "camhead/base/partial_file.h"
-#include "camhead/base/png_guard.h"
+#include "camhead/base/png_reader.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
@@ -38,13 +40,6 @@
 #define TINYEXR_USE_MINIZ 0
 #define TINYEXR_IMPLEMENTATION
 #include <tinyexr.h>
-// Only PNG is needed; leaving the other decoders out shrinks the attack
-// surface for untrusted plates.
-#define STBI_ONLY_PNG
-#define STBI_NO_STDIO
-#define STB_IMAGE_STATIC // private to this file, whoever else links stb
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb/stb_image.h>
 #define STBI_WRITE_NO_STDIO
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -56,8 +51,9 @@ namespace {
 
 // Far beyond any render (65536 x 2048) yet small enough that a corrupt header
 // cannot make us allocate tens of gigabytes.
-// 8K UHD (7680 x 4320) fits; a 16-bit RGBA decode of this many pixels is
-// 256 MiB, the most a file of any size can make stb or tinyexr allocate.
+// 8K UHD (7680 x 4320) fits; a 16-bit RGB decode of this many pixels is
+// 192 MiB beside the float image's 384, the most a file of any size can make
+// the PNG reader allocate (tinyexr: 256 MiB of 16-bit RGBA).
 constexpr std::size_t kMaxPixels = std::size_t(1) << 25;
 
 [[noreturn]] void fail(const std::filesystem::path &path, const std::string &reason) {
@@ -349,34 +345,30 @@ void write_exr(const std::filesystem::path &path, const Image &image) {
 Image read_png(const std::filesystem::path &path, std::span<const unsigned char> file,
                const std::optional<ImageSize> &expected) {
   std::string error;
-  const std::optional<std::vector<unsigned char>> checked = base::png_chunks_checked(file, error);
-  if (!checked)
+  const std::optional<base::PngInfo> info = base::read_png_info(file, error);
+  if (!info)
     fail(path, error);
-  const std::vector<unsigned char> &bytes = *checked;
-  if (bytes.size() > std::size_t(INT_MAX))
-    fail(path, "file too large");
-  const int len = int(bytes.size());
-  int w = 0, h = 0, comp = 0;
-  if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp))
-    fail(path, std::string("not a readable PNG: ") + stbi_failure_reason());
-  check_size(path, w, h, expected);
-  if (w < 1 || h < 1 || std::size_t(w) * std::size_t(h) > kMaxPixels)
+  check_size(path, info->width, info->height, expected);
+  if (info->width < 1 || info->height < 1 ||
+      std::size_t(info->width) * std::size_t(info->height) > kMaxPixels)
     fail(path, "unsupported image size");
-  if (!base::png_inflates_within_header(bytes, error))
-    fail(path, error);
-  const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
-  const std::unique_ptr<void, decltype(&stbi_image_free)> pixels(
-      sixteen ? static_cast<void *>(stbi_load_16_from_memory(bytes.data(), len, &w, &h, &comp, 3))
-              : static_cast<void *>(stbi_load_from_memory(bytes.data(), len, &w, &h, &comp, 3)),
-      &stbi_image_free);
-  if (!pixels)
-    fail(path, std::string("cannot decode PNG: ") + stbi_failure_reason());
-  Image out(w, h, 3);
-  const double scale = sixteen ? 65535.0 : 255.0;
-  for (std::size_t i = 0; i < out.data.size(); ++i) {
-    const double v = sixteen ? static_cast<const std::uint16_t *>(pixels.get())[i]
-                             : static_cast<const std::uint8_t *>(pixels.get())[i];
-    out.data[i] = float(srgb_to_linear_d(v / scale));
+  Image out(info->width, info->height, 3);
+  if (info->sixteen_bit) {
+    std::vector<std::uint16_t> samples(out.data.size());
+    if (!base::decode_png_rgb(file, std::span(samples), error))
+      fail(path, error);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      out.data[i] = float(srgb_to_linear_d(samples[i] / 65535.0));
+  } else {
+    std::vector<std::uint8_t> samples(out.data.size());
+    if (!base::decode_png_rgb(file, std::span(samples), error))
+      fail(path, error);
+    // 256 values: a table instead of a pow() per sample.
+    std::array<float, 256> linear;
+    for (std::size_t v = 0; v < linear.size(); ++v)
+      linear[v] = float(srgb_to_linear_d(double(v) / 255.0));
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      out.data[i] = linear[samples[i]];
   }
   return out;
 }

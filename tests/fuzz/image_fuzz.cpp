@@ -1,9 +1,10 @@
 // libFuzzer target for the image readers (renderer/image_io.h), built twice:
-// IMAGE_EXTENSION picks EXR (tinyexr) or PNG (stb_image). Any bytes must be
-// refused with an ImageError or decoded into a whole RGB image; any other
-// exception, crash, undefined behaviour or allocation past libFuzzer's
-// -malloc_limit_mb is a finding. PNG bytes also go through the file
-// camera's decoder (hal/video_file/png_frame.h), the other stb_image user.
+// IMAGE_EXTENSION picks EXR (tinyexr) or PNG (libpng, base/png_reader.h,
+// with CRCs unchecked in this build). Any bytes must be refused with an
+// ImageError or decoded into a whole RGB image; any other exception, crash,
+// undefined behaviour or allocation past libFuzzer's -malloc_limit_mb is a
+// finding. PNG bytes also go through the file camera's decoder
+// (hal/video_file/png_frame.h), the other PNG reader.
 #include <cstddef>
 #include <cstdint>
 #include <span>

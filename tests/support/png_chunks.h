@@ -2,6 +2,7 @@
 // zlib streams, for the damaged files that no encoder writes.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -27,6 +28,24 @@ inline std::string zlib_compressed(const std::string &raw) {
             uLong(raw.size()), 9);
   z.resize(size);
   return z;
+}
+
+// `png` with the CRC of every whole chunk made right, so that a damaged
+// file (a size changed in IHDR, a fuzzer's finding) reaches the decoder's
+// handling of what is really wrong with it rather than stopping at a CRC.
+inline std::string with_crcs_fixed(std::string png) {
+  for (std::size_t at = 8; at + 12 <= png.size();) {
+    const std::uint32_t length = std::uint32_t(std::uint8_t(png[at])) << 24 |
+                                 std::uint32_t(std::uint8_t(png[at + 1])) << 16 |
+                                 std::uint32_t(std::uint8_t(png[at + 2])) << 8 |
+                                 std::uint8_t(png[at + 3]);
+    if (length > png.size() - at - 12)
+      break; // cut short: nothing to make right
+    const auto crc = crc32(0, reinterpret_cast<const Bytef *>(png.data() + at + 4), length + 4);
+    png.replace(at + 8 + length, 4, be32(std::uint32_t(crc)));
+    at += 12 + std::size_t(length);
+  }
+  return png;
 }
 
 // An 8-bit RGB PNG of `width` x `height` whose image data is `raw`

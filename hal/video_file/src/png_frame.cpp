@@ -1,14 +1,14 @@
-// PNG through stb, compiled into this file only (private, static symbols, so
+// PNG decoding through base/png_reader.h (libpng); encoding through
+// stb_image_write, compiled into this file only (private, static symbols, so
 // the renderer's own copy in image_io.cpp does not clash). See png_frame.h.
 #include "camhead/hal/video_file/png_frame.h"
 
 #include <climits>
-#include <cstring>
-#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
-#include "camhead/base/png_guard.h"
+#include "camhead/base/png_reader.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
@@ -22,13 +22,6 @@
 #if !defined(__clang__) // GCC only; clang rejects the unknown group
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-// Only PNG: frames come from files anyone may hand us, and every other
-// decoder would be attack surface for nothing.
-#define STBI_ONLY_PNG
-#define STBI_NO_STDIO
-#define STB_IMAGE_STATIC
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb/stb_image.h>
 #define STBI_WRITE_NO_STDIO
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -37,11 +30,6 @@
 
 namespace camhead::hal::video_file {
 namespace {
-
-std::string stb_reason() {
-  const char *reason = stbi_failure_reason();
-  return reason != nullptr ? reason : "unknown error";
-}
 
 void append_bytes(void *context, void *data, int size) {
   auto *out = static_cast<std::vector<std::uint8_t> *>(context);
@@ -52,42 +40,29 @@ void append_bytes(void *context, void *data, int size) {
 } // namespace
 
 std::optional<PngSize> png_size(std::span<const std::uint8_t> file, std::string &error) {
-  int width = 0, height = 0, channels = 0;
-  if (file.size() > std::size_t(INT_MAX) ||
-      !stbi_info_from_memory(file.data(), static_cast<int>(file.size()), &width, &height,
-                             &channels)) {
-    error = "PNG: not a readable PNG (" + stb_reason() + ")";
+  const std::optional<base::PngInfo> info = base::read_png_info(file, error);
+  if (!info) {
+    error = "PNG: " + error;
     return std::nullopt;
   }
-  return PngSize{width, height};
+  return PngSize{info->width, info->height};
 }
 
 bool decode_png_rgb(std::span<const std::uint8_t> file, PngSize expected,
                     std::span<std::uint8_t> rgb, std::string &error) {
-  const std::optional<std::vector<std::uint8_t>> checked = base::png_chunks_checked(file, error);
-  if (!checked || !base::png_inflates_within_header(*checked, error)) {
+  const std::optional<PngSize> size = png_size(file, error);
+  if (!size)
+    return false;
+  if (*size != expected) {
+    error = "PNG: is " + std::to_string(size->width) + "x" + std::to_string(size->height) +
+            ", not the " + std::to_string(expected.width) + "x" + std::to_string(expected.height) +
+            " expected";
+    return false;
+  }
+  if (!base::decode_png_rgb(file, rgb, error)) {
     error = "PNG: " + error;
     return false;
   }
-  int width = 0, height = 0, channels = 0;
-  const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> pixels(
-      checked->size() > std::size_t(INT_MAX)
-          ? nullptr
-          : stbi_load_from_memory(checked->data(), static_cast<int>(checked->size()), &width,
-                                  &height, &channels, 3),
-      &stbi_image_free);
-  if (!pixels) {
-    error = "PNG: cannot decode (" + stb_reason() + ")";
-    return false;
-  }
-  const std::size_t bytes = std::size_t(width) * std::size_t(height) * 3;
-  if (PngSize{width, height} != expected || bytes != rgb.size()) {
-    error = "PNG: decodes to " + std::to_string(width) + "x" + std::to_string(height) +
-            ", not the " + std::to_string(expected.width) + "x" + std::to_string(expected.height) +
-            " its header states";
-    return false;
-  }
-  std::memcpy(rgb.data(), pixels.get(), bytes);
   return true;
 }
 

@@ -1,9 +1,10 @@
-// PNG frames through stb_image: the whole file is read into memory first, the
-// size is taken from the header and checked before anything is decoded (a
-// few bytes can claim a 100000 x 100000 image), and decoding gives 8-bit RGB
-// whatever the file holds (grey, alpha and 16-bit are converted). Encoding
-// writes 8-bit RGB. Errors are values: the file camera calls these at play
-// time, where nothing may throw. Any thread.
+// PNG frames: the whole file is read into memory first, the size is taken
+// from the header and checked before anything is decoded (a few bytes can
+// claim a 100000 x 100000 image), and decoding (libpng, base/png_reader.h)
+// gives 8-bit RGB whatever the file holds (palette, grey, alpha and 16-bit
+// are converted). Encoding (stb_image_write) writes 8-bit RGB. Errors are
+// values: the file camera calls these at play time, where nothing may
+// throw. Any thread.
 #pragma once
 
 #include <cstddef>
@@ -31,7 +32,7 @@ struct PngSize {
 
 // Decodes into `rgb`, width * 3 bytes a row, no padding, which must be
 // exactly the size of `expected` (what png_size said). False with `error`
-// when the data is corrupt or decodes to another size.
+// when the file is damaged (base::decode_png_rgb) or is another size.
 [[nodiscard]] bool decode_png_rgb(std::span<const std::uint8_t> file, PngSize expected,
                                   std::span<std::uint8_t> rgb, std::string &error);
 

@@ -1,0 +1,151 @@
+#include "camhead/base/png_reader.h"
+
+#include <bit>
+#include <cctype>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+
+#include <png.h>
+
+namespace camhead::base {
+namespace {
+
+// The file as libpng reads it, and the message of what ended the read.
+// libpng's build limits stay: a million pixels a side, and 8 MB for an
+// ancillary chunk held in memory (text, ICC profiles), 1000 of them.
+struct Source {
+  std::span<const std::uint8_t> file;
+  std::size_t at = 0;
+  char error[192] = {};
+};
+
+void read_from_memory(png_structp png, png_bytep out, std::size_t n) {
+  Source &source = *static_cast<Source *>(png_get_io_ptr(png));
+  if (n > source.file.size() - source.at)
+    png_error(png, "the file ends inside a chunk, or before IEND");
+  std::memcpy(out, source.file.data() + source.at, n);
+  source.at += n;
+}
+
+[[noreturn]] void stop_on_error(png_structp png, png_const_charp message) {
+  Source &source = *static_cast<Source *>(png_get_error_ptr(png));
+  // "Not a PNG file" reads as "not a readable PNG: not a PNG file"; "IDAT:
+  // CRC error" keeps its chunk's name.
+  const bool sentence = message[0] != '\0' && std::islower(static_cast<unsigned char>(message[1]));
+  std::snprintf(source.error, sizeof source.error, "not a readable PNG: %c%s",
+                sentence ? std::tolower(static_cast<unsigned char>(message[0])) : message[0],
+                message[0] != '\0' ? message + 1 : "");
+  png_longjmp(png, 1);
+}
+
+// A damaged ancillary chunk (text, colour metadata) is skipped: the image
+// does not depend on it.
+void skip_warning(png_structp, png_const_charp) {}
+
+// Where the rows go: nowhere (the header alone) or `bytes` at `rows`, 8 or
+// 16 bits a sample.
+struct Target {
+  bool header_only = true;
+  std::uint8_t *rows = nullptr;
+  std::size_t bytes = 0;
+  bool sixteen = false;
+};
+
+// One read of `source` into `target`. libpng reports errors by longjmp to
+// the setjmp below; no object with a destructor lives in this frame, so the
+// jump skips nothing. The caller's buffer is written row by row.
+bool read(Source &source, const Target &target, PngInfo &info) {
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, &source, &stop_on_error, &skip_warning);
+  png_infop header = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (header == nullptr) {
+    png_destroy_read_struct(&png, nullptr, nullptr);
+    std::snprintf(source.error, sizeof source.error, "cannot start libpng: out of memory");
+    return false;
+  }
+  if (setjmp(png_jmpbuf(png)) != 0) {
+    png_destroy_read_struct(&png, &header, nullptr);
+    return false;
+  }
+  png_set_read_fn(png, &source, &read_from_memory);
+#if defined(FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION)
+  // Mutated bytes seldom keep their CRCs right: the fuzzers (tests/fuzz)
+  // would stop at the checks and never reach what lies behind them.
+  png_set_crc_action(png, PNG_CRC_QUIET_USE, PNG_CRC_QUIET_USE);
+#endif
+  png_read_info(png, header);
+  const png_uint_32 width = png_get_image_width(png, header);
+  const png_uint_32 height = png_get_image_height(png, header);
+  info = {int(width), int(height), png_get_bit_depth(png, header) == 16};
+  if (!target.header_only) {
+    png_set_expand(png); // a palette to RGB, grey below 8 bits to 8, tRNS to alpha
+    png_set_gray_to_rgb(png);
+    png_set_strip_alpha(png);
+    if (target.sixteen) {
+      png_set_expand_16(png);
+      if constexpr (std::endian::native == std::endian::little)
+        png_set_swap(png);
+    } else {
+      png_set_strip_16(png);
+    }
+    const int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, header);
+    const std::size_t row_bytes = png_get_rowbytes(png, header);
+    if (row_bytes * height != target.bytes) {
+      std::snprintf(source.error, sizeof source.error,
+                    "the PNG is %ux%u; the buffer holds %zu samples, not its %zu", width, height,
+                    target.bytes / (target.sixteen ? 2 : 1),
+                    std::size_t(width) * std::size_t(height) * 3);
+      png_destroy_read_struct(&png, &header, nullptr);
+      return false;
+    }
+    // Image data past the last row ("Too much image data", found as the
+    // last row is read) is an error, not the warning libpng makes it by
+    // default: the file is damaged, or made to cost inflating.
+    png_set_benign_errors(png, 0);
+    // An interlaced image's passes fill in the rows of the passes before.
+    for (int pass = 0; pass < passes; ++pass)
+      for (png_uint_32 y = 0; y < height; ++y)
+        png_read_row(png, target.rows + y * row_bytes, nullptr);
+    // The chunks after the image, up to IEND: damaged critical ones and a
+    // missing IEND are errors, ancillary ones are skipped as before.
+    png_set_benign_errors(png, 1);
+    png_read_end(png, nullptr);
+  }
+  png_destroy_read_struct(&png, &header, nullptr);
+  return true;
+}
+
+bool decode(std::span<const std::uint8_t> file, const Target &target, std::string &error) {
+  Source source{file};
+  PngInfo info;
+  if (read(source, target, info))
+    return true;
+  error = source.error;
+  return false;
+}
+
+} // namespace
+
+std::optional<PngInfo> read_png_info(std::span<const std::uint8_t> file, std::string &error) {
+  Source source{file};
+  PngInfo info;
+  if (read(source, {}, info))
+    return info;
+  error = source.error;
+  return std::nullopt;
+}
+
+bool decode_png_rgb(std::span<const std::uint8_t> file, std::span<std::uint8_t> rgb,
+                    std::string &error) {
+  return decode(file, {false, rgb.data(), rgb.size(), false}, error);
+}
+
+bool decode_png_rgb(std::span<const std::uint8_t> file, std::span<std::uint16_t> rgb,
+                    std::string &error) {
+  return decode(file, {false, reinterpret_cast<std::uint8_t *>(rgb.data()), rgb.size_bytes(), true},
+                error);
+}
+
+} // namespace camhead::base
