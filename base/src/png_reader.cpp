@@ -39,6 +39,27 @@ void read_from_memory(png_structp png, png_bytep out, std::size_t n) {
   png_longjmp(png, 1);
 }
 
+// The bytes of image data (IDAT chunks) of `file`, as far as its chunks are
+// whole.
+std::uint64_t image_data_bytes(std::span<const std::uint8_t> file) {
+  std::uint64_t total = 0;
+  for (std::size_t at = 8; file.size() >= 12 && at <= file.size() - 12;) {
+    const std::size_t length = std::size_t(file[at]) << 24 | std::size_t(file[at + 1]) << 16 |
+                               std::size_t(file[at + 2]) << 8 | file[at + 3];
+    if (length > file.size() - at - 12)
+      break;
+    if (std::memcmp(&file[at + 4], "IDAT", 4) == 0)
+      total += length;
+    at += 12 + length;
+  }
+  return total;
+}
+
+// Deflate expands a byte to at most 1032 (a 258-byte match in 2 bits); a
+// block header and the zlib frame add a few.
+constexpr std::uint64_t kMaxInflation = 1032;
+constexpr std::uint64_t kInflationSlack = 1024;
+
 // A damaged ancillary chunk (text, colour metadata) is skipped: the image
 // does not depend on it.
 void skip_warning(png_structp, png_const_charp) {}
@@ -78,6 +99,22 @@ bool read(Source &source, const Target &target, PngInfo &info) {
   const png_uint_32 width = png_get_image_width(png, header);
   const png_uint_32 height = png_get_image_height(png, header);
   info = {int(width), int(height), png_get_bit_depth(png, header) == 16};
+  // A few bytes can claim a vast image. Image data that cannot inflate to
+  // the pixels claimed is refused now, before the caller allocates for them.
+  const std::uint64_t pixel_bytes =
+      (std::uint64_t(width) * height * png_get_bit_depth(png, header) *
+           png_get_channels(png, header) +
+       7) /
+      8;
+  const std::uint64_t data_bytes = image_data_bytes(source.file);
+  if (pixel_bytes > data_bytes * kMaxInflation + kInflationSlack) {
+    std::snprintf(source.error, sizeof source.error,
+                  "not a readable PNG: its %llu bytes of image data cannot hold the %ux%u "
+                  "image its header states",
+                  static_cast<unsigned long long>(data_bytes), width, height);
+    png_destroy_read_struct(&png, &header, nullptr);
+    return false;
+  }
   if (!target.header_only) {
     png_set_expand(png); // a palette to RGB, grey below 8 bits to 8, tRNS to alpha
     png_set_gray_to_rgb(png);

@@ -352,17 +352,20 @@ Image read_png(const std::filesystem::path &path, std::span<const unsigned char>
   if (info->width < 1 || info->height < 1 ||
       std::size_t(info->width) * std::size_t(info->height) > kMaxPixels)
     fail(path, "unsupported image size");
-  Image out(info->width, info->height, 3);
+  const std::size_t samples_rgb = std::size_t(info->width) * std::size_t(info->height) * 3;
+  Image out;
   if (info->sixteen_bit) {
-    std::vector<std::uint16_t> samples(out.data.size());
+    std::vector<std::uint16_t> samples(samples_rgb);
     if (!base::decode_png_rgb(file, std::span(samples), error))
       fail(path, error);
+    out = Image(info->width, info->height, 3);
     for (std::size_t i = 0; i < samples.size(); ++i)
       out.data[i] = float(srgb_to_linear_d(samples[i] / 65535.0));
   } else {
-    std::vector<std::uint8_t> samples(out.data.size());
+    std::vector<std::uint8_t> samples(samples_rgb);
     if (!base::decode_png_rgb(file, std::span(samples), error))
       fail(path, error);
+    out = Image(info->width, info->height, 3);
     // 256 values: a table instead of a pow() per sample.
     std::array<float, 256> linear;
     for (std::size_t v = 0; v < linear.size(); ++v)

@@ -54,13 +54,16 @@ std::string open_error(const std::filesystem::path &path) {
 
 // A real PNG whose header claims another width: stb reads the size from the
 // header and does not check its CRC, so this tests the size check alone.
-std::string png_claiming_width(std::uint32_t width) {
+// A whole PNG, 4 rows of `width` pixels of noise (which does not compress,
+// so its data can hold what its header states).
+std::string png_of_width(int width) {
   std::vector<std::uint8_t> png;
-  const std::vector<std::uint8_t> rgb(4 * 4 * 3, 0x55);
-  EXPECT_TRUE(hal::video_file::encode_png_rgb(rgb, 4, 4, 12, png));
-  for (int i = 0; i < 4; ++i) // IHDR's width, big-endian, at bytes 16-19
-    png[16 + i] = static_cast<std::uint8_t>(width >> (24 - 8 * i));
-  return test::with_crcs_fixed({png.begin(), png.end()});
+  std::vector<std::uint8_t> rgb(std::size_t(width) * 4 * 3);
+  std::uint32_t state = 1;
+  for (std::uint8_t &b : rgb)
+    b = std::uint8_t((state = state * 1664525u + 1013904223u) >> 24);
+  EXPECT_TRUE(hal::video_file::encode_png_rgb(rgb, width, 4, std::size_t(width) * 3, png));
+  return {png.begin(), png.end()};
 }
 
 TEST(PngSequence, RoundTripsPixelExactByPatternAndByFolder) {
@@ -116,7 +119,7 @@ TEST(PngSequence, AStillFrameLoops) {
 
 TEST(PngSequence, SizesAreCheckedFromTheHeaderBeforeDecoding) {
   const test::ScratchDir dir;
-  test::write_text(dir / "huge.png", png_claiming_width(20000));
+  test::write_text(dir / "huge.png", png_of_width(20000));
   EXPECT_EQ(open_error(dir / "huge.png"),
             (dir / "huge.png").string() + ": PNG header: size 20000x4 is over 16384 pixels a side");
 
@@ -124,7 +127,7 @@ TEST(PngSequence, SizesAreCheckedFromTheHeaderBeforeDecoding) {
   // decoded, naming the file.
   const auto format = test::make_format(PixelFormat::rgb24, 4, 4);
   write_sequence((dir / "seq" / "%02d.png").string(), format, 2);
-  test::write_text(dir / "seq" / "02.png", png_claiming_width(20000));
+  test::write_text(dir / "seq" / "02.png", png_of_width(20000));
   auto camera = open(dir / "seq" / "%02d.png");
   EXPECT_EQ(test::read_all(*camera).size(), 2u);
   EXPECT_FALSE(camera->status().connected);
