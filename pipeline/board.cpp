@@ -114,7 +114,7 @@ private:
     };
     if (type == "sim") {
       d.object({"type"}, with_common({"fps", "samples", "cache_mb", "disconnect_after_frames",
-                                      "disconnect_s"}));
+                                      "disconnect_s", "disconnect_silently"}));
       SimCameraConfig sim;
       if (d.has("fps"))
         sim.fps = d.at("fps").number(Range::within(1.0, 240.0));
@@ -127,6 +127,8 @@ private:
             std::uint64_t(d.at("disconnect_after_frames").integer(0, 1 << 30));
       if (d.has("disconnect_s"))
         sim.disconnect_s = d.at("disconnect_s").number(Range::within(0.0, 3600.0));
+      if (d.has("disconnect_silently"))
+        sim.disconnect_silently = d.at("disconnect_silently").boolean();
       camera.kind = sim;
     } else if (type == "file") {
       d.object({"type", "path"}, with_common({"loop", "realtime"}));

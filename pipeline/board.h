@@ -117,9 +117,10 @@ struct SimCameraConfig {
   // Memory for pictures already rendered, MiB; 0 renders every frame.
   std::uint32_t cache_mb = 256;
   // Fault option: the camera goes away after this many frames, for
-  // disconnect_s, and comes back.
+  // disconnect_s, and comes back; silently: it only stops sending.
   std::optional<std::uint64_t> disconnect_after_frames;
   double disconnect_s = 1.0;
+  bool disconnect_silently = false;
 };
 
 // A Y4M video or PNG sequence played as the camera (hal/camera/file).

@@ -10,10 +10,13 @@
 #include <vector>
 
 #include "board.h"
+#include "camhead/base/config_error.h"
+#include "camhead/hal/output/file/file_sink.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "commands.h"
+#include "run/output_uri.h"
 #include "run/run_loop.h"
 
 namespace camhead::cli {
@@ -32,8 +35,13 @@ struct RunArgs {
 
 std::atomic<bool> stop_requested{false};
 
-extern "C" void on_stop_signal(int) {
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// The first signal asks the run to stop and finish its outputs; the handler
+// then steps aside, so that a second one ends a run that does not stop.
+extern "C" void on_stop_signal(int signal) {
   stop_requested = true;
+  std::signal(signal, SIG_DFL);
 }
 
 int run(const RunArgs &args) {
@@ -60,8 +68,8 @@ int run(const RunArgs &args) {
   options.stop = &stop_requested;
 
   stop_requested = false;
-  std::signal(SIGINT, on_stop_signal);
-  std::signal(SIGTERM, on_stop_signal);
+  for (const int signal : kStopSignals)
+    std::signal(signal, on_stop_signal);
   int status = 0;
   try {
     const pipeline::RunSummary s = pipeline::run_pipeline(options);
@@ -83,6 +91,18 @@ int run(const RunArgs &args) {
   } catch (const lens_control::ProfileError &e) {
     std::fprintf(stderr, "lens profile error: %s\n", e.what());
     status = 2;
+  } catch (const base::ConfigError &e) { // a lens trace, a board's source, ...
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 2;
+  } catch (const pipeline::OutputError &e) { // an output URI
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 2;
+  } catch (const hal::output::FileSinkError &e) {
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 4;
+  } catch (const pipeline::StatsFileError &e) {
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 4;
   } catch (const renderer::GpuError &e) {
     std::fprintf(stderr,
                  "camhead run: Vulkan error: %s\n(--executor cpu renders with the CPU reference "
@@ -93,8 +113,8 @@ int run(const RunArgs &args) {
     std::fprintf(stderr, "camhead run: %s\n", e.what());
     status = 3;
   }
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  for (const int signal : kStopSignals)
+    std::signal(signal, SIG_DFL);
   return status;
 }
 
@@ -105,8 +125,9 @@ void add_run_command(CLI::App &app) {
   CLI::App *cmd = app.add_subcommand(
       "run", "The live pipeline: the board's camera and lens in, the virtual objects rendered\n"
              "with the lens's depth of field at each frame's mid-exposure and composited into\n"
-             "the camera frame, out to every output. Stops at Ctrl-C (or SIGTERM), after\n"
-             "--duration or --frames, or when a camera file played once ends.\n"
+             "the camera frame, out to every output. Stops at Ctrl-C (or SIGTERM, SIGHUP),\n"
+             "after --duration or --frames, or when a camera file played once ends; a\n"
+             "second Ctrl-C ends it at once.\n"
              "Outputs:\n"
              "  file:PATH.y4m[?format=yuyv|nv12]  Y4M video (ffplay PATH.y4m, mpv PATH.y4m)\n"
              "  file:DIR/%05d.png                 one PNG a frame\n"

@@ -173,6 +173,7 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
   options.fps = sim.fps;
   options.disconnect_after_frames = sim.disconnect_after_frames;
   options.disconnect_s = sim.disconnect_s;
+  options.disconnect_silently = sim.disconnect_silently;
   const std::uint32_t samples = sim.samples;
   auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
   auto generator = [world, cache, format, pose, samples, &lens,

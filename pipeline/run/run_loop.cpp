@@ -1,11 +1,15 @@
 #include "run_loop.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 #include <utility>
 #include <variant>
@@ -14,6 +18,7 @@
 
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/base/partial_file.h"
 #include "camhead/hal/camera/camera_source.h"
 #include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_budget.h"
@@ -61,6 +66,9 @@ struct Counters {
 // without a frame: without a composite for this long, the last one again,
 // or the placeholder while there is no camera (or none yet).
 constexpr std::int64_t kRepeatAfterNs = 500'000'000;
+// A camera without a frame for this long (or four frame intervals, if
+// longer) counts as lost, whatever it says.
+constexpr std::int64_t kCameraSilentNs = 1'000'000'000;
 constexpr int kSlots = 3; // frames between render and output
 
 class Pipeline {
@@ -78,6 +86,7 @@ private:
   void output_loop();
   void status_loop();
   void print_status(std::int64_t now, double dt, std::uint64_t in, std::uint64_t out, bool tty);
+  void report_sink_errors(bool tty);
   RunSummary finish();
   // Sends one frame to every sink; `fill` writes sink i's buffer.
   template <typename Fill> void send(Fill fill, std::int64_t capture_ns);
@@ -96,6 +105,7 @@ private:
 
   std::vector<Slot> slots_{kSlots};
   std::vector<std::vector<std::uint8_t>> last_frames_; // what each sink showed last
+  std::vector<std::uint64_t> sink_errors_seen_;        // status thread: reported so far
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   Counters counters_;
@@ -107,13 +117,32 @@ private:
   std::int64_t last_output_ns_ = 0; // output thread only
 };
 
+// Two outputs on one file or device would write over each other (one
+// file's frames and headers interleaved); the second is refused.
+bool same_target(const OutputSpec &a, const OutputSpec &b) {
+  if (a.kind == OutputKind::null || b.kind == OutputKind::null)
+    return false;
+  if (a.kind == OutputKind::drm || b.kind == OutputKind::drm) // a card drives connectors
+    return a.kind == b.kind && a.target == b.target && a.connector == b.connector;
+  std::error_code error;
+  const std::filesystem::path pa = std::filesystem::weakly_canonical(a.target, error);
+  const std::filesystem::path pb = std::filesystem::weakly_canonical(b.target, error);
+  return error ? a.target == b.target : pa == pb;
+}
+
 std::vector<OutputSpec> output_specs(const RunOptions &options) {
   std::vector<OutputSpec> specs;
-  for (const std::string &uri : options.outputs.empty() ? options.board.outputs : options.outputs)
-    specs.push_back(parse_output_uri(uri));
+  for (const std::string &uri : options.outputs.empty() ? options.board.outputs : options.outputs) {
+    OutputSpec spec = parse_output_uri(uri);
+    for (const OutputSpec &earlier : specs)
+      if (same_target(spec, earlier))
+        throw OutputError(uri, "writes to " + spec.target + " as " + earlier.uri +
+                                   " does; give each output its own file or device");
+    specs.push_back(std::move(spec));
+  }
   if (specs.empty())
-    throw std::runtime_error("no output: give --output URI, or \"outputs\" in " +
-                             options.board.file.string());
+    throw OutputError(options.board.file.string(),
+                      "no output: give --output URI, or \"outputs\" in the board");
   return specs;
 }
 
@@ -137,9 +166,14 @@ Pipeline::Pipeline(const RunOptions &options)
   for (const OutputSpec &spec : specs)
     sinks_.push_back(open_output(spec, board_.camera->width, board_.camera->height, fps_));
   if (options.stats_file) {
+    // Written as the run goes (a line a frame, for `tail -f`), not as a
+    // partial file; but never into a FIFO or a device node.
+    if (const std::string reason = base::check_replaceable(*options.stats_file); !reason.empty())
+      throw StatsFileError(options.stats_file->string() + ": " + reason);
     stats_ = std::fopen(options.stats_file->c_str(), "w");
     if (stats_ == nullptr)
-      throw std::runtime_error(options.stats_file->string() + ": cannot be written");
+      throw StatsFileError(options.stats_file->string() +
+                           ": cannot be written: " + std::strerror(errno));
   }
   // Every buffer the loop uses, made now.
   for (Slot &slot : slots_)
@@ -147,6 +181,7 @@ Pipeline::Pipeline(const RunOptions &options)
       slot.images.emplace_back(base::frame_bytes(sink->format()));
   for (const auto &sink : sinks_)
     last_frames_.emplace_back(base::frame_bytes(sink->format()));
+  sink_errors_seen_.assign(sinks_.size(), 0);
   for (int i = 0; i < kSlots; ++i)
     (void)free_slots_.push(i);
   if (const auto *file = std::get_if<FileCameraConfig>(&board_.camera->kind))
@@ -168,10 +203,20 @@ bool Pipeline::should_stop() const {
 }
 
 void Pipeline::capture_loop() {
+  // A camera that goes silent without saying it is gone (a capture card that
+  // lost its signal, a libcamera sensor that stopped) is lost as well: the
+  // outputs show the placeholder, not its last frame forever.
+  const std::int64_t silent_after_ns =
+      std::max<std::int64_t>(kCameraSilentNs, std::llround(4e9 / fps_));
+  std::int64_t last_frame_ns = base::monotonic_ns();
   while (!should_stop()) {
     CapturedFrame frame;
     const CaptureResult result = camera_->wait_frame(100ms, frame);
-    counters_.camera_lost = result == CaptureResult::disconnected;
+    const std::int64_t now = base::monotonic_ns();
+    if (result == CaptureResult::frame)
+      last_frame_ns = now;
+    counters_.camera_lost = result == CaptureResult::disconnected ||
+                            (!lossless_ && now - last_frame_ns > silent_after_ns);
     if (result == CaptureResult::ended) {
       stopping_ = true;
       break;
@@ -204,7 +249,7 @@ void Pipeline::render_loop() {
   for (;;) {
     std::optional<Delivered> delivered = captured_.pop(100ms);
     if (!delivered) {
-      if (captured_.closed())
+      if (captured_.drained())
         break;
       continue;
     }
@@ -291,9 +336,11 @@ void Pipeline::output_loop() {
   for (;;) {
     const std::optional<int> slot_index = ready_slots_.pop(100ms);
     if (!slot_index) {
-      if (ready_slots_.closed())
+      if (ready_slots_.drained())
         break;
-      if (base::monotonic_ns() - last_output_ns_ < kRepeatAfterNs)
+      // A take composited offline gets its composites alone, and a run that
+      // is stopping no more frames.
+      if (lossless_ || should_stop() || base::monotonic_ns() - last_output_ns_ < kRepeatAfterNs)
         continue;
       const bool repeat = shown_any && !counters_.camera_lost && !counters_.renderer_lost;
       if (repeat) {
@@ -349,17 +396,35 @@ void Pipeline::print_status(std::int64_t now, double dt, std::uint64_t in, std::
   const char *alarm = counters_.renderer_lost ? "  GPU LOST: placeholder"
                       : counters_.camera_lost ? "  CAMERA LOST: placeholder"
                                               : "";
+  char output_errors[48] = "";
+  if (const std::uint64_t errors = counters_.sink_errors; errors > 0)
+    std::snprintf(output_errors, sizeof output_errors, "  OUTPUT ERRORS %" PRIu64, errors);
   std::fprintf(options_.status,
                "%sin %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
-               " (camera %" PRIu64 ", render busy %" PRIu64
-               ")  focus %s f/%.1f %.0f mm%s  latency %.0f ms%s%s",
+               " (camera %" PRIu64 ", render busy %" PRIu64 ", output busy %" PRIu64
+               ")  focus %s f/%.1f %.0f mm%s  latency %.0f ms%s%s%s",
                tty ? "\r\033[K" : "", double(in) / dt, double(out) / dt, counters_.rpp.load(),
                0.1 * counters_.traced_permille.load(),
                cam.dropped + counters_.render_busy + counters_.output_busy, cam.dropped,
-               counters_.render_busy.load(), focus, lens.state.f_number.value,
-               lens.state.focal_length_mm.value, lens.fresh ? "" : " (stale)",
-               1e-6 * double(counters_.latency_ns.load()), alarm, tty ? "" : "\n");
+               counters_.render_busy.load(), counters_.output_busy.load(), focus,
+               lens.state.f_number.value, lens.state.focal_length_mm.value,
+               lens.fresh ? "" : " (stale)", 1e-6 * double(counters_.latency_ns.load()), alarm,
+               output_errors, tty ? "" : "\n");
   std::fflush(options_.status);
+}
+
+// An output that failed since the last look says what failed (the device or
+// file, and why) on a line of its own: a count alone tells nobody which of
+// them ran out of disk.
+void Pipeline::report_sink_errors(bool tty) {
+  for (std::size_t i = 0; i < sinks_.size(); ++i) {
+    const hal::output::SinkStatus status = sinks_[i]->status();
+    if (status.errors == sink_errors_seen_[i])
+      continue;
+    std::fprintf(options_.status, "%scamhead run: %s (%" PRIu64 " failed so far)\n",
+                 tty ? "\r\033[K" : "", status.detail.c_str(), status.errors);
+    sink_errors_seen_[i] = status.errors;
+  }
 }
 
 // The status line: redrawn in place on a terminal, a line a second in logs.
@@ -377,6 +442,7 @@ void Pipeline::status_loop() {
     if (options_.status == nullptr || now - last_ns < 900'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
+    report_sink_errors(tty);
     print_status(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out, tty);
     last_in = in;
     last_out = out;
@@ -409,6 +475,8 @@ RunSummary Pipeline::run() {
 
 RunSummary Pipeline::finish() {
   RunSummary summary;
+  if (options_.status != nullptr)
+    report_sink_errors(false); // those of the last second
   for (const auto &sink : sinks_)
     if (!sink->close()) {
       ++summary.sink_errors;
@@ -417,9 +485,13 @@ RunSummary Pipeline::finish() {
                      sink->status().detail.c_str());
     }
   // Closed once, here or (after a failed run) by the destructor.
-  if (std::FILE *stats = std::exchange(stats_, nullptr);
-      stats != nullptr && std::fclose(stats) != 0)
-    throw std::runtime_error(options_.stats_file->string() + ": write failed");
+  if (std::FILE *stats = std::exchange(stats_, nullptr); stats != nullptr) {
+    // A failed write mid-run shows in ferror(), the last one in fclose().
+    const bool written = std::ferror(stats) == 0;
+    if (std::fclose(stats) != 0 || !written)
+      throw StatsFileError(options_.stats_file->string() +
+                           ": not all of the statistics were written (a full disk?)");
+  }
   const hal::camera::CameraStatus cam = camera_->status();
   summary.frames_in = counters_.frames_in;
   summary.frames_out = counters_.frames_out;

@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -60,9 +61,16 @@ struct RunSummary {
   std::string executor;
 };
 
+// The statistics file (--record-stats) cannot be opened or written.
+class StatsFileError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
 // Sets everything up (throws std::runtime_error naming the board field,
 // file or device at fault before any output is written), runs until
-// `frames`, `duration_s` or `*stop`, and closes the outputs.
+// `frames`, `duration_s` or `*stop`, and closes the outputs. Throws
+// StatsFileError when the statistics could not all be written.
 RunSummary run_pipeline(const RunOptions &options);
 
 } // namespace camhead::pipeline

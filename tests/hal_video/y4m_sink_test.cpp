@@ -152,14 +152,30 @@ TEST(Y4mSink, MisuseIsAStatusNotAThrow) {
   auto sink = hal::output::open_y4m_sink(dir / "out.y4m", kFormat, 25);
   EXPECT_FALSE(sink->submit(0));
   EXPECT_NE(sink->status().detail.find("submit without acquire"), std::string::npos);
+  submit_one(*sink, 0);
   ASSERT_TRUE(sink->close());
   EXPECT_TRUE(sink->acquire().empty());
   EXPECT_FALSE(sink->submit(0));
   EXPECT_FALSE(sink->close());
   EXPECT_EQ(sink->status().errors, 3u);
-  EXPECT_EQ(sink->status().frames, 0u);
-  EXPECT_EQ(test::read_text(dir / "out.y4m"),
-            "YUV4MPEG2 W8 H2 F25:1 Ip A1:1 C422 XCOLORRANGE=LIMITED\n");
+  EXPECT_EQ(sink->status().frames, 1u);
+  EXPECT_EQ(test::read_text(dir / "out.y4m")
+                .rfind("YUV4MPEG2 W8 H2 F25:1 Ip A1:1 C422 XCOLORRANGE=LIMITED\nFRAME\n", 0),
+            0u);
+}
+
+// A run stopped before its first frame (Ctrl-C while it starts) leaves no
+// file that no player opens, and keeps the take that was there.
+TEST(Y4mSink, WithoutAFrameTheOldFileIsKept) {
+  const test::ScratchDir dir;
+  test::write_text(dir / "take.y4m", "the take of yesterday");
+  auto sink = hal::output::open_y4m_sink(dir / "take.y4m", kFormat, 25);
+  EXPECT_FALSE(sink->close());
+  EXPECT_EQ(sink->status().detail, "file " + (dir / "take.y4m").string() +
+                                       ": not written: no frame reached it (an earlier file "
+                                       "of that name is kept)");
+  EXPECT_EQ(test::read_text(dir / "take.y4m"), "the take of yesterday");
+  EXPECT_FALSE(std::filesystem::exists(dir / "take.y4m.partial"));
 }
 
 TEST(Y4mSink, AFailedWriteIsCutOffAndTheFileStaysWhole) {

@@ -2,6 +2,7 @@
 // camera frame that nothing virtual touches reaches the output byte for
 // byte; a camera that goes away leaves the outputs running on the
 // placeholder and is taken up again; drops are counted, never hidden.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -61,6 +62,44 @@ TEST_F(RunLoop, CameraFramesThatNothingVirtualTouchesLeaveByteForByte) {
   }
 }
 
+// A take composited offline (a file camera not in real time) gets its
+// composites and nothing else, however long each takes: a live output shows
+// the last frame again after 0.5 s without a new one, a file must not.
+TEST_F(RunLoop, AnOfflineTakeGetsItsCompositesAlone) {
+  // Three frames: while the first renders, the third waits to be taken, so
+  // the run is not yet stopping.
+  const int w = 48, h = 32, n = 3;
+  const std::vector<std::vector<std::uint8_t>> frames(
+      n, std::vector<std::uint8_t>(std::size_t(w) * h * 2, 128));
+  const fs::path input = write("in.y4m", y4m_422(w, h, frames));
+  // A lit virtual wall that fills the frame, at 2048 rays a pixel on one
+  // thread of the CPU reference: about a second a frame.
+  const fs::path scene = write("wall.json", R"({"render": {"width": 48, "height": 32, "samples": 1},
+    "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0],
+               "focal_length_mm": 35, "sensor_width_mm": 36, "f_number": 2, "focus_distance_m": 2},
+    "materials": {"grey": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "objects": [{"name": "wall", "type": "plane", "center": [0, 0, -3], "size": [20, 20],
+                 "rotation_deg": [90, 0, 0], "material": "grey", "real": false}],
+    "lights": [{"name": "key", "type": "point", "position": [0, 1, -1], "power_W": 100}]})");
+  RunOptions options;
+  options.board = board(R"({"type": "file", "path": ")" + input.string() +
+                            R"(", "loop": false, "realtime": false, "width": 48, "height": 32})",
+                        scene, "", R"(, "render": {"executor": "cpu", "rays_per_pixel": 2048})");
+  options.threads = 1;
+  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
+  options.stats_file = dir_ / "stats.jsonl";
+  options.status = nullptr;
+  const RunSummary summary = run_pipeline(options);
+  double longest_render_s = 0.0;
+  for (const CompositeRecord &r : recorded_composites(dir_ / "stats.jsonl"))
+    longest_render_s = std::max(longest_render_s, r.render_s);
+  ASSERT_GT(longest_render_s, 0.6) << "renders this fast check nothing: raise the rays per pixel";
+  EXPECT_EQ(summary.frames_out, std::uint64_t(n));
+  EXPECT_EQ(summary.repeats, 0u);
+  EXPECT_EQ(summary.placeholders, 0u);
+  EXPECT_EQ(y4m_frames(dir_ / "out.y4m", frames[0].size()).size(), std::size_t(n));
+}
+
 TEST_F(RunLoop, LostCameraShowsThePlaceholderAndIsTakenUpAgain) {
   RunOptions options;
   options.board = board(R"({"type": "sim", "width": 32, "height": 16, "fps": 25,
@@ -72,6 +111,25 @@ TEST_F(RunLoop, LostCameraShowsThePlaceholderAndIsTakenUpAgain) {
   const RunSummary summary = run_pipeline(options);
   EXPECT_EQ(summary.camera_reconnects, 1u);
   EXPECT_GE(summary.placeholders, 2u) << "1.5 s without frames, a placeholder every 0.5 s";
+  EXPECT_GT(summary.frames_out, 10u) << "frames after the camera came back";
+}
+
+// A camera that only stops sending (a capture card without signal) says
+// nothing; after a second without frames the outputs show the placeholder
+// all the same, not its last frame for as long as it stays silent.
+TEST_F(RunLoop, SilentCameraShowsThePlaceholderToo) {
+  RunOptions options;
+  options.board = board(R"({"type": "sim", "width": 32, "height": 16, "fps": 25,
+                            "disconnect_after_frames": 5, "disconnect_s": 3,
+                            "disconnect_silently": true})",
+                        real_scene(32, 16));
+  options.outputs = {"null"};
+  options.duration_s = 4.5;
+  options.status = nullptr;
+  const RunSummary summary = run_pipeline(options);
+  EXPECT_EQ(summary.camera_reconnects, 0u) << "it never said it was gone";
+  EXPECT_GE(summary.repeats, 1u) << "the last frame again within the first second";
+  EXPECT_GE(summary.placeholders, 3u) << "3 s without frames: from 1 s on, one every 0.5 s";
   EXPECT_GT(summary.frames_out, 10u) << "frames after the camera came back";
 }
 

@@ -84,6 +84,14 @@ public:
     return closed_;
   }
 
+  // Closed with nothing left to pop: what a consumer whose pop() came back
+  // empty checks before it stops, since an item may have come between the
+  // two (pushed just before the close).
+  [[nodiscard]] bool drained() const {
+    std::lock_guard lock(mutex_);
+    return closed_ && items_.empty();
+  }
+
 private:
   const std::size_t capacity_;
   mutable std::mutex mutex_;

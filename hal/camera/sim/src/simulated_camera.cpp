@@ -44,11 +44,12 @@ public:
     if (gone_until_ns_ != 0) {
       if (now < gone_until_ns_) {
         sleep_until_ns(std::min(deadline, gone_until_ns_));
-        return CaptureResult::disconnected;
+        return options_.disconnect_silently ? CaptureResult::timeout : CaptureResult::disconnected;
       }
       // Back: a camera that was re-plugged starts a new stream.
       gone_until_ns_ = 0;
-      set_connected(true, "back after a simulated disconnect");
+      if (!options_.disconnect_silently)
+        set_connected(true, "back after a simulated disconnect");
       if (options_.realtime)
         next_ = frame_due_after(base::monotonic_ns());
     }
@@ -76,6 +77,8 @@ public:
         !fault_done_) {
       fault_done_ = true;
       gone_until_ns_ = base::monotonic_ns() + std::int64_t(options_.disconnect_s * 1e9);
+      if (options_.disconnect_silently)
+        return CaptureResult::timeout;
       set_connected(false,
                     "simulated disconnect for " + std::to_string(options_.disconnect_s) + " s");
       return CaptureResult::disconnected;

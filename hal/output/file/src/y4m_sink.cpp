@@ -68,6 +68,12 @@ public:
       file_.discard();
       return fail("not written: an earlier write failed and could not be undone");
     }
+    if (status().frames == 0) {
+      // A run stopped before its first frame (Ctrl-C while it started)
+      // must not replace a take with a file no player opens.
+      file_.discard();
+      return fail("not written: no frame reached it (an earlier file of that name is kept)");
+    }
     if (!file_.commit(true, error))
       return fail(error);
     const std::lock_guard lock(mutex_);

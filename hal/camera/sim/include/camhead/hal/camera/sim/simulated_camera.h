@@ -43,6 +43,9 @@ struct SimulatedCameraOptions {
   // (wait_frame answers disconnected), then comes back on its own.
   std::optional<std::uint64_t> disconnect_after_frames;
   double disconnect_s = 1.0;
+  // ... or, silent, it only stops sending (wait_frame times out, the status
+  // stays connected), as a capture card that lost its signal does.
+  bool disconnect_silently = false;
 };
 
 // Throws std::invalid_argument for a format check_video_format() refuses, a
