@@ -18,7 +18,6 @@
 
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
-#include "camhead/base/partial_file.h"
 #include "camhead/hal/camera/camera_source.h"
 #include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_budget.h"
@@ -166,10 +165,9 @@ Pipeline::Pipeline(const RunOptions &options)
   for (const OutputSpec &spec : specs)
     sinks_.push_back(open_output(spec, board_.camera->width, board_.camera->height, fps_));
   if (options.stats_file) {
-    // Written as the run goes (a line a frame, for `tail -f`), not as a
-    // partial file; but never into a FIFO or a device node.
-    if (const std::string reason = base::check_replaceable(*options.stats_file); !reason.empty())
-      throw StatsFileError(options.stats_file->string() + ": " + reason);
+    // A stream of records, written as the run goes (for `tail -f`, or into
+    // a FIFO or /dev/stdout on purpose), not a partial file renamed at the
+    // end as camhead's other files are.
     stats_ = std::fopen(options.stats_file->c_str(), "w");
     if (stats_ == nullptr)
       throw StatsFileError(options.stats_file->string() +
@@ -206,9 +204,11 @@ void Pipeline::capture_loop() {
   // A camera that goes silent without saying it is gone (a capture card that
   // lost its signal, a libcamera sensor that stopped) is lost as well: the
   // outputs show the placeholder, not its last frame forever.
+  // Silence counts from the first frame: a camera still starting is not
+  // lost (the outputs show the placeholder until it sends anyway).
   const std::int64_t silent_after_ns =
       std::max<std::int64_t>(kCameraSilentNs, std::llround(4e9 / fps_));
-  std::int64_t last_frame_ns = base::monotonic_ns();
+  std::optional<std::int64_t> last_frame_ns;
   while (!should_stop()) {
     CapturedFrame frame;
     const CaptureResult result = camera_->wait_frame(100ms, frame);
@@ -216,7 +216,7 @@ void Pipeline::capture_loop() {
     if (result == CaptureResult::frame)
       last_frame_ns = now;
     counters_.camera_lost = result == CaptureResult::disconnected ||
-                            (!lossless_ && now - last_frame_ns > silent_after_ns);
+                            (!lossless_ && last_frame_ns && now - *last_frame_ns > silent_after_ns);
     if (result == CaptureResult::ended) {
       stopping_ = true;
       break;
