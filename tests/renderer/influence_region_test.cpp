@@ -204,17 +204,10 @@ TEST(InfluenceRegion, GpuCompositeBitForBit) {
   std::vector<Scene> scenes = test::small_reference_scenes();
   for (std::uint32_t seed = 1; seed <= 40; ++seed)
     scenes.push_back(test::random_scene(seed));
-  // A virtual glass ball before a real lamp, as light_transport_test's, at
-  // many batches of samples.
-  Scene glass = test::empty_scene("glass ball", 0.0f, 1.0f, 32, 32);
-  glass.render.max_bounces = 4;
+  // The glass ball, as light_transport_test's, at many batches of samples.
+  Scene glass = test::glass_ball_before_lamp(0.0f, 1.0f);
   glass.render.samples = 256;
-  glass.materials = {{"glass", renderer::MaterialType::glass, glm::vec3(1.0f), 1.5f},
-                     {"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
-  glass.objects = {
-      test::sphere("ball", glm::vec3(0.0f, 0.0f, -4.0f), 0.3f, 0, false),
-      test::box("lamp", glm::vec3(0.0f, 0.0f, -8.0f), glm::vec3(100.0f, 100.0f, 0.1f), 1, true)};
-  scenes.push_back(test::with_noise_plate(std::move(glass), 9));
+  scenes.push_back(std::move(glass));
   for (const Scene &scene : scenes) {
     const CompiledScene compiled = renderer::compile_scene(scene);
     tracer.load(compiled);

@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
@@ -60,14 +60,7 @@ std::vector<Scene> scenes_of_every_kind() {
   std::vector<Scene> scenes = test::small_reference_scenes();
   for (std::uint32_t seed = 1; seed <= 24; ++seed)
     scenes.push_back(test::random_scene(seed));
-  Scene glass = test::empty_scene("glass ball", 2.8f, 4.0f, 32, 32);
-  glass.render.max_bounces = 4;
-  glass.materials = {{"glass", renderer::MaterialType::glass, glm::vec3(1.0f), 1.5f},
-                     {"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
-  glass.objects = {
-      test::sphere("ball", glm::vec3(0.0f, 0.0f, -4.0f), 0.3f, 0, false),
-      test::box("lamp", glm::vec3(0.0f, 0.0f, -8.0f), glm::vec3(100.0f, 100.0f, 0.1f), 1, true)};
-  scenes.push_back(test::with_noise_plate(std::move(glass), 9));
+  scenes.push_back(test::glass_ball_before_lamp(2.8f, 4.0f));
   return scenes;
 }
 

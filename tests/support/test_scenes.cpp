@@ -224,6 +224,17 @@ renderer::Scene random_scene(std::uint32_t seed) {
   return with_noise_plate(std::move(scene), seed);
 }
 
+renderer::Scene glass_ball_before_lamp(float f_number, float focus_m) {
+  renderer::Scene scene = empty_scene("glass ball", f_number, focus_m, 32, 32);
+  scene.render.max_bounces = 4;
+  scene.materials = {{"glass", renderer::MaterialType::glass, glm::vec3(1.0f), 1.5f},
+                     {"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
+  scene.objects = {
+      sphere("ball", glm::vec3(0.0f, 0.0f, -4.0f), 0.3f, 0, false),
+      box("lamp", glm::vec3(0.0f, 0.0f, -8.0f), glm::vec3(100.0f, 100.0f, 0.1f), 1, true)};
+  return with_noise_plate(std::move(scene), 9);
+}
+
 std::vector<renderer::Scene> small_reference_scenes() {
   std::vector<renderer::Scene> scenes;
   for (const char *name : {"ar_basic.json", "boxes.json"})

@@ -60,6 +60,11 @@ namespace camhead::test {
 // from f/1 to f/16 focused anywhere from 0.3 m to 20 m; 48 x 36 pixels.
 [[nodiscard]] renderer::Scene random_scene(std::uint32_t seed);
 
+// A virtual glass ball (IOR 1.5, radius 0.3 m, 4 m away) before a real lamp
+// that fills the view, 4 bounces, 32 x 32, with a noise plate: light
+// through glass, many bounces deep.
+[[nodiscard]] renderer::Scene glass_ball_before_lamp(float f_number, float focus_m);
+
 // The reference scenes ar_basic and boxes, the demo and the simulated rig's
 // scene at a quarter of their size, each with its plate or a noise plate.
 [[nodiscard]] std::vector<renderer::Scene> small_reference_scenes();
