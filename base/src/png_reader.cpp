@@ -65,9 +65,10 @@ constexpr std::uint64_t kInflationSlack = 1024;
 void skip_warning(png_structp, png_const_charp) {}
 
 // Where the rows go: nowhere (the header alone) or `bytes` at `rows`, 8 or
-// 16 bits a sample.
+// 16 bits a sample, for an image of `width` x `height`.
 struct Target {
   bool header_only = true;
+  int width = 0, height = 0;
   std::uint8_t *rows = nullptr;
   std::size_t bytes = 0;
   bool sixteen = false;
@@ -116,6 +117,14 @@ bool read(Source &source, const Target &target, PngInfo &info) {
     return false;
   }
   if (!target.header_only) {
+    const std::size_t sample_bytes = target.sixteen ? 2 : 1;
+    if (info.width != target.width || info.height != target.height ||
+        std::size_t(target.width) * std::size_t(target.height) * 3 * sample_bytes != target.bytes) {
+      std::snprintf(source.error, sizeof source.error, "is %ux%u, not the %dx%d expected", width,
+                    height, target.width, target.height);
+      png_destroy_read_struct(&png, &header, nullptr);
+      return false;
+    }
     png_set_expand(png); // a palette to RGB, grey below 8 bits to 8, tRNS to alpha
     png_set_gray_to_rgb(png);
     png_set_strip_alpha(png);
@@ -128,15 +137,8 @@ bool read(Source &source, const Target &target, PngInfo &info) {
     }
     const int passes = png_set_interlace_handling(png);
     png_read_update_info(png, header);
+    // The transforms make rows of 3 samples a pixel, as checked above.
     const std::size_t row_bytes = png_get_rowbytes(png, header);
-    if (row_bytes * height != target.bytes) {
-      std::snprintf(source.error, sizeof source.error,
-                    "the PNG is %ux%u; the buffer holds %zu samples, not its %zu", width, height,
-                    target.bytes / (target.sixteen ? 2 : 1),
-                    std::size_t(width) * std::size_t(height) * 3);
-      png_destroy_read_struct(&png, &header, nullptr);
-      return false;
-    }
     // Image data past the last row ("Too much image data", found as the
     // last row is read) is an error, not the warning libpng makes it by
     // default: the file is damaged, or made to cost inflating.
@@ -174,14 +176,16 @@ std::optional<PngInfo> read_png_info(std::span<const std::uint8_t> file, std::st
   return std::nullopt;
 }
 
-bool decode_png_rgb(std::span<const std::uint8_t> file, std::span<std::uint8_t> rgb,
-                    std::string &error) {
-  return decode(file, {false, rgb.data(), rgb.size(), false}, error);
+bool decode_png_rgb(std::span<const std::uint8_t> file, const PngInfo &size,
+                    std::span<std::uint8_t> rgb, std::string &error) {
+  return decode(file, {false, size.width, size.height, rgb.data(), rgb.size(), false}, error);
 }
 
-bool decode_png_rgb(std::span<const std::uint8_t> file, std::span<std::uint16_t> rgb,
-                    std::string &error) {
-  return decode(file, {false, reinterpret_cast<std::uint8_t *>(rgb.data()), rgb.size_bytes(), true},
+bool decode_png_rgb(std::span<const std::uint8_t> file, const PngInfo &size,
+                    std::span<std::uint16_t> rgb, std::string &error) {
+  return decode(file,
+                {false, size.width, size.height, reinterpret_cast<std::uint8_t *>(rgb.data()),
+                 rgb.size_bytes(), true},
                 error);
 }
 

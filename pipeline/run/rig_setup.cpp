@@ -44,6 +44,9 @@ class WorldPictures {
 public:
   explicit WorldPictures(std::size_t capacity) : capacity_(capacity) {}
 
+  // How many pictures of `bytes` each it keeps at most.
+  [[nodiscard]] std::size_t holds(std::size_t bytes) const { return capacity_ / bytes; }
+
   bool copy(const renderer::FrameCamera &camera, std::span<std::uint8_t> out) {
     const std::lock_guard lock(mutex_);
     const auto it = pictures_.find(key_of(camera));
@@ -125,7 +128,7 @@ std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Sce
 // its rate, which the run counts as camera drops. And when the loop's
 // frames cannot all be kept, or never repeat, it says so and why.
 void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &format,
-                         const std::optional<TraceLens> &truth) {
+                         const std::optional<TraceLens> &truth, const WorldPictures &cache) {
   if (!truth || !truth->loop_period_s())
     return;
   const double period_s = *truth->loop_period_s();
@@ -142,8 +145,7 @@ void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &fo
     return;
   }
   const std::size_t picture = base::frame_bytes(format);
-  const std::size_t capacity = std::size_t(sim.cache_mb) << 20;
-  const long kept = long(std::min<std::size_t>(std::size_t(states), capacity / picture));
+  const long kept = long(std::min<std::size_t>(std::size_t(states), cache.holds(picture)));
   std::fprintf(stderr,
                "camhead run: the simulated camera renders its world anew for each of the %ld "
                "lens states of its %.1f s loop, then replays them; until then, where a picture "
@@ -167,7 +169,6 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
                 const renderer::Scene &scene, const renderer::FrameCamera &pose,
                 const LensHub &lens, std::optional<TraceLens> truth, int threads) {
   auto world = make_world_renderer(real_world_of(scene), threads);
-  explain_world_cache(sim, format, truth);
   hal::camera::SimulatedCameraOptions options;
   options.format = format;
   options.fps = sim.fps;
@@ -176,6 +177,7 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
   options.disconnect_silently = sim.disconnect_silently;
   const std::uint32_t samples = sim.samples;
   auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
+  explain_world_cache(sim, format, truth, *cache);
   auto generator = [world, cache, format, pose, samples, &lens,
                     truth = std::move(truth)](std::int64_t start_ns, std::int64_t exposure_ns,
                                               std::span<std::uint8_t> out) {

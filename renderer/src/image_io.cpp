@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -356,14 +355,14 @@ Image read_png(const std::filesystem::path &path, std::span<const unsigned char>
   Image out;
   if (info->sixteen_bit) {
     std::vector<std::uint16_t> samples(samples_rgb);
-    if (!base::decode_png_rgb(file, std::span(samples), error))
+    if (!base::decode_png_rgb(file, *info, std::span(samples), error))
       fail(path, error);
     out = Image(info->width, info->height, 3);
     for (std::size_t i = 0; i < samples.size(); ++i)
       out.data[i] = float(srgb_to_linear_d(samples[i] / 65535.0));
   } else {
     std::vector<std::uint8_t> samples(samples_rgb);
-    if (!base::decode_png_rgb(file, std::span(samples), error))
+    if (!base::decode_png_rgb(file, *info, std::span(samples), error))
       fail(path, error);
     out = Image(info->width, info->height, 3);
     // 256 values: a table instead of a pow() per sample.

@@ -181,6 +181,15 @@ TEST(PngSequence, DamagedFramesAreRefused) {
   EXPECT_EQ(decode_error(test::rgb8_png(2, 2, std::string(64 << 20, '\0'))),
             "PNG: not a readable PNG: IDAT: Too much image data");
   EXPECT_EQ(decode_error(test::rgb8_png(2, 1, std::string(1, '\0') + "abcdef")), "decoded");
+  // A frame of the size expected, by pixels but not by shape, is refused
+  // before a row is written.
+  const std::string png = test::rgb8_png(2, 1, std::string(1, '\0') + "abcdef");
+  const std::vector<std::uint8_t> bytes(png.begin(), png.end());
+  std::vector<std::uint8_t> rgb(6, 0x55);
+  std::string error;
+  EXPECT_FALSE(hal::video_file::decode_png_rgb(bytes, {1, 2}, rgb, error));
+  EXPECT_EQ(error, "PNG: is 2x1, not the 1x2 expected");
+  EXPECT_EQ(rgb, std::vector<std::uint8_t>(6, 0x55));
 }
 
 TEST(PngSequence, FoldersWithoutPngsAreRefused) {

@@ -50,20 +50,10 @@ std::optional<PngSize> png_size(std::span<const std::uint8_t> file, std::string 
 
 bool decode_png_rgb(std::span<const std::uint8_t> file, PngSize expected,
                     std::span<std::uint8_t> rgb, std::string &error) {
-  const std::optional<PngSize> size = png_size(file, error);
-  if (!size)
-    return false;
-  if (*size != expected) {
-    error = "PNG: is " + std::to_string(size->width) + "x" + std::to_string(size->height) +
-            ", not the " + std::to_string(expected.width) + "x" + std::to_string(expected.height) +
-            " expected";
-    return false;
-  }
-  if (!base::decode_png_rgb(file, rgb, error)) {
-    error = "PNG: " + error;
-    return false;
-  }
-  return true;
+  if (base::decode_png_rgb(file, {expected.width, expected.height}, rgb, error))
+    return true;
+  error = "PNG: " + error;
+  return false;
 }
 
 bool encode_png_rgb(std::span<const std::uint8_t> rgb, int width, int height, std::size_t stride,

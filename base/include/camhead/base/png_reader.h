@@ -27,17 +27,19 @@ struct PngInfo {
 [[nodiscard]] std::optional<PngInfo> read_png_info(std::span<const std::uint8_t> file,
                                                    std::string &error);
 
-// Decodes `file` into RGB rows without padding: a palette expanded, grey
-// repeated into R, G and B, alpha dropped, the samples as stored (no gamma
-// applied). `rgb` holds exactly width x height x 3 samples of the file's
-// header. 8-bit samples take a 16-bit file's high bytes; 16-bit samples
+// Decodes `file`, whose header states `size` (what read_png_info said, or
+// what the caller needs), into RGB rows without padding: a palette
+// expanded, grey repeated into R, G and B, alpha dropped, the samples as
+// stored (no gamma applied). `rgb` holds exactly width x height x 3
+// samples. 8-bit samples take a 16-bit file's high bytes; 16-bit samples
 // (native byte order) take an 8-bit file's times 257. False with `error`
 // ("not a readable PNG: ...") when anything up to the IEND chunk is damaged:
 // a CRC, the image data (too little of it, or more than the image), a chunk
-// cut short; or when `rgb` is not the header's size.
-[[nodiscard]] bool decode_png_rgb(std::span<const std::uint8_t> file, std::span<std::uint8_t> rgb,
-                                  std::string &error);
-[[nodiscard]] bool decode_png_rgb(std::span<const std::uint8_t> file, std::span<std::uint16_t> rgb,
-                                  std::string &error);
+// cut short; or ("is WxH, not the WxH expected") when the header states
+// another size, or `rgb` does not hold it.
+[[nodiscard]] bool decode_png_rgb(std::span<const std::uint8_t> file, const PngInfo &size,
+                                  std::span<std::uint8_t> rgb, std::string &error);
+[[nodiscard]] bool decode_png_rgb(std::span<const std::uint8_t> file, const PngInfo &size,
+                                  std::span<std::uint16_t> rgb, std::string &error);
 
 } // namespace camhead::base
