@@ -61,10 +61,6 @@ struct Counters {
   std::atomic<bool> renderer_lost{false}; // the GPU is gone: placeholders from now on
 };
 
-// A consumer (a browser on the loopback webcam) must never go a second
-// without a frame: without a composite for this long, the last one again,
-// or the placeholder while there is no camera (or none yet).
-constexpr std::int64_t kRepeatAfterNs = 500'000'000;
 // A camera without a frame for this long (or four frame intervals, if
 // longer) counts as lost, whatever it says.
 constexpr std::int64_t kCameraSilentNs = 1'000'000'000;
@@ -330,17 +326,21 @@ template <typename Fill> void Pipeline::send(Fill fill, std::int64_t capture_ns)
 }
 
 void Pipeline::output_loop() {
+  const std::int64_t repeat_after_ns = std::llround(options_.repeat_after_s * 1e9);
+  // Awake at least as often as a filler may be due.
+  const auto wait =
+      std::min<std::chrono::nanoseconds>(100ms, std::chrono::nanoseconds(repeat_after_ns));
   last_output_ns_ = base::monotonic_ns();
   bool shown_any = false;
   std::uint64_t output_frame = 0; // frames sent to every output so far
   for (;;) {
-    const std::optional<int> slot_index = ready_slots_.pop(100ms);
+    const std::optional<int> slot_index = ready_slots_.pop(wait);
     if (!slot_index) {
       if (ready_slots_.drained())
         break;
       // A take composited offline gets its composites alone, and a run that
       // is stopping no more frames.
-      if (lossless_ || should_stop() || base::monotonic_ns() - last_output_ns_ < kRepeatAfterNs)
+      if (lossless_ || should_stop() || base::monotonic_ns() - last_output_ns_ < repeat_after_ns)
         continue;
       const bool repeat = shown_any && !counters_.camera_lost && !counters_.renderer_lost;
       if (repeat) {

@@ -41,6 +41,10 @@ struct RunOptions {
   // Trace only where the virtual objects can change the composite
   // (renderer influence_region.h); false traces every pixel, for comparison.
   bool influence_region = true;
+  // A consumer (a browser on the loopback webcam) must never go a second
+  // without a frame: after this long without a composite, the last one
+  // again, or the placeholder while there is no camera (or none yet).
+  double repeat_after_s = 0.5;
   std::FILE *status = stderr; // the status line; null: none
   const std::atomic<bool> *stop = nullptr;
 };

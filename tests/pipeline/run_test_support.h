@@ -105,7 +105,6 @@ struct CompositeRecord {
   double exposure_mid_ns = 0.0;
   double focus_m = 0.0;
   bool lens_fresh = false;
-  double render_s = 0.0; // render_end_ns - render_start_ns
 };
 
 inline double json_number(const std::string &line, const std::string &field) {
@@ -134,11 +133,10 @@ inline std::vector<CompositeRecord> recorded_composites(const fs::path &stats) {
     for (const char *field : {"capture_ns", "delivered_ns", "output_ns", "focus_m", "f_number",
                               "focal_length_mm", "rpp", "dropped_before", "trace_ms"})
       (void)json_number(line, field);
-    records.push_back(
-        {std::uint64_t(json_number(line, "output_frame")),
-         std::uint64_t(json_number(line, "sequence")), json_number(line, "exposure_mid_ns"),
-         json_number(line, "focus_m"), line.find("\"lens_fresh\":true") != std::string::npos,
-         (json_number(line, "render_end_ns") - json_number(line, "render_start_ns")) * 1e-9});
+    records.push_back({std::uint64_t(json_number(line, "output_frame")),
+                       std::uint64_t(json_number(line, "sequence")),
+                       json_number(line, "exposure_mid_ns"), json_number(line, "focus_m"),
+                       line.find("\"lens_fresh\":true") != std::string::npos});
   }
   return records;
 }
