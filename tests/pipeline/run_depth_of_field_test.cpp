@@ -148,19 +148,26 @@ TEST_F(RunLoop, VirtualBlurFollowsTheLensFrameByFrame) {
     else
       EXPECT_LT(virt, 1.0) << "frame " << k << ": a blur of " << expected << " px reads as "
                            << virt;
-    EXPECT_NEAR(real, virt, 0.25) << "frame " << k << ": real and virtual edges at one depth";
+    // The real edge against the virtual one, by the same rule: where the
+    // blur is measurable they agree; below a pixel both read sharp (the real
+    // one, 128 noisy samples of the simulated world, may read 0.4 px where
+    // the clean virtual edge reads 0).
     if (expected >= 1.0) {
+      EXPECT_NEAR(real, virt, 0.25) << "frame " << k << ": real and virtual edges at one depth";
       worst_virtual = std::max(worst_virtual, std::abs(virt - expected));
+      worst_real_vs_virtual = std::max(worst_real_vs_virtual, std::abs(real - virt));
       ++measurable;
+    } else {
+      EXPECT_LT(real, 1.0) << "frame " << k << ": the real edge of a " << expected
+                           << " px blur reads as " << real;
     }
-    worst_real_vs_virtual = std::max(worst_real_vs_virtual, std::abs(real - virt));
     smallest = std::min(smallest, expected);
     largest = std::max(largest, expected);
     ++checked;
   }
   EXPECT_GE(measurable, 3u);
   std::printf("%zu frames: blur %.2f..%.2f px; %zu of 1 px or more, virtual vs thin lens within "
-              "%.3f px; real vs virtual within %.3f px\n",
+              "%.3f px, real vs virtual within %.3f px\n",
               checked, smallest, largest, measurable, worst_virtual, worst_real_vs_virtual);
 }
 
