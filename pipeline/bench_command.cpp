@@ -271,7 +271,7 @@ void add_bench_command(CLI::App &app) {
       "bench", "Frame rate and camera-ray throughput of the GPU tracer at the paper's\n"
                "settings (720x576; 1, 25, 49 rays per pixel). Prints a Markdown table.");
   cmd->add_option("--scene", args->scene, "Scene file")
-      ->check(CLI::ExistingFile)
+      ->check(path_text() & CLI::ExistingFile)
       ->capture_default_str();
   cmd->add_option("--rpp", args->rpp, "Rays per pixel to measure")
       ->delimiter(',')

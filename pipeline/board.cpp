@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "camhead/base/config_json.h"
+#include "camhead/base/path_text.h"
+#include "camhead/renderer/frame_camera.h"
 #include "data_dir.h"
 
 namespace camhead::pipeline {
@@ -25,6 +27,7 @@ using base::Range;
 
 constexpr std::string_view kFormat = "camhead-board";
 constexpr std::int64_t kVersion = 1;
+constexpr std::int64_t kMaxCameraPixels = std::int64_t(1) << 25;
 
 // USB ids as lsusb prints them ("1209") or as integers.
 std::uint16_t usb_id(const JsonValue &v) {
@@ -38,6 +41,15 @@ std::uint16_t usb_id(const JsonValue &v) {
     return static_cast<std::uint16_t>(std::stoul(s, nullptr, 16));
   }
   return static_cast<std::uint16_t>(v.integer(0, 0xFFFF));
+}
+
+// A device node or a name that stands for one (/dev/video0, gpiochip0): a
+// string that names a file, so it is held to path_text.h's rule.
+std::string device_name(const JsonValue &v) {
+  const std::string name = v.string();
+  if (const std::string problem = base::path_text_problem(name); !problem.empty())
+    v.fail(problem);
+  return name;
 }
 
 std::array<double, 3> vec3(const JsonValue &v) {
@@ -142,7 +154,7 @@ private:
     } else if (type == "v4l2") {
       d.object({"type", "device"}, with_common({"fps", "buffers"}));
       V4l2CameraConfig v4l2;
-      v4l2.device = d.at("device").string();
+      v4l2.device = device_name(d.at("device"));
       if (d.has("fps"))
         v4l2.fps = d.at("fps").number(Range::within(0.0, 1000.0));
       if (d.has("buffers"))
@@ -160,6 +172,9 @@ private:
       type_value.fail("unknown camera \"" + type + "\" (sim, file, v4l2 or libcamera)");
     }
     if (const auto format = d.find("format")) {
+      if (std::holds_alternative<FileCameraConfig>(camera.kind))
+        format->fail("a file camera's frames are in the file's own format (Y4M 4:2:2 yuyv, "
+                     "4:2:0 nv12; PNG rgb24): remove \"format\"");
       const std::string name = format->string();
       auto *v4l2 = std::get_if<V4l2CameraConfig>(&camera.kind);
       if (name == "mjpeg") {
@@ -183,6 +198,11 @@ private:
     if (camera.width % 2 != 0 || camera.height % 2 != 0)
       d.fail_member("width", "width and height must be even (" + std::to_string(camera.width) +
                                  "x" + std::to_string(camera.height) + ")");
+    // The image limit of every reader (docs/input-errors.md), checked here,
+    // before a buffer, a renderer or an output is made for the size.
+    if (std::int64_t(camera.width) * camera.height > kMaxCameraPixels)
+      d.fail_member("width", std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                                 " is more than 2^25 pixels (8K UHD, 7680x4320, is within)");
     if (d.has("sensor_width_mm"))
       camera.sensor_width_mm = d.at("sensor_width_mm").number(Range::within(1.0, 100.0));
     return camera;
@@ -193,10 +213,25 @@ private:
     PoseConfig pose;
     pose.position = vec3(d.at("position"));
     pose.look_at = vec3(d.at("look_at"));
-    if (d.has("up"))
+    if (d.has("up")) {
       pose.up = vec3(d.at("up"));
-    if (pose.position == pose.look_at)
-      d.at("look_at").fail("must differ from position");
+      if (pose.up == std::array<double, 3>{})
+        d.at("up").fail("must not be zero");
+    }
+    // As the tracer sees the pose: in float32 (renderer/frame_camera.h).
+    const auto f = [](const std::array<double, 3> &a) {
+      return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
+    };
+    if (f(pose.position) == f(pose.look_at))
+      d.at("look_at").fail("equals position (in the float32 the renderer works in)");
+    if (renderer::view_has_no_orientation(f(pose.position), f(pose.look_at), f(pose.up))) {
+      if (d.has("up"))
+        d.at("up").fail("parallel to the view from position to look_at");
+      // A rig looking straight down at a table, or up at a ceiling.
+      d.fail_member("up", "missing, and the default [0, 1, 0] is parallel to the view from "
+                          "position to look_at (straight down or up): give the direction the "
+                          "top of the picture points to, e.g. [0, 0, -1]");
+    }
     return pose;
   }
 
@@ -248,6 +283,12 @@ private:
         trace.loop = d.at("loop").boolean();
       if (d.has("speed"))
         trace.speed = d.at("speed").number(Range::within(0.01, 100.0));
+      // Time 0 at the machine's boot, played once: over before any run
+      // starts, and every frame would get the profile's rest state.
+      if (trace.monotonic_origin && !trace.loop)
+        d.fail_member("loop", "false with clock_origin \"monotonic\": the trace would start at "
+                              "the machine's boot and be over before the run; loop it, or use "
+                              "clock_origin \"start\"");
       source.kind = trace;
     } else if (type == "usb") {
       d.object({"type", "vendor_id", "product_id"}, {"name", "delay_ms", "serial", "simulate"});
@@ -295,7 +336,7 @@ private:
 
   static GpioSourceConfig read_gpio(const JsonValue &d) {
     GpioSourceConfig gpio;
-    gpio.chip = d.at("chip").string();
+    gpio.chip = device_name(d.at("chip"));
     if (d.has("simulate"))
       gpio.simulate = d.at("simulate").path();
     if (const auto bias_value = d.find("bias")) {

@@ -128,10 +128,11 @@ void add_calibrate_command(CLI::App &app) {
                    "           --name \"35 mm T1.5\" --prime -o lens.json");
   cmd->add_option("measurements", args->measurements, "Measurements CSV (format below)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(path_text() & CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output,
                   "Profile JSON to write (replaced only when the new one loads)")
-      ->required();
+      ->required()
+      ->check(path_text());
   cmd->add_option("--name", args->name, "The profile's name")->required();
   cmd->add_option("--description", args->description,
                   "The profile's description (default: names the measurements file)");

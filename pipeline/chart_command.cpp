@@ -654,9 +654,12 @@ void add_bench_chart_command(CLI::App &bench) {
           "  camhead bench chart tests/assets/reference/ar_basic.json --scale 0.5 -o bench\n"
           "  camhead bench chart tests/assets/reference/ar_basic.json --scale 0.25 \\\n"
           "      --methods uniform,adaptive --frames 3 --warmup 1 -o /tmp/chart");
-  cmd->add_option("scenes", args->scenes, "Scene files")->required()->check(CLI::ExistingFile);
+  cmd->add_option("scenes", args->scenes, "Scene files")
+      ->required()
+      ->check(path_text() & CLI::ExistingFile);
   cmd->add_option("-o,--output", args->out_dir, "Output folder (created if absent)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(path_text());
   cmd->add_option("--scale", args->scale,
                   "Render at this fraction of the scene's size: 1, 0.5, 0.25, ... (the plate\n"
                   "is box-filtered to match; the blur in pixels scales with it)")

@@ -1,7 +1,11 @@
 // Subcommands of the camhead command line.
 #pragma once
 
+#include <string>
+
 #include <CLI/CLI.hpp>
+
+#include "camhead/base/path_text.h"
 
 namespace camhead::cli {
 
@@ -11,6 +15,12 @@ void add_bench_command(CLI::App &app);     // camhead bench
 void add_calibrate_command(CLI::App &app); // camhead calibrate
 void add_lens_command(CLI::App &app);      // camhead lens monitor | record
 void add_run_command(CLI::App &app);       // camhead run
+
+// A command-line path held to the rule every path camhead takes from a user
+// follows (base/path_text.h): no control characters.
+[[nodiscard]] inline CLI::Validator path_text() {
+  return CLI::Validator([](std::string &text) { return base::path_text_problem(text); }, "PATH");
+}
 
 // The exit status the chosen subcommand left (0 = success).
 [[nodiscard]] int exit_code();

@@ -264,7 +264,8 @@ void record(const LensArgs &args) {
 void add_common(CLI::App *cmd, LensArgs &args) {
   cmd->add_option("--board", args.board,
                   "Board name in board/ (sim, example-rig, ...) or a board file")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(path_text());
   cmd->add_option("--duration", args.duration_s, "Stop after this many seconds (0: at Ctrl-C)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
@@ -295,7 +296,9 @@ void add_lens_command(CLI::App &app) {
                 "simulated rig replays. Written to FILE.partial and renamed when done.");
   add_common(rec, *args);
   rec->add_option("--source", args->source, "Source name in the board (default: the first)");
-  rec->add_option("-o,--output", args->output, "Trace file to write")->required();
+  rec->add_option("-o,--output", args->output, "Trace file to write")
+      ->required()
+      ->check(path_text());
   rec->callback([args] { record(*args); });
 }
 

@@ -1,5 +1,6 @@
 // camhead: the command line. Each subcommand lives in its own file and
 // registers itself here.
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
@@ -8,6 +9,10 @@
 #include "commands.h"
 
 int main(int argc, char **argv) {
+  // A write past a file-size limit (ulimit -f) fails with EFBIG, which the
+  // writers report and recover from (docs/input-errors.md), rather than
+  // ending the process with SIGXFSZ halfway through a file.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"camhead: physically-based depth of field for AR camera rigs.\n"
                "Renders virtual objects with the depth of field of the physical lens and\n"
                "composites them into the camera image in one ray-tracing pass."};
@@ -22,7 +27,10 @@ int main(int argc, char **argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &e) {
-    return app.exit(e);
+    // --help and --version are ParseErrors that exit 0; every other is a
+    // wrong command line, an input error like any other (exit 2), not
+    // CLI11's own codes 101-127.
+    return app.exit(e) == 0 ? 0 : 2;
   }
   return camhead::cli::exit_code();
 }

@@ -170,10 +170,13 @@ void add_render_command(CLI::App &app) {
   CLI::App *cmd = app.add_subcommand(
       "render", "Render one still of a scene file (JSON, see scene-format.md).\n"
                 "Example: camhead render scenes/ar_demo.json --rpp 49 -o out.png");
-  cmd->add_option("scene", args->scene, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("scene", args->scene, "Scene file (JSON)")
+      ->required()
+      ->check(path_text() & CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output,
                   "Output image: .exr (linear float) or .png (8-bit sRGB)")
-      ->required();
+      ->required()
+      ->check(path_text());
   cmd->add_option("--rpp", args->rpp,
                   "Rays per pixel (default: the scene's render.samples). The paper's\n"
                   "live setting is 49; 1024 approaches a converged reference")

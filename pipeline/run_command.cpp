@@ -1,8 +1,10 @@
 // camhead run: the live pipeline. A board's camera and lens in, composited
 // video out (pipeline/run/run_loop.h).
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <memory>
 #include <optional>
@@ -11,6 +13,7 @@
 
 #include "board.h"
 #include "camhead/base/config_error.h"
+#include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/renderer/gpu_tracer.h"
@@ -18,6 +21,7 @@
 #include "commands.h"
 #include "run/output_uri.h"
 #include "run/run_loop.h"
+#include "run/run_paths.h"
 
 namespace camhead::cli {
 namespace {
@@ -42,6 +46,41 @@ constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 extern "C" void on_stop_signal(int signal) {
   stop_requested = true;
   std::signal(signal, SIG_DFL);
+}
+
+// The summary, a line for the run and one for each output, and the exit
+// status (docs/input-errors.md): 4 when a file output lost frames or could
+// not be completed (a full disk, a size limit), 5 when a device or stream
+// failed (the camera's take broke off, a webcam or display output failed).
+int report(const pipeline::RunSummary &s) {
+  std::fprintf(stderr,
+               "camhead run: %llu frames in, %llu out in %.1f s (%.1f fps out); dropped: "
+               "camera %llu, render busy %llu, output busy %llu; render failures %llu, "
+               "repeated frames %llu, placeholder frames %llu, output errors %llu, camera "
+               "errors %llu, camera reconnects %llu, frames without their lens state %llu\n",
+               (unsigned long long)s.frames_in, (unsigned long long)s.frames_out, s.seconds,
+               s.seconds > 0 ? double(s.frames_out) / s.seconds : 0.0,
+               (unsigned long long)s.camera_dropped, (unsigned long long)s.render_busy,
+               (unsigned long long)s.output_busy, (unsigned long long)s.render_failed,
+               (unsigned long long)s.repeats, (unsigned long long)s.placeholders,
+               (unsigned long long)s.sink_errors, (unsigned long long)s.camera_errors,
+               (unsigned long long)s.camera_reconnects, (unsigned long long)s.lens_late);
+  bool file_failed = false, device_failed = !s.camera_failure.empty();
+  for (const pipeline::OutputSummary &o : s.outputs) {
+    (o.file ? file_failed : device_failed) |= o.failed > 0 || !o.closed;
+    // Each failed frame's error was said as it happened; a failed close
+    // (a file not completed) is said here.
+    std::fprintf(stderr, "camhead run: %s: frames written %llu, lost %llu%s%s\n", o.name.c_str(),
+                 (unsigned long long)o.written, (unsigned long long)o.failed, o.closed ? "" : "; ",
+                 o.closed ? "" : o.detail.c_str());
+  }
+  if (!s.camera_failure.empty())
+    std::fprintf(stderr, "camhead run: the camera failed: %s\n", s.camera_failure.c_str());
+  if (!s.stats_failure.empty())
+    std::fprintf(stderr, "camhead run: %s\n", s.stats_failure.c_str());
+  if (file_failed || !s.stats_failure.empty())
+    return 4;
+  return device_failed ? 5 : 0;
 }
 
 int run(const RunArgs &args) {
@@ -72,19 +111,7 @@ int run(const RunArgs &args) {
     std::signal(signal, on_stop_signal);
   int status = 0;
   try {
-    const pipeline::RunSummary s = pipeline::run_pipeline(options);
-    std::fprintf(stderr,
-                 "camhead run: %llu frames in, %llu out in %.1f s (%.1f fps out); dropped: "
-                 "camera %llu, render busy %llu, output busy %llu; render failures %llu, "
-                 "repeated frames %llu, placeholder frames %llu, output errors %llu, camera "
-                 "reconnects %llu\n",
-                 (unsigned long long)s.frames_in, (unsigned long long)s.frames_out, s.seconds,
-                 s.seconds > 0 ? double(s.frames_out) / s.seconds : 0.0,
-                 (unsigned long long)s.camera_dropped, (unsigned long long)s.render_busy,
-                 (unsigned long long)s.output_busy, (unsigned long long)s.render_failed,
-                 (unsigned long long)s.repeats, (unsigned long long)s.placeholders,
-                 (unsigned long long)s.sink_errors, (unsigned long long)s.camera_reconnects);
-    status = s.sink_errors > 0 ? 5 : 0;
+    status = report(pipeline::run_pipeline(options));
   } catch (const renderer::SceneError &e) {
     std::fprintf(stderr, "scene error: %s\n", e.what());
     status = 2;
@@ -96,6 +123,12 @@ int run(const RunArgs &args) {
     status = 2;
   } catch (const pipeline::OutputError &e) { // an output URI
     std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 2;
+  } catch (const pipeline::RunPathError &e) { // an output over an input
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 2;
+  } catch (const hal::camera::FileCameraError &e) { // the camera's take
+    std::fprintf(stderr, "camhead run: camera: %s\n", e.what());
     status = 2;
   } catch (const hal::output::FileSinkError &e) {
     std::fprintf(stderr, "camhead run: %s\n", e.what());
@@ -116,6 +149,23 @@ int run(const RunArgs &args) {
   for (const int signal : kStopSignals)
     std::signal(signal, SIG_DFL);
   return status;
+}
+
+// A number above 0 and at most `most` ("--duration 0" would otherwise mean
+// "no limit" without a word, and NaN compares false with every bound).
+CLI::Validator positive(const char *unit, double most, const char *flag) {
+  return CLI::Validator(
+      [=](std::string &text) -> std::string {
+        char *end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(value) || value <= 0 ||
+            value > most)
+          return text + " is not a number of " + unit + " above 0 and at most " +
+                 std::to_string(std::llround(most)) + " (leave " + flag +
+                 " out to run until stopped)";
+        return {};
+      },
+      "> 0");
 }
 
 } // namespace
@@ -142,17 +192,23 @@ void add_run_command(CLI::App &app) {
   cmd->add_option("--board", args->board,
                   "Board name in board/ (sim, ...) or a board file; its camera, scene,\n"
                   "lens and outputs")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(path_text());
   cmd->add_option("--output", args->outputs,
                   "Output URI (repeat for more); replaces the board's outputs");
-  cmd->add_option("--duration", args->duration_s, "Stop after this many seconds")
-      ->check(CLI::Range(0.0, 1e7));
-  cmd->add_option("--frames", args->frames, "Stop after this many output frames")
-      ->check(CLI::Range(std::uint64_t(0), std::uint64_t(1) << 40));
+  cmd->add_option("--duration", args->duration_s,
+                  "Stop after this many seconds (omit it to run until stopped)")
+      ->check(positive("seconds", 1e7, "--duration"));
+  cmd->add_option("--frames", args->frames,
+                  "Stop after this many composited frames (omit it to run until stopped). The\n"
+                  "outputs may also get fillers, counted apart in the summary: the placeholder\n"
+                  "until the camera's first frame, the last frame again when one is late")
+      ->check(positive("frames", double(std::uint64_t(1) << 40), "--frames"));
   cmd->add_option("--record-stats", args->stats,
                   "Write one JSON object per output frame to FILE.jsonl: sequence, capture,\n"
-                  "exposure-middle and output times, the lens state, rays per pixel, drops\n"
-                  "and each stage's time");
+                  "exposure-middle and output times, the lens state (and how long the frame\n"
+                  "waited for it), rays per pixel, drops and each stage's time")
+      ->check(path_text());
   cmd->add_option("--executor", args->executor,
                   "auto (the board's default: a hardware GPU if there is one that takes the\n"
                   "scene, else the CPU reference), cpu, or gpu (the Vulkan tracer, lavapipe\n"

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "camhead/base/path_text.h"
 #include "config_words.h"
 
 namespace camhead::base {
@@ -103,6 +104,70 @@ std::string syntax_reason(const std::string &what) {
   return "invalid JSON: " + (bracket == std::string::npos ? what : what.substr(bracket + 2));
 }
 
+// Refuses a key given twice in one object, naming its field: a parsed
+// object keeps only one of them, so the other would be ignored without a
+// word (a second "camera" silently replacing the first). Follows the
+// parser's events to know each key's field path.
+class DuplicateKeyCheck {
+public:
+  explicit DuplicateKeyCheck(const std::string &file) : file_(file) {}
+
+  bool operator()(int, nlohmann::detail::parse_event_t event, const Json &parsed) {
+    using Event = nlohmann::detail::parse_event_t;
+    switch (event) {
+    case Event::object_start:
+    case Event::array_start:
+      stack_.push_back({event == Event::array_start, 0, {}, {}});
+      break;
+    case Event::key: {
+      Level &level = stack_.back();
+      const std::string key = parsed.get<std::string>();
+      if (std::find(level.keys.begin(), level.keys.end(), key) != level.keys.end())
+        throw ConfigError(file_, child(field(stack_.size() - 1), key),
+                          "given twice in one object; only one would count: give it once");
+      level.keys.push_back(key);
+      level.key = key;
+      break;
+    }
+    case Event::object_end:
+    case Event::array_end:
+      stack_.pop_back();
+      next_element();
+      break;
+    case Event::value:
+      next_element();
+      break;
+    }
+    return true;
+  }
+
+private:
+  struct Level {
+    bool array;
+    std::size_t index;
+    std::string key;               // an object's current member
+    std::vector<std::string> keys; // an object's members so far
+  };
+
+  void next_element() {
+    if (!stack_.empty() && stack_.back().array)
+      ++stack_.back().index;
+  }
+
+  // The field of the value being read at depth `depth` (its parents' keys
+  // and indices), as JsonValue names fields.
+  [[nodiscard]] std::string field(std::size_t depth) const {
+    std::string out;
+    for (std::size_t i = 0; i < depth; ++i)
+      out = stack_[i].array ? out + "[" + std::to_string(stack_[i].index) + "]"
+                            : child(out, stack_[i].key);
+    return out;
+  }
+
+  const std::string &file_;
+  std::vector<Level> stack_;
+};
+
 } // namespace
 
 JsonFile::JsonFile(std::string_view text, std::string file) : name_(std::move(file)) {
@@ -110,7 +175,7 @@ JsonFile::JsonFile(std::string_view text, std::string file) : name_(std::move(fi
   const std::filesystem::path abs = std::filesystem::absolute(name_, ec);
   folder_ = (ec ? std::filesystem::path(name_) : abs).parent_path();
   try {
-    json_ = Json::parse(rewrite_non_finite(text));
+    json_ = Json::parse(rewrite_non_finite(text), DuplicateKeyCheck(name_));
   } catch (const Json::exception &e) {
     // parse_error, and out_of_range.406 should a literal escape the rewrite.
     throw ConfigError(name_, "(JSON)", syntax_reason(e.what()));
@@ -248,8 +313,11 @@ std::vector<double> JsonValue::numbers(std::size_t n, const Range &range) const 
 }
 
 std::filesystem::path JsonValue::path() const {
+  const std::string name = string();
+  if (const std::string problem = path_text_problem(name); !problem.empty())
+    fail(problem);
   // An absolute path replaces the folder.
-  return (file_->folder_ / string()).lexically_normal();
+  return (file_->folder_ / name).lexically_normal();
 }
 
 } // namespace camhead::base

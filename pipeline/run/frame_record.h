@@ -17,7 +17,8 @@ struct FrameRecord {
   std::int64_t render_start_ns = 0;
   std::int64_t render_end_ns = 0;
   double focus_m = 0.0, f_number = 0.0, focal_length_mm = 0.0;
-  bool lens_fresh = false;
+  bool lens_fresh = false;  // the lens state covers the mid-exposure (else held or extrapolated)
+  double lens_wait_s = 0.0; // how long the frame waited for it (bounded; run_loop.h)
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;
   double traced = 1.0;              // the fraction of the pixels traced (the influence region)

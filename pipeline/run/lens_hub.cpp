@@ -28,6 +28,7 @@ void LensHub::poll_loop() {
       channel.feed();
       connected_[i] = connected;
     }
+    started_ = true;
   }
 }
 

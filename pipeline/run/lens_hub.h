@@ -36,6 +36,10 @@ public:
   // The lens at CLOCK_MONOTONIC instant t_ns: a lost source holds its last
   // state, flagged not fresh.
   [[nodiscard]] LensSnapshot state_at(std::int64_t t_ns) const;
+  // Whether every source has been polled once, and what it had handed to
+  // its tracker (a frame before that finds no reading that is not yet
+  // there).
+  [[nodiscard]] bool started() const { return started_; }
   // "focus pull [trace ...]" for the status line.
   [[nodiscard]] std::string source_name() const;
 
@@ -48,6 +52,7 @@ private:
   std::vector<LensChannel> channels_;
   std::vector<bool> connected_; // each source's status().connected after its last poll
   std::atomic<bool> stop_{false};
+  std::atomic<bool> started_{false};
   std::thread thread_;
 };
 

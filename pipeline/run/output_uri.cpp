@@ -1,9 +1,7 @@
 #include "output_uri.h"
 
-#include "camhead/hal/output/drm/drm_sink.h"
-#include "camhead/hal/output/file/file_sink.h"
-#include "camhead/hal/output/null/null_sink.h"
-#include "camhead/hal/output/v4l2/v4l2_loopback_sink.h"
+#include "camhead/base/path_text.h"
+#include "camhead/hal/video_file/frame_pattern.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -60,6 +58,8 @@ std::string_view take_format(std::string_view uri, std::string_view rest, Output
 OutputSpec parse_output_uri(std::string_view uri) {
   OutputSpec spec;
   spec.uri = std::string(uri);
+  if (const std::string problem = base::path_text_problem(uri); !problem.empty())
+    throw OutputError(base::printable_text(uri), problem);
   if (uri == "null") {
     spec.kind = OutputKind::null;
     return spec;
@@ -87,6 +87,9 @@ OutputSpec parse_output_uri(std::string_view uri) {
       if (spec.target.find('%') == std::string::npos)
         throw OutputError(uri, "a PNG sequence needs a frame number in its name, e.g. "
                                "file:frames/%05d.png");
+      std::string error;
+      if (!hal::video_file::FramePattern::parse(spec.target, error))
+        throw OutputError(uri, "pattern: " + error);
     } else {
       throw OutputError(uri, "a file output is PATH.y4m or DIR/%05d.png");
     }
@@ -96,31 +99,6 @@ OutputSpec parse_output_uri(std::string_view uri) {
   if (spec.target.empty())
     throw OutputError(uri, "names no device or file");
   return spec;
-}
-
-std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width, int height,
-                                                    double fps) {
-  base::VideoFormat format;
-  format.pixel = spec.format;
-  format.width = width;
-  format.height = height;
-  switch (spec.kind) {
-  case OutputKind::null:
-    return hal::output::open_null_sink(format);
-  case OutputKind::y4m:
-    return hal::output::open_y4m_sink(spec.target, format, fps);
-  case OutputKind::png:
-    return hal::output::open_png_sequence_sink(spec.target, format);
-  case OutputKind::v4l2:
-    return hal::output::open_v4l2_loopback_sink(spec.target, format, fps);
-  case OutputKind::drm:
-    return hal::output::open_drm_sink({.card = spec.target,
-                                       .connector = spec.connector,
-                                       .width = width,
-                                       .height = height,
-                                       .mode = spec.mode});
-  }
-  throw OutputError(spec.uri, "unknown output kind");
 }
 
 } // namespace camhead::pipeline

@@ -9,13 +9,11 @@
 //   null                                  nothing (benchmarks)
 #pragma once
 
-#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
 #include "camhead/base/video_format.h"
-#include "camhead/hal/output/frame_sink.h"
 
 namespace camhead::pipeline {
 
@@ -39,11 +37,5 @@ struct OutputSpec {
 
 // Throws OutputError naming the URI and what is wrong with it.
 [[nodiscard]] OutputSpec parse_output_uri(std::string_view uri);
-
-// Opens the sink at `width` x `height`, `fps` frames a second (for the
-// formats that carry a rate). Throws OutputError (or the backend's error,
-// which names the file or device).
-[[nodiscard]] std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width,
-                                                                  int height, double fps);
 
 } // namespace camhead::pipeline

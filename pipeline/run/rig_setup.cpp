@@ -14,10 +14,15 @@
 #include <variant>
 #include <vector>
 
+#include "camhead/base/config_error.h"
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/camera/libcamera/libcamera_camera.h"
 #include "camhead/hal/camera/sim/simulated_camera.h"
 #include "camhead/hal/camera/v4l2/v4l2_camera.h"
+#include "camhead/hal/output/drm/drm_sink.h"
+#include "camhead/hal/output/file/file_sink.h"
+#include "camhead/hal/output/null/null_sink.h"
+#include "camhead/hal/output/v4l2/v4l2_loopback_sink.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "lens_camera.h"
@@ -236,16 +241,30 @@ bool has_hardware_gpu() {
 
 } // namespace
 
-std::unique_ptr<renderer::FrameRenderer> make_renderer(Executor wanted,
+std::unique_ptr<renderer::FrameRenderer> make_renderer(const Board &board, Executor wanted,
                                                        const renderer::Scene &scene, int threads) {
-  if (wanted == Executor::gpu)
+  // The GPU video kernels work in blocks of 4 x 2 pixels (video_encode.comp).
+  const bool gpu_size = board.camera->width % 4 == 0;
+  if (wanted == Executor::gpu) {
+    if (!gpu_size)
+      throw base::ConfigError(board.file.string(), "camera.width",
+                              std::to_string(board.camera->width) +
+                                  " is not a multiple of 4, which the GPU's video kernels need "
+                                  "(--executor cpu renders it)");
     return renderer::make_gpu_frame_renderer(scene);
+  }
   if (wanted == Executor::automatic && has_hardware_gpu()) {
-    try {
-      return renderer::make_gpu_frame_renderer(scene);
-    } catch (const renderer::GpuError &e) {
-      std::fprintf(stderr, "camhead run: the CPU reference renders, not Vulkan: %s\n", e.what());
-    }
+    if (!gpu_size)
+      std::fprintf(stderr,
+                   "camhead run: the CPU reference renders, not Vulkan: camera.width %d is not a "
+                   "multiple of 4, which the GPU's video kernels need\n",
+                   board.camera->width);
+    else
+      try {
+        return renderer::make_gpu_frame_renderer(scene);
+      } catch (const renderer::GpuError &e) {
+        std::fprintf(stderr, "camhead run: the CPU reference renders, not Vulkan: %s\n", e.what());
+      }
   }
   return renderer::make_cpu_frame_renderer(scene, threads);
 }
@@ -284,6 +303,31 @@ std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Sc
                              ", the board says " + std::to_string(c.width) + "x" +
                              std::to_string(c.height));
   return camera;
+}
+
+std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width, int height,
+                                                    double fps) {
+  base::VideoFormat format;
+  format.pixel = spec.format;
+  format.width = width;
+  format.height = height;
+  switch (spec.kind) {
+  case OutputKind::null:
+    return hal::output::open_null_sink(format);
+  case OutputKind::y4m:
+    return hal::output::open_y4m_sink(spec.target, format, fps);
+  case OutputKind::png:
+    return hal::output::open_png_sequence_sink(spec.target, format);
+  case OutputKind::v4l2:
+    return hal::output::open_v4l2_loopback_sink(spec.target, format, fps);
+  case OutputKind::drm:
+    return hal::output::open_drm_sink({.card = spec.target,
+                                       .connector = spec.connector,
+                                       .width = width,
+                                       .height = height,
+                                       .mode = spec.mode});
+  }
+  throw OutputError(spec.uri, "unknown output kind");
 }
 
 double camera_fps(const CameraSource &camera) {

@@ -1,8 +1,8 @@
 // What `camhead run` opens before the first frame, from a board: the scene at
-// the camera's size, the pose, the executor, the frame renderer and the
-// camera (the simulated one filming the scene's real objects). Everything
-// here throws, naming the board field, file or device at fault; nothing
-// after it does.
+// the camera's size, the pose, the executor, the frame renderer, the camera
+// (the simulated one filming the scene's real objects) and the outputs.
+// Everything here throws, naming the board field, file or device at fault;
+// nothing after it does.
 #pragma once
 
 #include <cstdint>
@@ -10,10 +10,12 @@
 
 #include "board.h"
 #include "camhead/hal/camera/camera_source.h"
+#include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_camera.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/scene.h"
 #include "lens_hub.h"
+#include "output_uri.h"
 
 namespace camhead::pipeline {
 
@@ -28,9 +30,10 @@ namespace camhead::pipeline {
 // renders a live frame over the influence region as fast as lavapipe,
 // without lavapipe's kernel compiles at start (bench/RESULTS.md, "The live
 // frame on lavapipe, again"). A GPU asked for by name that cannot take the
-// scene is an error (GpuError); `automatic` says why it fell back.
+// scene is an error (GpuError, or base::ConfigError on the board's
+// camera.width); `automatic` says why it fell back.
 [[nodiscard]] std::unique_ptr<renderer::FrameRenderer>
-make_renderer(Executor wanted, const renderer::Scene &scene, int threads);
+make_renderer(const Board &board, Executor wanted, const renderer::Scene &scene, int threads);
 
 // The board's camera. The simulated one renders the scene's real objects
 // through the lens at each exposure (trace_lens.h, or `lens`) with Vulkan,
@@ -38,6 +41,12 @@ make_renderer(Executor wanted, const renderer::Scene &scene, int threads);
 [[nodiscard]] std::unique_ptr<hal::camera::CameraSource>
 open_camera(const Board &board, const renderer::Scene &scene, const renderer::FrameCamera &pose,
             const LensHub &lens, int threads);
+
+// Opens the sink at `width` x `height`, `fps` frames a second (for the
+// formats that carry a rate). Throws OutputError (or the backend's error,
+// which names the file or device).
+[[nodiscard]] std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width,
+                                                                  int height, double fps);
 
 // The camera's rate, 25 where it does not say.
 [[nodiscard]] double camera_fps(const hal::camera::CameraSource &camera);

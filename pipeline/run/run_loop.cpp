@@ -28,6 +28,7 @@
 #include "output_uri.h"
 #include "placeholder.h"
 #include "rig_setup.h"
+#include "run_paths.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -53,7 +54,7 @@ struct Delivered {
 // The counters every thread adds to; the status line and the summary read them.
 struct Counters {
   std::atomic<std::uint64_t> frames_in{0}, frames_out{0}, render_busy{0}, output_busy{0},
-      render_failed{0}, placeholders{0}, repeats{0}, sink_errors{0};
+      render_failed{0}, placeholders{0}, repeats{0}, sink_errors{0}, lens_late{0};
   std::atomic<std::uint32_t> rpp{0};
   std::atomic<std::uint32_t> traced_permille{1000}; // of the last frame's pixels
   std::atomic<std::int64_t> latency_ns{0};          // capture to output, last frame
@@ -65,6 +66,11 @@ struct Counters {
 // longer) counts as lost, whatever it says.
 constexpr std::int64_t kCameraSilentNs = 1'000'000'000;
 constexpr int kSlots = 3; // frames between render and output
+// How long a frame waits for the lens state of its mid-exposure while the
+// source's readings are still coming: a live frame at most half its
+// interval (the latency it adds), a take composited offline (nothing live
+// waits on it) at most this long.
+constexpr std::int64_t kOfflineLensWaitNs = 1'000'000'000;
 
 class Pipeline {
 public:
@@ -82,6 +88,10 @@ private:
   void status_loop();
   void print_status(std::int64_t now, double dt, std::uint64_t in, std::uint64_t out, bool tty);
   void report_sink_errors(bool tty);
+  void report_camera(bool tty);
+  // The lens at the frame's mid-exposure; waits (bounded) for readings that
+  // are on their way, and says how long in the record.
+  LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
   RunSummary finish();
   // Sends one frame to every sink; `fill` writes sink i's buffer.
   template <typename Fill> void send(Fill fill, std::int64_t capture_ns);
@@ -90,17 +100,21 @@ private:
   const Board &board_;
   const renderer::Scene scene_;
   const renderer::FrameCamera pose_;
-  std::unique_ptr<renderer::FrameRenderer> renderer_;
   LensHub lens_;
   std::unique_ptr<CameraSource> camera_;
   double fps_ = 25.0;
+  std::unique_ptr<renderer::FrameRenderer> renderer_;
   std::vector<std::unique_ptr<FrameSink>> sinks_;
+  std::vector<bool> file_sinks_;           // which sinks are files (their errors: exit 4)
+  std::vector<std::uint64_t> sink_failed_; // output thread: frames each sink did not take
   std::FILE *stats_ = nullptr;
   std::string executor_name_;
 
   std::vector<Slot> slots_{kSlots};
   std::vector<std::vector<std::uint8_t>> last_frames_; // what each sink showed last
   std::vector<std::uint64_t> sink_errors_seen_;        // status thread: reported so far
+  std::string camera_detail_seen_;                     // status thread: reported last
+  std::string camera_failure_;                         // capture thread; read after it is joined
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   Counters counters_;
@@ -112,27 +126,17 @@ private:
   std::int64_t last_output_ns_ = 0; // output thread only
 };
 
-// Two outputs on one file or device would write over each other (one
-// file's frames and headers interleaved); the second is refused.
-bool same_target(const OutputSpec &a, const OutputSpec &b) {
-  if (a.kind == OutputKind::null || b.kind == OutputKind::null)
-    return false;
-  if (a.kind == OutputKind::drm || b.kind == OutputKind::drm) // a card drives connectors
-    return a.kind == b.kind && a.target == b.target && a.connector == b.connector;
-  std::error_code error;
-  const std::filesystem::path pa = std::filesystem::weakly_canonical(a.target, error);
-  const std::filesystem::path pb = std::filesystem::weakly_canonical(b.target, error);
-  return error ? a.target == b.target : pa == pb;
-}
-
+// Two outputs on one connector would fight over it; files and device nodes
+// are checked with every other path of the run (run_paths.h).
 std::vector<OutputSpec> output_specs(const RunOptions &options) {
   std::vector<OutputSpec> specs;
   for (const std::string &uri : options.outputs.empty() ? options.board.outputs : options.outputs) {
     OutputSpec spec = parse_output_uri(uri);
     for (const OutputSpec &earlier : specs)
-      if (same_target(spec, earlier))
-        throw OutputError(uri, "writes to " + spec.target + " as " + earlier.uri +
-                                   " does; give each output its own file or device");
+      if (spec.kind == OutputKind::drm && earlier.kind == OutputKind::drm &&
+          spec.target == earlier.target && spec.connector == earlier.connector)
+        throw OutputError(uri, "drives " + spec.target + " as " + earlier.uri +
+                                   " does; give each output its own connector");
     specs.push_back(std::move(spec));
   }
   if (specs.empty())
@@ -149,17 +153,28 @@ const Board &checked_board(const RunOptions &options) {
 }
 
 // Everything that can fail is opened here, before the first frame, and the
-// outputs last (a file output is only created once the rest stands).
+// outputs last (a file output is only created once the rest stands). The
+// camera comes before the renderer: a take's size is checked against the
+// board before anything of that size is allocated.
 Pipeline::Pipeline(const RunOptions &options)
     : options_(options), board_(checked_board(options)), scene_(load_run_scene(board_)),
-      pose_(base_camera(board_, scene_)),
-      renderer_(make_renderer(options.executor.value_or(board_.render.executor), scene_,
+      pose_(base_camera(board_, scene_)), lens_(board_),
+      camera_(open_camera(board_, scene_, pose_, lens_, options.threads)),
+      fps_(camera_fps(*camera_)),
+      renderer_(make_renderer(board_, options.executor.value_or(board_.render.executor), scene_,
                               options.threads)),
-      lens_(board_), camera_(open_camera(board_, scene_, pose_, lens_, options.threads)),
-      fps_(camera_fps(*camera_)), executor_name_(renderer_->executor()) {
+      executor_name_(renderer_->executor()) {
   const std::vector<OutputSpec> specs = output_specs(options);
-  for (const OutputSpec &spec : specs)
+  std::vector<RunPath> paths = run_inputs(board_, scene_);
+  for (RunPath &output : run_outputs(specs))
+    paths.push_back(std::move(output));
+  if (options.stats_file)
+    paths.push_back({"--record-stats", *options.stats_file, true, false});
+  check_run_paths(paths);
+  for (const OutputSpec &spec : specs) {
     sinks_.push_back(open_output(spec, board_.camera->width, board_.camera->height, fps_));
+    file_sinks_.push_back(spec.kind == OutputKind::y4m || spec.kind == OutputKind::png);
+  }
   if (options.stats_file) {
     // A stream of records, written as the run goes (for `tail -f`, or into
     // a FIFO or /dev/stdout on purpose), not a partial file renamed at the
@@ -176,6 +191,7 @@ Pipeline::Pipeline(const RunOptions &options)
   for (const auto &sink : sinks_)
     last_frames_.emplace_back(base::frame_bytes(sink->format()));
   sink_errors_seen_.assign(sinks_.size(), 0);
+  sink_failed_.assign(sinks_.size(), 0);
   for (int i = 0; i < kSlots; ++i)
     (void)free_slots_.push(i);
   if (const auto *file = std::get_if<FileCameraConfig>(&board_.camera->kind))
@@ -213,7 +229,9 @@ void Pipeline::capture_loop() {
       last_frame_ns = now;
     counters_.camera_lost = result == CaptureResult::disconnected ||
                             (!lossless_ && last_frame_ns && now - *last_frame_ns > silent_after_ns);
-    if (result == CaptureResult::ended) {
+    if (result == CaptureResult::failed)
+      camera_failure_ = camera_->status().detail;
+    if (result == CaptureResult::ended || result == CaptureResult::failed) {
       stopping_ = true;
       break;
     }
@@ -271,7 +289,7 @@ void Pipeline::render_loop() {
     r.dropped_before = last_sequence ? frame.sequence - *last_sequence - 1 : frame.sequence;
     last_sequence = frame.sequence;
 
-    const LensSnapshot lens = lens_.state_at(r.exposure_mid_ns);
+    const LensSnapshot lens = lens_at(r.exposure_mid_ns, r);
     r.focus_m = lens.state.focus_distance_m.value;
     r.f_number = lens.state.f_number.value;
     r.focal_length_mm = lens.state.focal_length_mm.value;
@@ -311,16 +329,43 @@ void Pipeline::render_loop() {
   ready_slots_.close();
 }
 
+LensSnapshot Pipeline::lens_at(std::int64_t mid_exposure_ns, FrameRecord &record) {
+  LensSnapshot lens = lens_.state_at(mid_exposure_ns);
+  // A source hands its readings over a little after they happen (its own
+  // delay, the lens thread's poll), and a run's first frame can come before
+  // the first of them: then the state is the profile's rest state or an
+  // extrapolation, a lens the rig never had. Such a frame waits for the
+  // readings, while they can still come: not for a source that is lost.
+  const std::int64_t start = base::monotonic_ns();
+  const std::int64_t give_up =
+      start + (lossless_ ? kOfflineLensWaitNs : std::llround(0.5e9 / fps_));
+  // A stop asked for by the user ends the wait; a take played to its end
+  // does not (its last frames still get their lens).
+  const auto asked_to_stop = [this] { return options_.stop != nullptr && *options_.stop; };
+  while (!lens.fresh && (lens.connected || !lens_.started()) && !asked_to_stop() &&
+         base::monotonic_ns() < give_up) {
+    std::this_thread::sleep_for(1ms);
+    lens = lens_.state_at(mid_exposure_ns);
+  }
+  record.lens_wait_s = double(base::monotonic_ns() - start) * 1e-9;
+  if (!lens.fresh)
+    ++counters_.lens_late;
+  return lens;
+}
+
 template <typename Fill> void Pipeline::send(Fill fill, std::int64_t capture_ns) {
   for (std::size_t i = 0; i < sinks_.size(); ++i) {
     const std::span<std::uint8_t> buffer = sinks_[i]->acquire();
     if (buffer.size() < base::frame_bytes(sinks_[i]->format())) {
       ++counters_.sink_errors;
+      ++sink_failed_[i];
       continue;
     }
     fill(i, buffer);
-    if (!sinks_[i]->submit(capture_ns))
+    if (!sinks_[i]->submit(capture_ns)) {
       ++counters_.sink_errors;
+      ++sink_failed_[i];
+    }
   }
   last_output_ns_ = base::monotonic_ns();
 }
@@ -399,17 +444,20 @@ void Pipeline::print_status(std::int64_t now, double dt, std::uint64_t in, std::
   char output_errors[48] = "";
   if (const std::uint64_t errors = counters_.sink_errors; errors > 0)
     std::snprintf(output_errors, sizeof output_errors, "  OUTPUT ERRORS %" PRIu64, errors);
+  char lens_late[64] = "";
+  if (const std::uint64_t late = counters_.lens_late; late > 0)
+    std::snprintf(lens_late, sizeof lens_late, " (%" PRIu64 " frames without it)", late);
   std::fprintf(options_.status,
                "%sin %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
                " (camera %" PRIu64 ", render busy %" PRIu64 ", output busy %" PRIu64
-               ")  focus %s f/%.1f %.0f mm%s  latency %.0f ms%s%s%s",
+               ")  focus %s f/%.1f %.0f mm%s%s  latency %.0f ms%s%s%s",
                tty ? "\r\033[K" : "", double(in) / dt, double(out) / dt, counters_.rpp.load(),
                0.1 * counters_.traced_permille.load(),
                cam.dropped + counters_.render_busy + counters_.output_busy, cam.dropped,
                counters_.render_busy.load(), counters_.output_busy.load(), focus,
                lens.state.f_number.value, lens.state.focal_length_mm.value,
-               lens.fresh ? "" : " (stale)", 1e-6 * double(counters_.latency_ns.load()), alarm,
-               output_errors, tty ? "" : "\n");
+               lens.fresh ? "" : " (stale)", lens_late, 1e-6 * double(counters_.latency_ns.load()),
+               alarm, output_errors, tty ? "" : "\n");
   std::fflush(options_.status);
 }
 
@@ -427,6 +475,17 @@ void Pipeline::report_sink_errors(bool tty) {
   }
 }
 
+// A camera that is lost says why, once each time its word changes (a
+// take's frame that cannot be read, a device gone).
+void Pipeline::report_camera(bool tty) {
+  const hal::camera::CameraStatus status = camera_->status();
+  if (status.connected || status.detail == camera_detail_seen_)
+    return;
+  camera_detail_seen_ = status.detail;
+  std::fprintf(options_.status, "%scamhead run: camera: %s\n", tty ? "\r\033[K" : "",
+               status.detail.c_str());
+}
+
 // The status line: redrawn in place on a terminal, a line a second in logs.
 void Pipeline::status_loop() {
   const bool tty = options_.status != nullptr && isatty(fileno(options_.status)) != 0;
@@ -436,12 +495,16 @@ void Pipeline::status_loop() {
                  executor_name_.c_str(), lens_.source_name().c_str());
   std::uint64_t last_in = 0, last_out = 0;
   std::int64_t last_ns = start_ns_;
+  // Awake often, so that a run ends as soon as its last frame is out, and
+  // a line a second (four on a terminal).
+  const std::int64_t every_ns = tty ? 250'000'000 : 1'000'000'000;
   while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
-    std::this_thread::sleep_for(tty ? 250ms : 1000ms);
+    std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
-    if (options_.status == nullptr || now - last_ns < 900'000'000)
+    if (options_.status == nullptr || now - last_ns < every_ns)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
+    report_camera(tty);
     report_sink_errors(tty);
     print_status(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out, tty);
     last_in = in;
@@ -477,21 +540,25 @@ RunSummary Pipeline::finish() {
   RunSummary summary;
   if (options_.status != nullptr)
     report_sink_errors(false); // those of the last second
-  for (const auto &sink : sinks_)
-    if (!sink->close()) {
+  for (std::size_t i = 0; i < sinks_.size(); ++i) {
+    FrameSink &sink = *sinks_[i];
+    const bool closed = sink.close();
+    if (!closed)
       ++summary.sink_errors;
-      if (options_.status != nullptr)
-        std::fprintf(options_.status, "camhead run: %s: %s\n", sink->name().c_str(),
-                     sink->status().detail.c_str());
-    }
+    const hal::output::SinkStatus status = sink.status();
+    summary.outputs.push_back(
+        {sink.name(), file_sinks_[i], status.frames, sink_failed_[i], closed, status.detail});
+  }
   // Closed once, here or (after a failed run) by the destructor.
   if (std::FILE *stats = std::exchange(stats_, nullptr); stats != nullptr) {
     // A failed write mid-run shows in ferror(), the last one in fclose().
     const bool written = std::ferror(stats) == 0;
     if (std::fclose(stats) != 0 || !written)
-      throw StatsFileError(options_.stats_file->string() +
-                           ": not all of the statistics were written (a full disk?)");
+      summary.stats_failure =
+          options_.stats_file->string() + ": not all of the statistics were written (a full disk?)";
   }
+  summary.camera_failure = camera_failure_;
+  summary.lens_late = counters_.lens_late;
   const hal::camera::CameraStatus cam = camera_->status();
   summary.frames_in = counters_.frames_in;
   summary.frames_out = counters_.frames_out;

@@ -2,8 +2,9 @@
 // composited video out.
 //
 //   capture thread   camera.wait_frame() -> [queue of 1, newest wins] ->
-//   render thread    lens state at mid-exposure, FrameBudget's rays per
-//                    pixel, FrameRenderer into a free output slot ->
+//   render thread    lens state at mid-exposure (waiting for it, bounded,
+//                    while its readings are still coming), FrameBudget's
+//                    rays per pixel, FrameRenderer into a free output slot ->
 //                    [queue of slots] ->
 //   output thread    each sink: acquire, copy, submit; the per-frame record;
 //                    after half a second without a composite, the last one
@@ -14,7 +15,9 @@
 // takes the newest camera frame (the one it replaces is dropped and
 // counted, "render busy"), and a frame with no free output slot is dropped
 // ("output busy"). Nothing in the loop throws; a camera that goes away is
-// waited for while the outputs show the placeholder.
+// waited for while the outputs show the placeholder. A take played once
+// that breaks off ends the run, and the summary says where
+// (RunSummary::camera_failure).
 #pragma once
 
 #include <atomic>
@@ -34,7 +37,7 @@ struct RunOptions {
   Board board;
   std::vector<std::string> outputs; // URIs; empty: the board's
   double duration_s = 0.0;          // 0: until stopped
-  std::uint64_t frames = 0;         // output frames; 0: until stopped
+  std::uint64_t frames = 0;         // composites output; 0: until stopped
   std::optional<std::filesystem::path> stats_file;
   std::optional<Executor> executor; // overrides the board's
   int threads = 0;                  // CPU executor; <= 0: one per hardware thread
@@ -49,6 +52,16 @@ struct RunOptions {
   const std::atomic<bool> *stop = nullptr;
 };
 
+// What one output took.
+struct OutputSummary {
+  std::string name;          // "file camhead_sim.y4m"
+  bool file = false;         // a file (errors are exit 4), else a device (exit 5)
+  std::uint64_t written = 0; // frames it took
+  std::uint64_t failed = 0;  // frames it did not (a full disk, a device gone)
+  bool closed = true;        // finished: a file completed and put in place
+  std::string detail;        // its last state or error
+};
+
 struct RunSummary {
   std::uint64_t frames_in = 0;  // camera frames captured
   std::uint64_t frames_out = 0; // composites sent to the outputs
@@ -61,6 +74,13 @@ struct RunSummary {
   std::uint64_t placeholders = 0; // placeholder frames sent (no camera, or none yet)
   std::uint64_t repeats = 0;      // the last composite sent again (the camera was slow)
   std::uint64_t sink_errors = 0;
+  std::uint64_t lens_late = 0; // composites whose lens state did not cover their mid-exposure
+  std::vector<OutputSummary> outputs;
+  // Why the camera ended the run, if it broke off (a take played once with
+  // a frame that cannot be read), naming the file and frame.
+  std::string camera_failure;
+  // Why the statistics file is not whole (a full disk); empty if it is.
+  std::string stats_failure;
   double seconds = 0.0;
   std::string executor;
 };
@@ -72,9 +92,11 @@ public:
 };
 
 // Sets everything up (throws std::runtime_error naming the board field,
-// file or device at fault before any output is written), runs until
-// `frames`, `duration_s` or `*stop`, and closes the outputs. Throws
-// StatsFileError when the statistics could not all be written.
+// file or device at fault before any output is written: RunPathError when
+// an output or the statistics file is one of the run's inputs or another
+// output, StatsFileError when the statistics file cannot be opened), runs
+// until `frames`, `duration_s`, `*stop` or the end of a take played once,
+// and closes the outputs. What failed while running is in the summary.
 RunSummary run_pipeline(const RunOptions &options);
 
 } // namespace camhead::pipeline

@@ -124,12 +124,12 @@ void main() {
     real_out = mix(real_out, fg_real / fg_weight, alpha);
   }
 
-  // Equation (4) as resolve_pixel() writes it.
+  // Equation (4) as composite_pixel() (kernel.glsl) writes it, not below black.
   vec3 m = vec3(mixed_out);
   float mask = mixed_out.w;
   vec3 camera = params.image.z != 0u ? vec3(plate[i]) : real_out;
   precise vec3 composite = camera + (m - real_out) - mask * (camera - real_out);
-  out_composite[i] = vec4(composite, 1.0);
+  out_composite[i] = vec4(max(composite, min(camera, vec3(0.0))), 1.0);
   out_mixed[i] = mixed_out;
   out_real[i] = vec4(real_out, 0.0);
 }

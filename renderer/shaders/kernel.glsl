@@ -421,11 +421,25 @@ struct Resolved {
   float depth;
 };
 
-// Layers from the accumulators, and equation (4):
-//   I_f = M I_m + (1 - M)(I_c + I_m - I_r)
+// Equation (4),
+//   I_f = M I_m + (1 - M)(I_c + I_m - I_r),
 // evaluated as I_c + (I_m - I_r) - M (I_c - I_r), which returns I_c bit for
-// bit where nothing virtual is seen (M = 0 and I_m == I_r). Without a plate
-// the real render stands in for the camera image, so I_f = I_m.
+// bit where nothing virtual is seen (M = 0 and I_m == I_r). Where the camera
+// pixel is darker than the real proxy predicts, a virtual shadow would take
+// it below black (I_c + I_m - I_r < 0): light that cannot be, and video
+// codes under 16 that limited range reserves. The virtual contribution
+// stops at black, and never moves a camera value that is already below it
+// (a Y'CbCr triple outside the RGB cube), so pass-through stays exact.
+// (shared/reference/compose.py does not clamp: its composites differ from
+// these only where they are negative.)
+vec3 composite_pixel(vec3 camera, vec3 mixed, vec3 real, float mask) {
+  // PRECISE: a reassociating compiler (Mesa does) would break the identity.
+  PRECISE vec3 composite = camera + (mixed - real) - mask * (camera - real);
+  return max(composite, min(camera, vec3(0.0f)));
+}
+
+// Layers from the accumulators, composited by composite_pixel(). Without a
+// plate the real render stands in for the camera image, so I_f = I_m.
 // `samples`: the pixel's sample count (frame.sampling.z, or its adaptive n_i;
 // 0 outside the influence region, whose accumulators are zero: the camera
 // image).
@@ -438,8 +452,6 @@ Resolved resolve_pixel(vec4 acc_mixed, vec4 acc_real, vec4 acc_aux, vec4 plate, 
   r.mask = acc_mixed.w * inv;
   r.depth = acc_aux.y > 0.0f ? acc_aux.x / acc_aux.y : 0.0f;
   vec3 camera = has_plate ? vec3(plate) : r.real;
-  // PRECISE: a reassociating compiler (Mesa does) would break the identity.
-  PRECISE vec3 composite = camera + (r.mixed - r.real) - r.mask * (camera - r.real);
-  r.composite = composite;
+  r.composite = composite_pixel(camera, r.mixed, r.real, r.mask);
   return r;
 }

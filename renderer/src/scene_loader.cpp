@@ -20,6 +20,7 @@
 #include <glm/vec3.hpp>
 
 #include "camhead/base/config_json.h"
+#include "camhead/renderer/frame_camera.h"
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/mesh_io.h"
 
@@ -82,8 +83,10 @@ public:
     objects(S.at("objects"), scene);
     if (S.has("lights"))
       lights(S.at("lights"), scene);
-    if (plate)
+    if (plate) {
       scene.plate = load_plate(*plate, scene.render);
+      scene.plate_file = plate->path();
+    }
     return scene;
   }
 
@@ -128,14 +131,7 @@ private:
     out.f_number = float(f_number);
     if (position == look_at)
       c.fail_member("look_at", "equals camera.position");
-    // The reference does this test on float32 vectors (Blender's mathutils),
-    // so a direction that vanishes in float is parallel to anything.
-    const glm::dvec3 fwd(out.look_at - out.position), u(out.up);
-    const auto normalized = [](glm::dvec3 v) {
-      const double len = glm::length(v);
-      return len > 0.0 ? v / len : v;
-    };
-    if (glm::length(glm::cross(normalized(fwd), normalized(u))) < 1e-6)
+    if (view_has_no_orientation(out.position, out.look_at, out.up))
       c.fail_member("up", "parallel to the viewing direction");
     if (f_number > 0.0 || c.has("focus_distance_m"))
       out.focus_distance_m = float(number(c.at("focus_distance_m"), Range::above(0.0, 1e6)));

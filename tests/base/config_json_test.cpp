@@ -243,12 +243,31 @@ TEST(ConfigJson, PathsAreRelativeToTheFile) {
   EXPECT_EQ(g.root().at("p").path(), std::filesystem::current_path() / "scenes" / "m.obj");
 }
 
-TEST(ConfigJson, DuplicateKeysKeepTheFirstPositionAndTheLastValue) {
-  const JsonFile f(R"({"a": 1, "b": 2, "a": 3})", kFile);
-  const auto members = f.root().members();
-  ASSERT_EQ(members.size(), 2u);
-  EXPECT_EQ(members[0].first, "a");
-  EXPECT_EQ(members[0].second.integer(0, 9), 3);
+TEST(ConfigJson, APathHoldingANulOrAControlCharacterIsRefused) {
+  // The C library would open "victim", not the file the string names.
+  const auto path_of = [](const JsonValue &r) { (void)r.at("p").path(); };
+  EXPECT_EQ(error_of(R"({"p": "victim\u0000.y4m"})", path_of),
+            std::string(kFile) +
+                R"(: p: holds a NUL character (\u0000) at position 6; a file name cannot)");
+  EXPECT_EQ(error_of(R"({"p": "take\n.y4m"})", path_of),
+            std::string(kFile) +
+                R"(: p: holds a control character (\u000a) at position 4; a file name cannot)");
+  EXPECT_EQ(error_of(R"({"p": "caf\u00e9 take.y4m"})", path_of), "(no error)");
+}
+
+TEST(ConfigJson, AKeyGivenTwiceInOneObjectIsRefusedOnItsField) {
+  // Python's json would keep the last "camera" without a word.
+  EXPECT_EQ(error_of(R"({"a": 1, "b": 2, "a": 3})", [](const JsonValue &) {}),
+            std::string(kFile) + ": a: given twice in one object; only one would count: give it "
+                                 "once");
+  EXPECT_EQ(error_of(R"({"l": {"s": [{"p": 1}, [2, {}], {"t": {"x": 1}, "p": 2, "p": 3}]}})",
+                     [](const JsonValue &) {}),
+            std::string(kFile) +
+                ": l.s[2].p: given twice in one object; only one would count: give it once");
+  // The same key in different objects is no duplicate.
+  EXPECT_EQ(error_of(R"({"a": {"k": 1}, "b": {"k": 2}, "c": [{"k": 3}, {"k": 4}]})",
+                     [](const JsonValue &) {}),
+            "(no error)");
 }
 
 TEST(ConfigJson, DamagedTextGivesAValueOrAConfigError) {

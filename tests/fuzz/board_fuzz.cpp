@@ -1,17 +1,71 @@
-// libFuzzer target for the board-file reader (pipeline/board.h): any text
-// must be refused with a BoardError or parsed; any other exception is a
-// finding. Paths inside a board are only stored, never opened, here.
+// libFuzzer target for the board-file reader (pipeline/board.h) and what
+// `camhead run` builds from a board before it opens a device: the output
+// URIs, the check of every path the run reads and writes against the others
+// (run_paths.h; it only looks at paths, with stat()), the camera's size and
+// the pose's view. Any text must be refused with the error of the step that
+// read it, or give a rig whose invariants hold; anything else is a finding.
+// Nothing is opened for writing and no device is started.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 #include "board.h"
+#include "camhead/renderer/scene.h"
 #include "fuzz_check.h"
+#include "run/output_uri.h"
+#include "run/run_paths.h"
+
+namespace {
+
+using namespace camhead;
+
+bool finite(glm::vec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// The camera frame make_frame_params() builds from a pose: a pose the board
+// reader lets through must give one without a NaN or a zero axis.
+void check_pose(const pipeline::PoseConfig &pose) {
+  const auto f = [](const std::array<double, 3> &a) {
+    return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
+  };
+  const glm::vec3 forward = glm::normalize(f(pose.look_at) - f(pose.position));
+  const glm::vec3 right = glm::normalize(glm::cross(forward, f(pose.up)));
+  fuzz::check(finite(forward) && finite(right) && glm::length(right) > 0.5f);
+}
+
+void build_rig(const pipeline::Board &board) {
+  std::vector<pipeline::OutputSpec> outputs;
+  for (const std::string &uri : board.outputs)
+    outputs.push_back(pipeline::parse_output_uri(uri));
+  renderer::Scene scene;
+  if (board.scene)
+    scene.source = *board.scene;
+  std::vector<pipeline::RunPath> paths = pipeline::run_inputs(board, scene);
+  for (pipeline::RunPath &output : pipeline::run_outputs(outputs))
+    paths.push_back(std::move(output));
+  pipeline::check_run_paths(paths);
+  if (board.camera) {
+    const auto &c = *board.camera;
+    fuzz::check(c.width >= 2 && c.height >= 2 && c.width % 2 == 0 && c.height % 2 == 0 &&
+                std::int64_t(c.width) * c.height <= std::int64_t(1) << 25);
+  }
+  if (board.pose)
+    check_pose(*board.pose);
+}
+
+} // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
   try {
-    (void)camhead::pipeline::parse_board(camhead::fuzz::text_of(data, size),
-                                         "/nonexistent/fuzz_board.json");
-  } catch (const camhead::pipeline::BoardError &) {
+    build_rig(pipeline::parse_board(fuzz::text_of(data, size), "/nonexistent/fuzz_board.json"));
+  } catch (const pipeline::BoardError &) {
+  } catch (const pipeline::OutputError &) {
+  } catch (const pipeline::RunPathError &) {
   }
   return 0;
 }

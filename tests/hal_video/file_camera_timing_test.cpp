@@ -117,6 +117,22 @@ TEST(FileCameraTiming, RealtimeKeepsTheRateAndNeverBlocksPastTheTimeout) {
   camera->release(second);
 }
 
+// In real time a frame is handed over as its exposure ends, as a camera's
+// is: its mid-exposure lies half a frame in the past, where the lens chain
+// has readings, not half a frame in the future.
+TEST(FileCameraTiming, RealtimeFramesAreStampedAtTheEndOfTheirExposure) {
+  const test::ScratchDir dir;
+  auto camera = open(two_frames(dir), true, true, 10.0); // 100 ms a frame
+  CapturedFrame frame;
+  ASSERT_EQ(camera->wait_frame(milliseconds(1000), frame), CaptureResult::frame);
+  const std::int64_t now = base::monotonic_ns();
+  EXPECT_EQ(frame.mark, hal::camera::TimestampMark::end_of_frame);
+  EXPECT_EQ(frame.exposure_ns, 100'000'000);
+  EXPECT_LE(frame.timestamp_ns, now);
+  EXPECT_LE(hal::camera::mid_exposure_ns(frame), now - 50'000'000);
+  camera->release(frame);
+}
+
 TEST(FileCameraTiming, ThreeBuffersAndNoFourth) {
   const test::ScratchDir dir;
   auto camera = open(two_frames(dir), true, false);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "camhead/base/monotonic_clock.h"
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "video_test_files.h"
@@ -149,11 +150,12 @@ std::string three_frames(const test::ScratchDir &dir) {
   return test::read_text(dir / "take.y4m");
 }
 
-void expect_ends_after(hal::camera::CameraSource &camera, std::size_t frames,
-                       const std::string &detail) {
+// A take played once that breaks off has failed, naming the file and frame.
+void expect_fails_after(hal::camera::CameraSource &camera, std::size_t frames,
+                        const std::string &detail) {
   EXPECT_EQ(test::read_all(camera).size(), frames);
   CapturedFrame frame;
-  EXPECT_EQ(camera.wait_frame(std::chrono::milliseconds(0), frame), CaptureResult::ended);
+  EXPECT_EQ(camera.wait_frame(std::chrono::milliseconds(0), frame), CaptureResult::failed);
   const auto status = camera.status();
   EXPECT_FALSE(status.connected);
   EXPECT_EQ(status.frames, frames);
@@ -161,7 +163,7 @@ void expect_ends_after(hal::camera::CameraSource &camera, std::size_t frames,
   EXPECT_EQ(status.detail, detail);
 }
 
-TEST(FileCameraErrors, ATruncatedLastFrameEndsTheStreamNamingIt) {
+TEST(FileCameraErrors, ATruncatedLastFrameFailsATakePlayedOnceNamingIt) {
   const test::ScratchDir dir;
   const std::string file = three_frames(dir);
   const auto path = dir / "take.y4m";
@@ -169,12 +171,44 @@ TEST(FileCameraErrors, ATruncatedLastFrameEndsTheStreamNamingIt) {
   FileCameraOptions options;
   options.path = path;
   options.realtime = false;
-  options.loop = true; // an error ends even a looping stream
+  options.loop = false;
   auto camera = hal::camera::open_file_camera(options);
-  expect_ends_after(*camera, 2, path.string() + ":frame 2: truncated: 38 of 48 bytes");
+  expect_fails_after(*camera, 2, path.string() + ":frame 2: truncated: 38 of 48 bytes");
 }
 
-TEST(FileCameraErrors, AGarbledFrameEndsTheStreamNamingIt) {
+// A looping file stands in for a live camera: a frame it cannot read is a
+// lost signal, named, and after kFileCameraRetryAfter it plays again from
+// its first frame, for as long as the show goes on.
+TEST(FileCameraErrors, ALoopingFileThatBreaksIsLostThenPlaysAgainFromItsFirstFrame) {
+  const test::ScratchDir dir;
+  const std::string file = three_frames(dir);
+  const auto path = dir / "take.y4m";
+  test::write_text(path, file.substr(0, file.size() - 10));
+  FileCameraOptions options;
+  options.path = path;
+  options.realtime = false;
+  options.loop = true;
+  auto camera = hal::camera::open_file_camera(options);
+  const std::vector<std::vector<std::uint8_t>> first_pass = test::read_all(*camera);
+  ASSERT_EQ(first_pass.size(), 2u);
+  CapturedFrame frame;
+  EXPECT_EQ(camera->wait_frame(std::chrono::milliseconds(0), frame), CaptureResult::disconnected);
+  auto status = camera->status();
+  EXPECT_FALSE(status.connected);
+  EXPECT_EQ(status.errors, 1u);
+  EXPECT_EQ(status.detail, path.string() + ":frame 2: truncated: 38 of 48 bytes; playing again "
+                                           "from the first frame in 1000 ms");
+  // Waiting out the retry: no frame before it, never past the timeout.
+  const std::int64_t start = base::monotonic_ns();
+  EXPECT_EQ(camera->wait_frame(std::chrono::milliseconds(100), frame), CaptureResult::disconnected);
+  EXPECT_LT(base::monotonic_ns() - start, 900'000'000);
+  EXPECT_EQ(test::read_all(*camera), first_pass) << "the same two frames again";
+  status = camera->status();
+  EXPECT_EQ(status.reconnects, 1u);
+  EXPECT_EQ(status.errors, 2u) << "the second pass breaks at the same frame";
+}
+
+TEST(FileCameraErrors, AGarbledFrameFailsTheTakeNamingIt) {
   const test::ScratchDir dir;
   std::string file = three_frames(dir);
   const std::size_t second = file.find("FRAME\n", file.find("FRAME\n") + 1);
@@ -186,7 +220,8 @@ TEST(FileCameraErrors, AGarbledFrameEndsTheStreamNamingIt) {
   options.path = path;
   options.realtime = false;
   auto camera = hal::camera::open_file_camera(options);
-  expect_ends_after(*camera, 1, path.string() + ":frame 1: garbled: 'FRAMX' where FRAME should be");
+  expect_fails_after(*camera, 1,
+                     path.string() + ":frame 1: garbled: 'FRAMX' where FRAME should be");
 }
 
 } // namespace

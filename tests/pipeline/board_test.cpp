@@ -170,13 +170,54 @@ TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
   expect(live(R"({"type": "sim"})",
               R"(, "render": {"min_rays_per_pixel": 9, "max_rays_per_pixel": 4})"),
          "render.min_rays_per_pixel: must not exceed max_rays_per_pixel (4)");
-  expect(live(R"({"type": "sim"})", R"(, "pose": {"position": [0, 1, 0], "look_at": [0, 1, 0]})"),
-         "pose.look_at: must differ from position");
+  EXPECT_EQ(
+      error_of(with_source(
+          R"({"type": "trace", "file": "a.csv", "clock_origin": "monotonic", "loop": false})")),
+      "/rigs/test.json: lens.sources[0].loop: false with clock_origin \"monotonic\": the "
+      "trace would start at the machine's boot and be over before the run; loop it, or use "
+      "clock_origin \"start\"");
+  expect(live(R"({"type": "sim", "width": 8192, "height": 8192})"),
+         "camera.width: 8192x8192 is more than 2^25 pixels (8K UHD, 7680x4320, is within)");
+  expect(live(R"({"type": "file", "path": "take.y4m", "format": "nv12"})"),
+         "camera.format: a file camera's frames are in the file's own format (Y4M 4:2:2 yuyv, "
+         "4:2:0 nv12; PNG rgb24): remove \"format\"");
+  expect(live(R"({"type": "file", "path": "victim\u0000.y4m"})"),
+         R"(camera.path: holds a NUL character (\u0000) at position 6; a file name cannot)");
+  expect(live(R"({"type": "v4l2", "device": "/dev/video0\u0000x"})"),
+         R"(camera.device: holds a NUL character (\u0000) at position 11; a file name cannot)");
+  expect(live(R"({"type": "sim"}, "camera": {"type": "file", "path": "a.y4m"})"),
+         "camera: given twice in one object; only one would count: give it once");
   // A camera without a scene has nothing to composite.
   EXPECT_EQ(error_of(R"({"format": "camhead-board", "version": 1, "name": "t",
                         "lens": {"sources": [{"type": "freed"}]}, "camera": {"type": "sim"}})"),
             "/rigs/test.json: scene: missing: a board with a camera needs the scene of its "
             "virtual objects");
+}
+
+// A pose the tracer cannot build a view from would render no virtual object
+// at all, silently: every frame the plate.
+TEST(BoardLive, APoseWithoutAViewOrAnOrientationIsRefused) {
+  const auto pose = [](const std::string &fields) {
+    return error_of(live(R"({"type": "sim"})", R"(, "pose": {)" + fields + "}"));
+  };
+  const std::string file = "/rigs/test.json: ";
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, 0])"),
+            file + "pose.look_at: equals position (in the float32 the renderer works in)");
+  // Different doubles, one float.
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1.00000001, 0])"),
+            file + "pose.look_at: equals position (in the float32 the renderer works in)");
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 0, 0])"),
+            file + "pose.up: must not be zero");
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 0, 3])"),
+            file + "pose.up: parallel to the view from position to look_at");
+  // A rig looking straight down at a table, with the default up.
+  EXPECT_EQ(pose(R"("position": [0, 3, -2], "look_at": [0, 0, -2])"),
+            file + "pose.up: missing, and the default [0, 1, 0] is parallel to the view from "
+                   "position to look_at (straight down or up): give the direction the top of "
+                   "the picture points to, e.g. [0, 0, -1]");
+  EXPECT_EQ(pose(R"("position": [0, 3, -2], "look_at": [0, 0, -2], "up": [0, 0, -1])"),
+            "(no error)");
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2])"), "(no error)");
 }
 
 TEST(BoardLive, TheSimulatedRigHasACameraASceneAndAnOutput) {

@@ -157,6 +157,39 @@ TEST_F(RunLoop, LostLensSourceHoldsTheLastStateFlaggedStale) {
   EXPECT_GE(late, 5u);
 }
 
+// A camera hands a frame over once its exposure is done, and the frame is
+// rendered with the lens of its mid-exposure, which the lens chain has
+// readings around: every composite's lens state is fresh, the first
+// included (it waits for the lens thread's first readings if it must),
+// whether the take plays in real time or offline.
+TEST_F(RunLoop, EveryFrameGetsTheLensStateOfItsMidExposure) {
+  const int w = 48, h = 32, n = 8;
+  const std::vector<std::vector<std::uint8_t>> frames(
+      n, std::vector<std::uint8_t>(std::size_t(w) * h * 2, 128));
+  const fs::path input = write("in.y4m", y4m_422(w, h, frames));
+  for (const bool realtime : {true, false}) {
+    RunOptions options;
+    options.board = board(R"({"type": "file", "path": ")" + input.string() +
+                              R"(", "loop": false, "realtime": )" + (realtime ? "true" : "false") +
+                              R"(, "width": 48, "height": 32})",
+                          real_scene(w, h));
+    options.outputs = {"null"};
+    options.stats_file = dir_ / "stats.jsonl";
+    options.status = nullptr;
+    const RunSummary summary = run_pipeline(options);
+    const std::vector<CompositeRecord> records = recorded_composites(dir_ / "stats.jsonl");
+    ASSERT_EQ(records.size(), std::size_t(n)) << (realtime ? "real time" : "offline");
+    for (const CompositeRecord &r : records) {
+      EXPECT_TRUE(r.lens_fresh) << (realtime ? "real time" : "offline") << ", frame " << r.sequence;
+      // No camera hands a frame over before the middle of its exposure.
+      if (realtime) {
+        EXPECT_LT(r.exposure_mid_ns, r.delivered_ns) << "frame " << r.sequence;
+      }
+    }
+    EXPECT_EQ(summary.lens_late, 0u);
+  }
+}
+
 TEST_F(RunLoop, RefusesABoardWithoutCameraOrOutput) {
   RunOptions options;
   options.board = load_board(resolve_board("sim"));

@@ -103,6 +103,7 @@ struct CompositeRecord {
   std::uint64_t output_frame = 0;
   std::uint64_t sequence = 0;
   double exposure_mid_ns = 0.0;
+  double delivered_ns = 0.0;
   double focus_m = 0.0;
   bool lens_fresh = false;
 };
@@ -135,7 +136,8 @@ inline std::vector<CompositeRecord> recorded_composites(const fs::path &stats) {
       (void)json_number(line, field);
     records.push_back({std::uint64_t(json_number(line, "output_frame")),
                        std::uint64_t(json_number(line, "sequence")),
-                       json_number(line, "exposure_mid_ns"), json_number(line, "focus_m"),
+                       json_number(line, "exposure_mid_ns"), json_number(line, "delivered_ns"),
+                       json_number(line, "focus_m"),
                        line.find("\"lens_fresh\":true") != std::string::npos});
   }
   return records;

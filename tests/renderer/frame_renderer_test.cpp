@@ -291,6 +291,42 @@ TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
   EXPECT_NE(r.detail.find("output"), std::string::npos) << r.detail;
 }
 
+// A virtual ball's shadow on a real floor whose camera pixels are darker
+// than the proxy predicts (a near-black plate): I_c + I_m - I_r < 0 there,
+// which limited range would carry as luma codes under 16 (reserved in SDI).
+// The composite stops at black: the shadow reaches code 16 and no lower,
+// and the camera pixels outside it pass through untouched.
+TEST_P(FramePassThrough, AVirtualShadowStopsAtBlack) {
+  const int w = 64, h = 48;
+  Scene scene = real_only(w, h);
+  scene.objects.push_back(test::sphere("ball", {-0.3f, -0.1f, -2.5f}, 0.35f, 0, false));
+  auto renderer = make_renderer(GetParam(), scene);
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
+  const VideoFormat f = format(PixelFormat::yuyv, w, h);
+  std::vector<std::uint8_t> plate(base::frame_bytes(f));
+  for (std::size_t i = 0; i < plate.size(); i += 2) {
+    plate[i] = 18;      // luma: just above black
+    plate[i + 1] = 128; // neutral chroma
+  }
+  std::vector<std::uint8_t> out(plate.size());
+  const VideoBuffer target{f, out};
+  FrameRequest request;
+  request.camera = scene_camera(scene);
+  request.rays_per_pixel = 16;
+  ASSERT_EQ(renderer->render(request, {f, plate}, std::span(&target, 1)).status, FrameStatus::ok);
+  int darkest = 255;
+  std::size_t shadowed = 0, unchanged = 0;
+  for (std::size_t i = 0; i < out.size(); i += 2) {
+    darkest = std::min<int>(darkest, out[i]);
+    shadowed += out[i] == 16;
+    unchanged += out[i] == 18;
+  }
+  EXPECT_EQ(darkest, 16) << "the shadow takes the floor to black, and not below";
+  EXPECT_GT(shadowed, 20u) << "a shadow of some size";
+  EXPECT_GT(unchanged, out.size() / 4) << "the floor away from the ball passes through";
+}
+
 INSTANTIATE_TEST_SUITE_P(Executors, FramePassThrough,
                          ::testing::Values(Executor::cpu, Executor::gpu),
                          [](const auto &param_info) {

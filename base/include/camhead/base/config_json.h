@@ -8,7 +8,8 @@
 // (shared/reference/blender_scene.py) uses: NaN, Infinity, -Infinity and
 // number literals beyond the double range are read, and then refused as "must
 // be a finite number" on their field; objects keep their members in file
-// order; with a duplicate key the first position and the last value count.
+// order. Unlike Python's json, a key given twice in one object is an error on
+// its field (Python keeps the last value without a word).
 // A syntax error is reported on the field "(JSON)" with its line and column.
 //
 // Values are only looked at, never converted implicitly: nlohmann's own
@@ -84,7 +85,8 @@ public:
   // "must be an array of N finite numbers", then "components must be " +
   // range.describe().
   [[nodiscard]] std::vector<double> numbers(std::size_t n, const Range &range = {}) const;
-  // A non-empty string naming a file; a relative one is taken relative to
+  // A non-empty string naming a file, without a NUL or another control
+  // character (path_text.h); a relative one is taken relative to
   // the folder of the file it is written in, made absolute so that it does
   // not depend on the working directory when it is opened later.
   [[nodiscard]] std::filesystem::path path() const;

@@ -10,6 +10,7 @@
 #include <ctime>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <string_view>
 #include <system_error>
 
@@ -50,11 +51,10 @@ public:
     try {
       return next_frame(timeout, out);
     } catch (const std::exception &e) { // std::bad_alloc from a message, at worst
-      finish(name() + ": " + e.what(), true);
+      return broke(name() + ": " + e.what());
     } catch (...) {
-      finish(name() + ": unknown error", true);
+      return broke(name() + ": unknown error");
     }
-    return CaptureResult::ended;
   }
 
   void release(const CapturedFrame &frame) override { ring_.release(frame.buffer, frame.sequence); }
@@ -67,7 +67,13 @@ public:
 private:
   CaptureResult next_frame(std::chrono::milliseconds timeout, CapturedFrame &out);
   FrameReader::Read read_looping(std::span<std::uint8_t> frame, std::string &error);
-  void finish(std::string detail, bool error);
+  // A frame that cannot be read: `failed` for a file played once, else
+  // `disconnected` until the retry (file_camera.h).
+  CaptureResult broke(const std::string &error);
+  // A broken looping file: waits until the retry is due (or `deadline`),
+  // then goes back to the first frame; true once it plays again.
+  bool retry(std::int64_t deadline);
+  void set_detail(std::string detail);
 
   const std::string source_;
   const std::unique_ptr<FrameReader> reader_;
@@ -78,7 +84,9 @@ private:
   BufferRing ring_;
 
   // The capture thread's own.
-  bool ended_ = false;
+  bool ended_ = false;  // no frame follows: played once to its end, or failed
+  bool failed_ = false; // ended by an error
+  std::optional<std::int64_t> retry_at_ns_;
   bool started_ = false;
   std::int64_t first_ns_ = 0;    // the first frame's stamp
   std::int64_t next_due_ns_ = 0; // realtime: when the next frame goes out
@@ -95,7 +103,9 @@ CaptureResult FileCamera::next_frame(std::chrono::milliseconds timeout, Captured
       base::monotonic_ns() +
       std::chrono::nanoseconds(std::max(timeout, std::chrono::milliseconds::zero())).count();
   if (ended_)
-    return CaptureResult::ended;
+    return failed_ ? CaptureResult::failed : CaptureResult::ended;
+  if (retry_at_ns_ && !retry(deadline))
+    return CaptureResult::disconnected;
   const int index = ring_.wait_free(deadline);
   if (index < 0)
     return CaptureResult::timeout;
@@ -114,12 +124,15 @@ CaptureResult FileCamera::next_frame(std::chrono::milliseconds timeout, Captured
   switch (read_looping(ring_.bytes(index), error)) {
   case FrameReader::Read::frame:
     break;
-  case FrameReader::Read::end:
-    finish(name() + ": ended after " + std::to_string(sequence_) + " frames", false);
+  case FrameReader::Read::end: {
+    ended_ = true;
+    const std::lock_guard lock(status_mutex_);
+    status_.connected = false;
+    status_.detail = name() + ": ended after " + std::to_string(sequence_) + " frames";
     return CaptureResult::ended;
+  }
   case FrameReader::Read::error:
-    finish(error, true);
-    return CaptureResult::ended;
+    return broke(error);
   }
   // Read first, then wait: the frame leaves when it is due, not a decode later.
   if (realtime_)
@@ -132,9 +145,11 @@ CaptureResult FileCamera::next_frame(std::chrono::milliseconds timeout, Captured
   out.format = format_;
   out.bytes = ring_.bytes(index);
   out.sequence = sequence_;
+  // In real time a frame is delivered as its exposure ends, as a camera's;
+  // offline, on an exact clock from the first.
   out.timestamp_ns =
       realtime_ ? now : first_ns_ + static_cast<std::int64_t>(sequence_) * interval_ns_;
-  out.mark = TimestampMark::start_of_exposure;
+  out.mark = realtime_ ? TimestampMark::end_of_frame : TimestampMark::start_of_exposure;
   out.exposure_ns = interval_ns_;
   out.buffer = index;
   ring_.hold(index, sequence_);
@@ -163,10 +178,7 @@ FrameReader::Read FileCamera::read_looping(std::span<std::uint8_t> frame, std::s
     return FrameReader::Read::error;
   frames_in_pass_ = 0;
   ++loops_;
-  {
-    const std::lock_guard lock(status_mutex_);
-    status_.detail = name() + ": playing, loop " + std::to_string(loops_ + 1);
-  }
+  set_detail(name() + ": playing, loop " + std::to_string(loops_ + 1));
   read = reader_->read(frame, error);
   if (read == FrameReader::Read::frame)
     ++frames_in_pass_;
@@ -177,12 +189,46 @@ FrameReader::Read FileCamera::read_looping(std::span<std::uint8_t> frame, std::s
   return read;
 }
 
-void FileCamera::finish(std::string detail, bool error) {
-  ended_ = true;
-  const std::lock_guard lock(status_mutex_);
-  status_.connected = false;
-  if (error)
+CaptureResult FileCamera::broke(const std::string &error) {
+  {
+    const std::lock_guard lock(status_mutex_);
+    status_.connected = false;
     ++status_.errors;
+    status_.detail = error;
+    if (loop_)
+      status_.detail += "; playing again from the first frame in " +
+                        std::to_string(kFileCameraRetryAfter.count()) + " ms";
+  }
+  if (!loop_) {
+    ended_ = failed_ = true;
+    return CaptureResult::failed;
+  }
+  retry_at_ns_ = base::monotonic_ns() + std::chrono::nanoseconds(kFileCameraRetryAfter).count();
+  return CaptureResult::disconnected;
+}
+
+bool FileCamera::retry(std::int64_t deadline) {
+  if (base::monotonic_ns() < *retry_at_ns_) {
+    sleep_until(std::min(deadline, *retry_at_ns_));
+    if (base::monotonic_ns() < *retry_at_ns_)
+      return false;
+  }
+  std::string error;
+  if (!reader_->rewind(error)) {
+    (void)broke(error);
+    return false;
+  }
+  retry_at_ns_.reset();
+  frames_in_pass_ = 0;
+  const std::lock_guard lock(status_mutex_);
+  status_.connected = true;
+  ++status_.reconnects;
+  status_.detail = name() + ": playing again from the first frame";
+  return true;
+}
+
+void FileCamera::set_detail(std::string detail) {
+  const std::lock_guard lock(status_mutex_);
   status_.detail = std::move(detail);
 }
 

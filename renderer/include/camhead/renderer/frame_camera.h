@@ -33,6 +33,13 @@ struct FrameCamera {
   float entrance_pupil_offset_m = 0.0f;
 };
 
+// Whether `up` gives the view from `position` to `look_at` no orientation:
+// parallel to it (within 1e-6 of the unit vectors' cross product), zero, or
+// the view itself of zero length, in the float32 the tracer builds its frame
+// in (make_frame_params() would divide by zero and render nothing). The
+// scene reader and the board reader both refuse such a camera.
+[[nodiscard]] bool view_has_no_orientation(glm::vec3 position, glm::vec3 look_at, glm::vec3 up);
+
 // The scene file's camera: pupil at its position, no breathing.
 [[nodiscard]] FrameCamera scene_camera(const Scene &scene);
 

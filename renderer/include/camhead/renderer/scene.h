@@ -89,7 +89,8 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Object> objects;
   std::vector<Light> lights;
-  std::optional<Image> plate; // the camera image I_c, linear RGB
+  std::optional<Image> plate;       // the camera image I_c, linear RGB
+  std::filesystem::path plate_file; // where the plate was read from, if any
 };
 
 } // namespace camhead::renderer

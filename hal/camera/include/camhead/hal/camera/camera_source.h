@@ -51,6 +51,8 @@ enum class CaptureResult {
   timeout,      // nothing within the timeout
   disconnected, // the camera is gone; later calls try to take it up again
   ended,        // a file played once is over
+  failed,       // a file played once broke off (a frame that cannot be read); status().detail
+                // names the file and frame; no frame follows
 };
 
 // Health of a camera, for the status line, statistics and logs.

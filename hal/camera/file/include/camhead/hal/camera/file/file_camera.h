@@ -16,19 +16,24 @@
 // Errors: open_file_camera throws FileCameraError ("FILE: FIELD: REASON")
 // for anything it can see at open: an unreadable file, a bad header, a
 // first frame that is missing or short. Once open, nothing throws: a frame
-// that is short or garbled ends the stream (`ended`, connected false,
-// errors 1) and status().detail says which file and frame, as
-// "take.y4m:frame 12: truncated: 8192 of 622080 bytes".
+// that is short or garbled (or a PNG of another size) is an error that
+// status().detail names by file and frame, as
+// "take.y4m:frame 12: truncated: 8192 of 622080 bytes", counted in errors.
+// A file played once then `failed`: its take is not whole. A looping file
+// stands in for a live camera, and goes as a live one that lost its signal
+// does: `disconnected` while it waits kRetryAfter, then it plays again from
+// the first frame (a reconnect), and so on for as long as it fails.
 //
 // Timing: the rate is FileCameraOptions::fps, or else the Y4M's F, or 25
 // for PNGs. With `realtime`, frame i+1 is delivered one interval after frame
-// i was due, stamped with CLOCK_MONOTONIC when it is delivered; a consumer
-// more than a frame behind restarts the schedule rather than getting a burst
-// (a file never drops frames). Without `realtime`, frames come as fast as
-// they are asked for and stamps are the first delivery's time plus exactly
-// sequence * interval, so that offline runs are reproducible. A file says
-// nothing about exposure: each frame is taken as exposed for a whole
-// interval from its stamp (mark start_of_exposure, exposure_ns = interval).
+// i was due, as a camera delivers a frame once its exposure is over: stamped
+// with CLOCK_MONOTONIC when it is delivered, as the end of an exposure of a
+// whole interval (mark end_of_frame), so that its mid-exposure is half a
+// frame in the past, as the lens chain has it. A consumer more than a frame
+// behind restarts the schedule rather than getting a burst (a file never
+// drops frames). Without `realtime`, frames come as fast as they are asked
+// for and stamps are the first delivery's time plus exactly sequence *
+// interval (mark start_of_exposure), so that offline runs are reproducible.
 // sequence counts every delivered frame from 0, across loops.
 //
 // Buffers: three, allocated at open. A caller holding all three gets
@@ -41,6 +46,7 @@
 // status from any).
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -66,6 +72,10 @@ public:
 };
 
 inline constexpr int kFileCameraBuffers = 3;
+
+// How long a looping file camera whose frame failed waits before it plays
+// again from the first frame.
+inline constexpr std::chrono::milliseconds kFileCameraRetryAfter{1000};
 
 [[nodiscard]] std::unique_ptr<CameraSource> open_file_camera(const FileCameraOptions &options);
 

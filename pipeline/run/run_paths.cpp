@@ -1,0 +1,150 @@
+#include "run_paths.h"
+
+#include <optional>
+#include <system_error>
+#include <variant>
+
+#include <sys/stat.h>
+
+#include "camhead/hal/video_file/frame_pattern.h"
+
+namespace camhead::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+
+// What a path is on this machine, as far as it can be told now.
+struct Identity {
+  std::optional<struct stat> node; // it exists: stat() after following links
+  fs::path canonical;              // absolute, links resolved as far as they exist
+};
+
+Identity identity_of(const fs::path &path) {
+  Identity id;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0)
+    id.node = st;
+  std::error_code error;
+  id.canonical = fs::weakly_canonical(path, error);
+  if (error)
+    id.canonical = fs::absolute(path, error).lexically_normal();
+  return id;
+}
+
+bool same(const Identity &a, const Identity &b) {
+  if (a.node && b.node) {
+    // Two device nodes for one device (a by-id link is followed already;
+    // a second node made by hand is not).
+    if (S_ISCHR(a.node->st_mode) && S_ISCHR(b.node->st_mode))
+      return a.node->st_rdev == b.node->st_rdev;
+    return a.node->st_dev == b.node->st_dev && a.node->st_ino == b.node->st_ino;
+  }
+  return a.canonical == b.canonical;
+}
+
+// The folder a PNG sequence's frames are in: the pattern's, or the folder
+// named.
+fs::path sequence_folder(const fs::path &path) {
+  std::error_code error;
+  if (!hal::video_file::FramePattern::is_pattern(path.string()) && fs::is_directory(path, error))
+    return path;
+  const fs::path parent = path.parent_path();
+  return parent.empty() ? fs::path(".") : parent;
+}
+
+bool is_png(const fs::path &path) {
+  std::string ext = path.extension().string();
+  for (char &c : ext)
+    c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".png";
+}
+
+void check_written(const RunPath &w, const std::vector<RunPath> &paths, std::size_t index) {
+  const Identity target = identity_of(w.path);
+  const std::optional<Identity> folder =
+      w.sequence ? std::optional(identity_of(sequence_folder(w.path))) : std::nullopt;
+  for (std::size_t j = 0; j < paths.size(); ++j) {
+    if (j == index)
+      continue;
+    const RunPath &other = paths[j];
+    // Each pair of written paths once: the later one is the one refused.
+    if (other.written && j > index)
+      continue;
+    if (folder) {
+      const bool inside = other.sequence ? same(*folder, identity_of(sequence_folder(other.path)))
+                                         : is_png(other.path) &&
+                                               same(*folder, identity_of(other.path.parent_path()));
+      if (inside && other.written)
+        throw RunPathError(w.role + ": writes its frames into " + folder->canonical.string() +
+                           " as " + other.role + " does; give each sequence a folder of its own");
+      if (inside)
+        throw RunPathError(w.role + ": writes its frames into " + folder->canonical.string() +
+                           ", which holds " + other.role + " (" + other.path.string() +
+                           ") that this run reads; give the sequence a folder of its own");
+      continue;
+    }
+    if (other.sequence || !same(target, identity_of(other.path)))
+      continue;
+    if (other.written)
+      throw RunPathError(w.role + ": writes to " + w.path.string() + " as " + other.role +
+                         " does; give each output its own file or device");
+    throw RunPathError(
+        w.role + ": writes to " + w.path.string() + ", which is " + other.role +
+        " that this run reads; writing there would destroy it: write somewhere else");
+  }
+}
+
+} // namespace
+
+std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene) {
+  std::vector<RunPath> inputs;
+  const auto add = [&](std::string role, const fs::path &path, bool sequence = false) {
+    inputs.push_back({std::move(role), path, false, sequence});
+  };
+  add("the board", board.file);
+  add("the scene", scene.source);
+  if (!scene.plate_file.empty())
+    add("the scene's plate", scene.plate_file);
+  for (const renderer::Object &object : scene.objects)
+    if (!object.mesh_file.empty())
+      add("the scene's mesh \"" + object.name + "\"", object.mesh_file);
+  if (board.lens.profile)
+    add("the lens profile", *board.lens.profile);
+  for (const LensSourceConfig &source : board.lens.sources) {
+    const std::string role = "lens source \"" + source.name + "\"'s trace";
+    if (const auto *trace = std::get_if<TraceSourceConfig>(&source.kind))
+      add(role, trace->file);
+    else if (const auto *usb = std::get_if<UsbSourceConfig>(&source.kind); usb && usb->simulate)
+      add(role, *usb->simulate);
+    else if (const auto *gpio = std::get_if<GpioSourceConfig>(&source.kind); gpio && gpio->simulate)
+      add(role, *gpio->simulate);
+  }
+  if (board.camera) {
+    if (const auto *file = std::get_if<FileCameraConfig>(&board.camera->kind)) {
+      std::error_code error;
+      const bool sequence = hal::video_file::FramePattern::is_pattern(file->path.string()) ||
+                            fs::is_directory(file->path, error);
+      add("the camera's take", file->path, sequence);
+    } else if (const auto *v4l2 = std::get_if<V4l2CameraConfig>(&board.camera->kind)) {
+      add("the camera", v4l2->device);
+    }
+  }
+  return inputs;
+}
+
+std::vector<RunPath> run_outputs(const std::vector<OutputSpec> &outputs) {
+  std::vector<RunPath> paths;
+  for (const OutputSpec &spec : outputs)
+    if (spec.kind == OutputKind::y4m || spec.kind == OutputKind::v4l2 ||
+        spec.kind == OutputKind::png)
+      paths.push_back({spec.uri, spec.target, true, spec.kind == OutputKind::png});
+  return paths;
+}
+
+void check_run_paths(const std::vector<RunPath> &paths) {
+  for (std::size_t i = 0; i < paths.size(); ++i)
+    if (paths[i].written)
+      check_written(paths[i], paths, i);
+}
+
+} // namespace camhead::pipeline

@@ -1,0 +1,53 @@
+// Every file and device a run reads or writes, in one place, checked against
+// each other by their real identity before anything is opened for writing.
+// An output or the statistics file that is one of the run's inputs would
+// destroy it: `file:take.y4m` with a file camera playing take.y4m replaces
+// the take when the run ends, `--record-stats take.y4m` empties it at once,
+// a loopback device that is both the camera and an output feeds itself.
+// Two outputs on one file or device would interleave their frames.
+//
+// Identity is the device and inode after following links, for what exists;
+// for what a run will create, the path made absolute with its links
+// resolved (std::filesystem::weakly_canonical). A PNG sequence is its
+// folder: no input may lie in the folder an output sequence writes to (the
+// camera's own frames, a plate), since its numbered names cannot be told
+// from theirs.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "board.h"
+#include "camhead/renderer/scene.h"
+#include "output_uri.h"
+
+namespace camhead::pipeline {
+
+// A run's files that clash; what() names both and what they are.
+class RunPathError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+struct RunPath {
+  std::string role;           // "the camera", "--record-stats", "output file:x.y4m", ...
+  std::filesystem::path path; // a file, a device node, or a PNG sequence's pattern
+  bool written = false;       // an output or the statistics file
+  bool sequence = false;      // a PNG sequence (pattern or folder): its folder counts
+};
+
+// The files and devices a board's run reads: the board itself, its scene and
+// the scene's meshes and plate, the lens profile and traces, the camera's
+// file or device.
+[[nodiscard]] std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene);
+
+// The outputs that are files or devices (null and DRM cards are neither).
+[[nodiscard]] std::vector<RunPath> run_outputs(const std::vector<OutputSpec> &outputs);
+
+// Throws RunPathError on the first written path that is another path of the
+// run, or holds one (a sequence's folder).
+void check_run_paths(const std::vector<RunPath> &paths);
+
+} // namespace camhead::pipeline
