@@ -12,6 +12,8 @@
 #include <system_error>
 #include <vector>
 
+#include <glm/geometric.hpp>
+
 #include "camhead/base/config_json.h"
 #include "camhead/base/path_text.h"
 #include "camhead/renderer/frame_camera.h"
@@ -218,13 +220,15 @@ private:
       if (pose.up == std::array<double, 3>{})
         d.at("up").fail("must not be zero");
     }
-    // As the tracer sees the pose: in float32 (renderer/frame_camera.h).
-    const auto f = [](const std::array<double, 3> &a) {
-      return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
-    };
-    if (f(pose.position) == f(pose.look_at))
-      d.at("look_at").fail("equals position (in the float32 the renderer works in)");
-    if (renderer::view_has_no_orientation(f(pose.position), f(pose.look_at), f(pose.up))) {
+    const PoseVectors v = pose_vectors(pose);
+    switch (renderer::view_problem(v.position, v.look_at, v.up)) {
+    case renderer::ViewProblem::none:
+      break;
+    case renderer::ViewProblem::no_direction:
+      d.at("look_at").fail(v.position == v.look_at
+                               ? "equals position (in the float32 the renderer works in)"
+                               : "too close to position for the float32 the renderer works in");
+    case renderer::ViewProblem::no_orientation:
       if (d.has("up"))
         d.at("up").fail("parallel to the view from position to look_at");
       // A rig looking straight down at a table, or up at a ceiling.
@@ -390,6 +394,16 @@ private:
 };
 
 } // namespace
+
+PoseVectors pose_vectors(const PoseConfig &pose) {
+  const auto f = [](const std::array<double, 3> &a) {
+    return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
+  };
+  const glm::dvec3 up(pose.up[0], pose.up[1], pose.up[2]);
+  const double length = glm::length(up);
+  return {f(pose.position), f(pose.look_at),
+          length > 0.0 ? glm::vec3(up / length) : glm::vec3(0.0f)};
+}
 
 std::filesystem::path resolve_board(std::string_view name_or_path) {
   const std::string s(name_or_path);

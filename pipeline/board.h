@@ -29,6 +29,8 @@
 #include <variant>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "camhead/base/config_error.h"
 #include "camhead/base/video_format.h"
 
@@ -164,6 +166,15 @@ struct PoseConfig {
   std::array<double, 3> look_at{0.0, 0.0, -1.0};
   std::array<double, 3> up{0.0, 1.0, 0.0};
 };
+
+// The pose as the renderer takes it: float32, `up` made of unit length
+// first (in double, so that a tiny one keeps its direction). The board
+// reader refuses a pose whose vectors give the renderer no view
+// (renderer/frame_camera.h).
+struct PoseVectors {
+  glm::vec3 position, look_at, up;
+};
+[[nodiscard]] PoseVectors pose_vectors(const PoseConfig &pose);
 
 enum class Executor { automatic, cpu, gpu };
 

@@ -19,6 +19,7 @@
 #include "camhead/lens_control/calibration.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "commands.h"
+#include "run/run_paths.h"
 
 namespace camhead::cli {
 namespace {
@@ -50,7 +51,8 @@ constexpr const char *kFormatHelp = R"(Measurements CSV:
   (measurement noise) are pooled by an isotonic fit. The residual report goes
   to stdout. Example: scenes/lenses/example_35mm_measurements.csv
 
-Exit status: 0 profile written; 2 bad measurements or too few points;
+Exit status: 0 profile written; 2 bad measurements, too few points, or -o
+naming the measurements file;
 3 the fitted profile does not load (nothing written); 4 the output cannot be
 written; 1 any other error.
 )";
@@ -68,6 +70,14 @@ int run_calibrate(const CalibrateArgs &args) {
   if (fs::is_directory(output)) {
     std::fprintf(stderr, "output %s: is a folder; give a file name\n", args.output.c_str());
     return 4;
+  }
+  try {
+    // The profile written over its own measurements would destroy them.
+    pipeline::check_run_paths({{"the measurements", args.measurements, false, false},
+                               {"-o " + args.output, output, true, false}});
+  } catch (const pipeline::RunPathError &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
   }
   try {
     const MeasurementSet measurements = read_measurements(args.measurements);

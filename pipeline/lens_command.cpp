@@ -27,6 +27,7 @@
 #include "camhead/lens_control/lens_profile.h"
 #include "commands.h"
 #include "lens_sources.h"
+#include "run/run_paths.h"
 
 namespace camhead::cli {
 namespace {
@@ -231,6 +232,17 @@ void record(const LensArgs &args) {
     return;
   }
   try {
+    // The trace written over one the board reads (its replay, its profile)
+    // would destroy it.
+    std::vector<pipeline::RunPath> paths = pipeline::run_inputs(*board, renderer::Scene{});
+    paths.push_back({"-o " + args.output, args.output, true, false});
+    pipeline::check_run_paths(paths);
+  } catch (const pipeline::RunPathError &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    set_exit_code(2);
+    return;
+  }
+  try {
     // Every input first: nothing is opened for writing before the profile
     // and the source have been checked.
     auto profile = pipeline::load_board_profile(*board);
@@ -267,7 +279,7 @@ void add_common(CLI::App *cmd, LensArgs &args) {
       ->capture_default_str()
       ->check(path_text());
   cmd->add_option("--duration", args.duration_s, "Stop after this many seconds (0: at Ctrl-C)")
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(finite_within(0.0, 1e6))
       ->capture_default_str();
 }
 

@@ -19,6 +19,7 @@
 #include "camhead/renderer/scene_loader.h"
 #include "commands.h"
 #include "progress.h"
+#include "run/run_paths.h"
 
 namespace camhead::cli {
 namespace {
@@ -98,6 +99,10 @@ int run_render(const RenderArgs &args) {
   }
   try {
     Scene scene = load_scene(args.scene);
+    // An image written over the scene's own plate or a mesh would destroy it.
+    std::vector<pipeline::RunPath> paths = pipeline::scene_inputs(scene);
+    paths.push_back({"-o " + args.output, args.output, true, false});
+    pipeline::check_run_paths(paths);
     if (args.seed) {
       scene.render.seed = *args.seed;
     }
@@ -149,6 +154,9 @@ int run_render(const RenderArgs &args) {
     return 0;
   } catch (const SceneError &e) {
     std::fprintf(stderr, "scene error: %s\n", e.what());
+    return 2;
+  } catch (const pipeline::RunPathError &e) {
+    std::fprintf(stderr, "%s\n", e.what());
     return 2;
   } catch (const GpuError &e) {
     std::fprintf(stderr, "Vulkan error: %s\n(--cpu renders with the CPU reference instead)\n",

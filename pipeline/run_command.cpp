@@ -49,9 +49,11 @@ extern "C" void on_stop_signal(int signal) {
 }
 
 // The summary, a line for the run and one for each output, and the exit
-// status (docs/input-errors.md): 4 when a file output lost frames or could
-// not be completed (a full disk, a size limit), 5 when a device or stream
-// failed (the camera's take broke off, a webcam or display output failed).
+// status (docs/input-errors.md): 3 when frames could not be rendered (the
+// GPU failed), 4 when a file output lost frames or could not be completed
+// (a full disk, a size limit), 5 when a device or stream failed (the
+// camera's take broke off, a webcam or display output failed); where more
+// than one applies, the smallest, and every cause is said.
 int report(const pipeline::RunSummary &s) {
   std::fprintf(stderr,
                "camhead run: %llu frames in, %llu out in %.1f s (%.1f fps out); dropped: "
@@ -78,6 +80,13 @@ int report(const pipeline::RunSummary &s) {
     std::fprintf(stderr, "camhead run: the camera failed: %s\n", s.camera_failure.c_str());
   if (!s.stats_failure.empty())
     std::fprintf(stderr, "camhead run: %s\n", s.stats_failure.c_str());
+  if (s.render_failed > 0)
+    std::fprintf(stderr, "camhead run: %llu frames could not be rendered%s; the first: %s\n",
+                 (unsigned long long)s.render_failed,
+                 s.offline ? " (the take composited offline is short of them)" : "",
+                 s.render_failure.c_str());
+  if (s.render_failed > 0)
+    return 3;
   if (file_failed || !s.stats_failure.empty())
     return 4;
   return device_failed ? 5 : 0;

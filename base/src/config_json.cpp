@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <unordered_set>
 
 #include "camhead/base/path_text.h"
 #include "config_words.h"
@@ -122,10 +123,9 @@ public:
     case Event::key: {
       Level &level = stack_.back();
       const std::string key = parsed.get<std::string>();
-      if (std::find(level.keys.begin(), level.keys.end(), key) != level.keys.end())
+      if (!level.keys.insert(key).second)
         throw ConfigError(file_, child(field(stack_.size() - 1), key),
                           "given twice in one object; only one would count: give it once");
-      level.keys.push_back(key);
       level.key = key;
       break;
     }
@@ -145,8 +145,8 @@ private:
   struct Level {
     bool array;
     std::size_t index;
-    std::string key;               // an object's current member
-    std::vector<std::string> keys; // an object's members so far
+    std::string key;                      // an object's current member
+    std::unordered_set<std::string> keys; // an object's members so far
   };
 
   void next_element() {

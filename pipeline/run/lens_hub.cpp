@@ -1,17 +1,23 @@
 #include "lens_hub.h"
 
 #include <chrono>
+#include <cmath>
+#include <optional>
 
 namespace camhead::pipeline {
 
 LensHub::LensHub(const Board &board)
-    : channels_(open_lens_channels(board)), connected_(channels_.size(), false) {
-  thread_ = std::thread([this] { poll_loop(); });
+    : channels_(open_lens_channels(board)), connected_(channels_.size(), false) {}
+
+void LensHub::start() {
+  if (!thread_.joinable())
+    thread_ = std::thread([this] { poll_loop(); });
 }
 
 LensHub::~LensHub() {
   stop_ = true;
-  thread_.join();
+  if (thread_.joinable())
+    thread_.join();
 }
 
 void LensHub::poll_loop() {
@@ -28,7 +34,7 @@ void LensHub::poll_loop() {
       channel.feed();
       connected_[i] = connected;
     }
-    started_ = true;
+    polled_ = true;
   }
 }
 
@@ -39,6 +45,10 @@ LensSnapshot LensHub::state_at(std::int64_t t_ns) const {
   snapshot.state = lens.state_at(t_ns);
   snapshot.connected = connected_.front();
   snapshot.fresh = snapshot.connected && snapshot.state.all_fresh();
+  // The newest reading, moved to physical time by the source's delay.
+  const std::optional<hal::lens::EncoderReading> &last = lens.last_reading();
+  const auto delay_ns = std::llround(lens.config().delay_ms * 1e6);
+  snapshot.awaited = (snapshot.connected || !polled_) && (!last || last->t_ns - delay_ns < t_ns);
   return snapshot;
 }
 

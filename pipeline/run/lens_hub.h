@@ -22,13 +22,19 @@ struct LensSnapshot {
   lens_control::LensState state;
   bool connected = false; // the source is there and delivering
   bool fresh = false;     // connected and every axis current at that instant
+  // The readings that would cover that instant may still come: the source
+  // is delivering (or not yet polled) and has no reading at or after it.
+  // Not so for an instant before its history or inside a dropout.
+  bool awaited = false;
 };
 
 class LensHub {
 public:
-  // Opens the board's sources (throws as open_lens_channels does) and starts
-  // polling them.
+  // Opens the board's sources (throws as open_lens_channels does).
   explicit LensHub(const Board &board);
+  // Starts polling them, once; a trace played from the rig's start starts
+  // here, so that a run starts it once everything else stands.
+  void start();
   ~LensHub();
   LensHub(const LensHub &) = delete;
   LensHub &operator=(const LensHub &) = delete;
@@ -36,10 +42,6 @@ public:
   // The lens at CLOCK_MONOTONIC instant t_ns: a lost source holds its last
   // state, flagged not fresh.
   [[nodiscard]] LensSnapshot state_at(std::int64_t t_ns) const;
-  // Whether every source has been polled once, and what it had handed to
-  // its tracker (a frame before that finds no reading that is not yet
-  // there).
-  [[nodiscard]] bool started() const { return started_; }
   // "focus pull [trace ...]" for the status line.
   [[nodiscard]] std::string source_name() const;
 
@@ -52,7 +54,7 @@ private:
   std::vector<LensChannel> channels_;
   std::vector<bool> connected_; // each source's status().connected after its last poll
   std::atomic<bool> stop_{false};
-  std::atomic<bool> started_{false};
+  std::atomic<bool> polled_{false}; // every source polled once
   std::thread thread_;
 };
 

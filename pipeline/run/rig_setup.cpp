@@ -215,12 +215,10 @@ renderer::Scene load_run_scene(const Board &board) {
 renderer::FrameCamera base_camera(const Board &board, const renderer::Scene &scene) {
   renderer::FrameCamera camera = renderer::scene_camera(scene);
   if (board.pose) {
-    const auto v = [](const std::array<double, 3> &a) {
-      return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
-    };
-    camera.position = v(board.pose->position);
-    camera.look_at = v(board.pose->look_at);
-    camera.up = v(board.pose->up);
+    const PoseVectors v = pose_vectors(*board.pose);
+    camera.position = v.position;
+    camera.look_at = v.look_at;
+    camera.up = v.up;
   }
   camera.sensor_width_mm = float(board.camera->sensor_width_mm);
   return camera;
@@ -294,15 +292,14 @@ std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Sc
                                                .height = c.height,
                                                .buffers = libcamera->buffers});
   const auto &file = std::get<FileCameraConfig>(c.kind);
-  auto camera = hal::camera::open_file_camera(
-      {.path = file.path, .loop = file.loop, .realtime = file.realtime, .fps = 0.0});
-  const base::VideoFormat got = camera->format();
-  if (got.width != c.width || got.height != c.height)
-    throw std::runtime_error(board.file.string() + ": camera: " + file.path.string() + " is " +
-                             std::to_string(got.width) + "x" + std::to_string(got.height) +
-                             ", the board says " + std::to_string(c.width) + "x" +
-                             std::to_string(c.height));
-  return camera;
+  // The board's size is checked against the take's header before anything
+  // of the take's size is made.
+  return hal::camera::open_file_camera({.path = file.path,
+                                        .loop = file.loop,
+                                        .realtime = file.realtime,
+                                        .fps = 0.0,
+                                        .width = c.width,
+                                        .height = c.height});
 }
 
 std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width, int height,

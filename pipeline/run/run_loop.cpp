@@ -114,7 +114,9 @@ private:
   std::vector<std::vector<std::uint8_t>> last_frames_; // what each sink showed last
   std::vector<std::uint64_t> sink_errors_seen_;        // status thread: reported so far
   std::string camera_detail_seen_;                     // status thread: reported last
+  std::uint64_t camera_errors_seen_ = 0;               // status thread: reported so far
   std::string camera_failure_;                         // capture thread; read after it is joined
+  std::string render_failure_;                         // render thread: the first; after the join
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   Counters counters_;
@@ -196,6 +198,9 @@ Pipeline::Pipeline(const RunOptions &options)
     (void)free_slots_.push(i);
   if (const auto *file = std::get_if<FileCameraConfig>(&board_.camera->kind))
     lossless_ = !file->realtime;
+  // Last: a trace played from the rig's start starts with the run, not a
+  // set-up's time (a renderer's kernel compiles) before its first frame.
+  lens_.start();
 }
 
 Pipeline::~Pipeline() {
@@ -311,6 +316,8 @@ void Pipeline::render_loop() {
     camera_->release(frame);
     if (report.status != renderer::FrameStatus::ok) {
       ++counters_.render_failed;
+      if (render_failure_.empty())
+        render_failure_ = report.detail;
       if (report.status == renderer::FrameStatus::device_lost)
         counters_.renderer_lost = true;
       (void)free_slots_.push(*slot_index);
@@ -335,15 +342,16 @@ LensSnapshot Pipeline::lens_at(std::int64_t mid_exposure_ns, FrameRecord &record
   // delay, the lens thread's poll), and a run's first frame can come before
   // the first of them: then the state is the profile's rest state or an
   // extrapolation, a lens the rig never had. Such a frame waits for the
-  // readings, while they can still come: not for a source that is lost.
+  // readings that would cover it, while they can still come (`awaited`):
+  // not for a source that is lost, nor for an instant before its history
+  // or inside a dropout, which no wait mends.
   const std::int64_t start = base::monotonic_ns();
   const std::int64_t give_up =
       start + (lossless_ ? kOfflineLensWaitNs : std::llround(0.5e9 / fps_));
   // A stop asked for by the user ends the wait; a take played to its end
   // does not (its last frames still get their lens).
   const auto asked_to_stop = [this] { return options_.stop != nullptr && *options_.stop; };
-  while (!lens.fresh && (lens.connected || !lens_.started()) && !asked_to_stop() &&
-         base::monotonic_ns() < give_up) {
+  while (!lens.fresh && lens.awaited && !asked_to_stop() && base::monotonic_ns() < give_up) {
     std::this_thread::sleep_for(1ms);
     lens = lens_.state_at(mid_exposure_ns);
   }
@@ -475,11 +483,15 @@ void Pipeline::report_sink_errors(bool tty) {
   }
 }
 
-// A camera that is lost says why, once each time its word changes (a
-// take's frame that cannot be read, a device gone).
+// A camera that failed or went away says why: once for each new error (a
+// take's frame that cannot be read; the detail keeps it after the camera is
+// back), and once each time a lost camera's word changes (a device gone).
 void Pipeline::report_camera(bool tty) {
   const hal::camera::CameraStatus status = camera_->status();
-  if (status.connected || status.detail == camera_detail_seen_)
+  const bool new_error = status.errors != camera_errors_seen_;
+  const bool new_loss = !status.connected && status.detail != camera_detail_seen_;
+  camera_errors_seen_ = status.errors;
+  if (!new_error && !new_loss)
     return;
   camera_detail_seen_ = status.detail;
   std::fprintf(options_.status, "%scamhead run: camera: %s\n", tty ? "\r\033[K" : "",
@@ -495,13 +507,12 @@ void Pipeline::status_loop() {
                  executor_name_.c_str(), lens_.source_name().c_str());
   std::uint64_t last_in = 0, last_out = 0;
   std::int64_t last_ns = start_ns_;
-  // Awake often, so that a run ends as soon as its last frame is out, and
-  // a line a second (four on a terminal).
-  const std::int64_t every_ns = tty ? 250'000'000 : 1'000'000'000;
+  // Awake often, so that a run ends as soon as its last frame is out (it
+  // lingered up to a second), and a line a second.
   while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
     std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
-    if (options_.status == nullptr || now - last_ns < every_ns)
+    if (options_.status == nullptr || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
     report_camera(tty);
@@ -558,6 +569,8 @@ RunSummary Pipeline::finish() {
           options_.stats_file->string() + ": not all of the statistics were written (a full disk?)";
   }
   summary.camera_failure = camera_failure_;
+  summary.render_failure = render_failure_;
+  summary.offline = lossless_;
   summary.lens_late = counters_.lens_late;
   const hal::camera::CameraStatus cam = camera_->status();
   summary.frames_in = counters_.frames_in;

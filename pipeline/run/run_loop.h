@@ -81,6 +81,11 @@ struct RunSummary {
   std::string camera_failure;
   // Why the statistics file is not whole (a full disk); empty if it is.
   std::string stats_failure;
+  // The first frame that could not be rendered, and why; empty if none.
+  std::string render_failure;
+  // A take composited offline: every camera frame was to be composited, so a
+  // frame not rendered leaves it short.
+  bool offline = false;
   double seconds = 0.0;
   std::string executor;
 };

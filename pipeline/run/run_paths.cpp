@@ -59,42 +59,57 @@ bool is_png(const fs::path &path) {
   return ext == ".png";
 }
 
-void check_written(const RunPath &w, const std::vector<RunPath> &paths, std::size_t index) {
-  const Identity target = identity_of(w.path);
-  const std::optional<Identity> folder =
-      w.sequence ? std::optional(identity_of(sequence_folder(w.path))) : std::nullopt;
-  for (std::size_t j = 0; j < paths.size(); ++j) {
-    if (j == index)
-      continue;
-    const RunPath &other = paths[j];
-    // Each pair of written paths once: the later one is the one refused.
-    if (other.written && j > index)
-      continue;
-    if (folder) {
-      const bool inside = other.sequence ? same(*folder, identity_of(sequence_folder(other.path)))
-                                         : is_png(other.path) &&
-                                               same(*folder, identity_of(other.path.parent_path()));
-      if (inside && other.written)
-        throw RunPathError(w.role + ": writes its frames into " + folder->canonical.string() +
-                           " as " + other.role + " does; give each sequence a folder of its own");
-      if (inside)
-        throw RunPathError(w.role + ": writes its frames into " + folder->canonical.string() +
-                           ", which holds " + other.role + " (" + other.path.string() +
-                           ") that this run reads; give the sequence a folder of its own");
-      continue;
-    }
-    if (other.sequence || !same(target, identity_of(other.path)))
-      continue;
-    if (other.written)
-      throw RunPathError(w.role + ": writes to " + w.path.string() + " as " + other.role +
-                         " does; give each output its own file or device");
-    throw RunPathError(
-        w.role + ": writes to " + w.path.string() + ", which is " + other.role +
-        " that this run reads; writing there would destroy it: write somewhere else");
+// Whether `a` and `b` are one file, or one lies among the numbered frames
+// the other (a PNG sequence) reads or writes: in its folder, and a PNG.
+bool clash(const RunPath &a, const RunPath &b) {
+  if (a.sequence && b.sequence)
+    return same(identity_of(sequence_folder(a.path)), identity_of(sequence_folder(b.path)));
+  if (a.sequence || b.sequence) {
+    const RunPath &sequence = a.sequence ? a : b, &file = a.sequence ? b : a;
+    return is_png(file.path) &&
+           same(identity_of(sequence_folder(sequence.path)), identity_of(file.path.parent_path()));
   }
+  return same(identity_of(a.path), identity_of(b.path));
+}
+
+[[noreturn]] void refuse(const RunPath &written, const RunPath &other) {
+  const char *does = other.written ? "writes" : "reads";
+  if (written.sequence && other.sequence)
+    throw RunPathError(written.role + ": writes its frames into " +
+                       identity_of(sequence_folder(written.path)).canonical.string() + ", where " +
+                       other.role + " " + does +
+                       " its own; give each sequence a folder of its own");
+  if (written.sequence)
+    throw RunPathError(written.role + ": writes its frames into " +
+                       identity_of(sequence_folder(written.path)).canonical.string() +
+                       ", which holds " + other.role + " (" + other.path.string() +
+                       ") that this run " + does + "; give the sequence a folder of its own");
+  if (other.sequence)
+    throw RunPathError(written.role + ": writes " + written.path.string() + " among the frames " +
+                       other.role + " " + does + " (" + other.path.string() +
+                       "); write somewhere else");
+  if (other.written)
+    throw RunPathError(written.role + ": writes to " + written.path.string() + " as " + other.role +
+                       " does; give each output its own file or device");
+  throw RunPathError(written.role + ": writes to " + written.path.string() + ", which is " +
+                     other.role +
+                     " that this run reads; writing there would destroy it: write somewhere else");
 }
 
 } // namespace
+
+std::vector<RunPath> scene_inputs(const renderer::Scene &scene) {
+  std::vector<RunPath> inputs;
+  const auto add = [&](std::string role, const fs::path &path) {
+    if (!path.empty()) // a scene not loaded (the lens commands)
+      inputs.push_back({std::move(role), path, false, false});
+  };
+  add("the scene", scene.source);
+  add("the scene's plate", scene.plate_file);
+  for (const renderer::Object &object : scene.objects)
+    add("the scene's mesh \"" + object.name + "\"", object.mesh_file);
+  return inputs;
+}
 
 std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene) {
   std::vector<RunPath> inputs;
@@ -102,12 +117,8 @@ std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene
     inputs.push_back({std::move(role), path, false, sequence});
   };
   add("the board", board.file);
-  add("the scene", scene.source);
-  if (!scene.plate_file.empty())
-    add("the scene's plate", scene.plate_file);
-  for (const renderer::Object &object : scene.objects)
-    if (!object.mesh_file.empty())
-      add("the scene's mesh \"" + object.name + "\"", object.mesh_file);
+  for (RunPath &input : scene_inputs(scene))
+    inputs.push_back(std::move(input));
   if (board.lens.profile)
     add("the lens profile", *board.lens.profile);
   for (const LensSourceConfig &source : board.lens.sources) {
@@ -142,9 +153,14 @@ std::vector<RunPath> run_outputs(const std::vector<OutputSpec> &outputs) {
 }
 
 void check_run_paths(const std::vector<RunPath> &paths) {
-  for (std::size_t i = 0; i < paths.size(); ++i)
-    if (paths[i].written)
-      check_written(paths[i], paths, i);
+  // Every pair with a written path in it; of two written, the later is the
+  // one refused.
+  for (std::size_t j = 0; j < paths.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i) {
+      const RunPath &a = paths[i], &b = paths[j];
+      if ((a.written || b.written) && clash(a, b))
+        refuse(b.written ? b : a, b.written ? a : b);
+    }
 }
 
 } // namespace camhead::pipeline

@@ -9,9 +9,10 @@
 // Identity is the device and inode after following links, for what exists;
 // for what a run will create, the path made absolute with its links
 // resolved (std::filesystem::weakly_canonical). A PNG sequence is its
-// folder: no input may lie in the folder an output sequence writes to (the
-// camera's own frames, a plate), since its numbered names cannot be told
-// from theirs.
+// folder: no PNG the run reads or writes may lie in the folder of a
+// sequence it reads or writes (the camera's own frames, a plate, a PNG
+// named as the statistics file), since numbered names cannot be told from
+// theirs, and two sequences need two folders.
 #pragma once
 
 #include <filesystem>
@@ -38,16 +39,21 @@ struct RunPath {
   bool sequence = false;      // a PNG sequence (pattern or folder): its folder counts
 };
 
+// The files a scene was read from: the scene file, its plate and meshes
+// (none for a scene not loaded).
+[[nodiscard]] std::vector<RunPath> scene_inputs(const renderer::Scene &scene);
+
 // The files and devices a board's run reads: the board itself, its scene and
-// the scene's meshes and plate, the lens profile and traces, the camera's
-// file or device.
+// the scene's meshes and plate (none for a scene not loaded, as the lens
+// commands have), the lens profile and traces, the camera's file or device.
 [[nodiscard]] std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene);
 
 // The outputs that are files or devices (null and DRM cards are neither).
 [[nodiscard]] std::vector<RunPath> run_outputs(const std::vector<OutputSpec> &outputs);
 
 // Throws RunPathError on the first written path that is another path of the
-// run, or holds one (a sequence's folder).
+// run, or where one of them is a PNG sequence, a PNG in its folder (or
+// another sequence in that folder).
 void check_run_paths(const std::vector<RunPath> &paths);
 
 } // namespace camhead::pipeline

@@ -2,20 +2,33 @@
 // scene and board readers (and their fuzz targets) need nothing more.
 #include "camhead/renderer/frame_camera.h"
 
+#include <cmath>
+
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 namespace camhead::renderer {
+namespace {
 
-bool view_has_no_orientation(glm::vec3 position, glm::vec3 look_at, glm::vec3 up) {
+bool finite(glm::vec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+} // namespace
+
+ViewProblem view_problem(glm::vec3 position, glm::vec3 look_at, glm::vec3 up) {
+  // The camera's axes as make_frame_params() makes them.
+  const glm::vec3 forward = glm::normalize(look_at - position);
+  if (!finite(forward))
+    return ViewProblem::no_direction;
+  if (!finite(glm::normalize(glm::cross(forward, up))))
+    return ViewProblem::no_orientation;
   // The reference does this test on float32 vectors (Blender's mathutils),
   // so a direction that vanishes in float is parallel to anything.
-  const glm::dvec3 forward(look_at - position), u(up);
-  const auto normalized = [](glm::dvec3 v) {
-    const double length = glm::length(v);
-    return length > 0.0 ? v / length : v;
-  };
-  return glm::length(glm::cross(normalized(forward), normalized(u))) < 1e-6;
+  const glm::dvec3 d(look_at - position), u(up);
+  if (glm::length(glm::cross(d / glm::length(d), u / glm::length(u))) < 1e-6)
+    return ViewProblem::no_orientation;
+  return ViewProblem::none;
 }
 
 } // namespace camhead::renderer

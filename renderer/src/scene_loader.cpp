@@ -131,8 +131,15 @@ private:
     out.f_number = float(f_number);
     if (position == look_at)
       c.fail_member("look_at", "equals camera.position");
-    if (view_has_no_orientation(out.position, out.look_at, out.up))
+    switch (view_problem(out.position, out.look_at, out.up)) {
+    case ViewProblem::none:
+      break;
+    case ViewProblem::no_direction:
+      c.fail_member("look_at", "too close to camera.position for the float32 the renderer "
+                               "works in");
+    case ViewProblem::no_orientation:
       c.fail_member("up", "parallel to the viewing direction");
+    }
     if (f_number > 0.0 || c.has("focus_distance_m"))
       out.focus_distance_m = float(number(c.at("focus_distance_m"), Range::above(0.0, 1e6)));
     return out;

@@ -88,6 +88,20 @@ cmp -s take.y4m take.before || fail "a refused run changed the camera's take"
 expect 2 "writes to board.json, which is the board" \
   sh -c "cp take.json board.json && \"$camhead\" run --board board.json --output null --record-stats board.json"
 
+# The other commands that write what a board or the user reads: a lens
+# recording over the trace the board replays, a profile over its own
+# measurements.
+cp "$src/scenes/lenses/sim_focus_pull.csv" pull.csv
+cp "$src/scenes/lenses/example_35mm_measurements.csv" measurements.csv
+sed "s|$src/scenes/lenses/sim_focus_pull.csv|$tmp/pull.csv|" take.json >pull.json
+expect 2 "-o pull.csv: writes to pull.csv, which is lens source \"trace\"'s trace" \
+  "$camhead" lens record --board pull.json --duration 0.2 -o pull.csv
+cmp -s pull.csv "$src/scenes/lenses/sim_focus_pull.csv" || fail "lens record changed its trace"
+expect 2 "which is the measurements" \
+  "$camhead" calibrate measurements.csv --prime --name x -o measurements.csv
+cmp -s measurements.csv "$src/scenes/lenses/example_35mm_measurements.csv" ||
+  fail "calibrate changed its measurements"
+
 # A NUL in a path would open another file than the one named (./victim).
 board nul.json '{"type": "sim", "width": 64, "height": 48}' \
   ', "pose": {"position": [0, 1, 0], "look_at": [0, 1, -2]}'
@@ -130,6 +144,23 @@ grep -q "file limited.y4m: frames written 2, lost 8" out ||
   fail "a run under ulimit -f did not count what it wrote: $(cat out)"
 [ "$(grep -c FRAME limited.y4m)" -eq 2 ] || fail "limited.y4m does not hold its 2 whole frames"
 [ -e limited.y4m.partial ] && fail "a run under ulimit -f left limited.y4m.partial"
+
+# A full disk, the same: a 32 KiB tmpfs (the header and 5 frames) in a
+# mount namespace of its own, where root may make one; skipped elsewhere.
+mkdir small
+if unshare --mount sh -c "mount -t tmpfs -o size=32k tmpfs small" 2>/dev/null; then
+  unshare --mount sh -c "mount -t tmpfs -o size=32k tmpfs small &&
+    \"$camhead\" run --board take.json --output file:small/full.y4m >out 2>&1
+    echo \$? >status; grep -c FRAME small/full.y4m >frames; ls small >left"
+  [ "$(cat status)" -eq 4 ] || fail "a run on a full disk exited $(cat status): $(cat out)"
+  grep -q "No space left on device" out || fail "a run on a full disk did not say why: $(cat out)"
+  grep -q "file small/full.y4m: frames written 5, lost 5" out ||
+    fail "a run on a full disk did not count what it wrote: $(cat out)"
+  [ "$(cat frames)" -eq 5 ] || fail "full.y4m does not hold its 5 whole frames"
+  [ "$(cat left)" = full.y4m ] || fail "a run on a full disk left $(cat left)"
+else
+  echo "hostile run: no full-disk check (no mount namespace here)"
+fi
 
 # Command-line values that mean nothing are input errors (2), not "no
 # limit" or CLI11's own exit codes.

@@ -30,11 +30,9 @@ bool finite(glm::vec3 v) {
 // The camera frame make_frame_params() builds from a pose: a pose the board
 // reader lets through must give one without a NaN or a zero axis.
 void check_pose(const pipeline::PoseConfig &pose) {
-  const auto f = [](const std::array<double, 3> &a) {
-    return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
-  };
-  const glm::vec3 forward = glm::normalize(f(pose.look_at) - f(pose.position));
-  const glm::vec3 right = glm::normalize(glm::cross(forward, f(pose.up)));
+  const pipeline::PoseVectors v = pipeline::pose_vectors(pose);
+  const glm::vec3 forward = glm::normalize(v.look_at - v.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, v.up));
   fuzz::check(finite(forward) && finite(right) && glm::length(right) > 0.5f);
 }
 

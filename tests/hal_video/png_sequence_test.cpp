@@ -123,7 +123,7 @@ TEST(PngSequence, SizesAreCheckedFromTheHeaderBeforeDecoding) {
   EXPECT_EQ(open_error(dir / "huge.png"),
             (dir / "huge.png").string() + ": PNG header: size 20000x4 is over 16384 pixels a side");
 
-  // A later frame that claims another size ends the stream before it is
+  // A later frame that claims another size fails the take before it is
   // decoded, naming the file.
   const auto format = test::make_format(PixelFormat::rgb24, 4, 4);
   write_sequence((dir / "seq" / "%02d.png").string(), format, 2);
@@ -137,7 +137,7 @@ TEST(PngSequence, SizesAreCheckedFromTheHeaderBeforeDecoding) {
                                          "frame's 4x4");
 }
 
-TEST(PngSequence, AFrameThatIsNotAPngEndsTheStream) {
+TEST(PngSequence, AFrameThatIsNotAPngFailsTheTake) {
   const test::ScratchDir dir;
   const auto format = test::make_format(PixelFormat::rgb24, 4, 4);
   write_sequence((dir / "%d.png").string(), format, 1);

@@ -206,6 +206,12 @@ TEST(BoardLive, APoseWithoutAViewOrAnOrientationIsRefused) {
   // Different doubles, one float.
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1.00000001, 0])"),
             file + "pose.look_at: equals position (in the float32 the renderer works in)");
+  // Apart in float, but too close for a direction once squared.
+  EXPECT_EQ(pose(R"("position": [0, 0, 0], "look_at": [1e-30, 0, 0])"),
+            file + "pose.look_at: too close to position for the float32 the renderer works in");
+  // A tiny up keeps its direction (made of unit length in double).
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 1e-30, 0])"),
+            "(no error)");
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 0, 0])"),
             file + "pose.up: must not be zero");
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 0, 3])"),

@@ -72,15 +72,25 @@ TEST(RunPaths, APngSequenceWritesIntoAFolderOfItsOwn) {
   const RunPath camera = input("the camera's take", dir.path() / "take" / "%05d.png", true);
   EXPECT_EQ(clash({camera, output("file:take/%05d.png", dir.path() / "take" / "%05d.png", true)}),
             "file:take/%05d.png: writes its frames into " + (dir.path() / "take").string() +
-                ", which holds the camera's take (" + camera.path.string() +
-                ") that this run reads; give the sequence a folder of its own");
+                ", where the camera's take reads its own; give each sequence a folder of its "
+                "own");
+  // A file among the sequence's frames, whichever comes first.
+  EXPECT_EQ(clash({camera, output("--record-stats", dir.path() / "take" / "00001.png")}),
+            "--record-stats: writes " + (dir.path() / "take" / "00001.png").string() +
+                " among the frames the camera's take reads (" + camera.path.string() +
+                "); write somewhere else");
+  EXPECT_NE(clash({output("file:out/%d.png", dir.path() / "out" / "%d.png", true),
+                   output("--record-stats", dir.path() / "out" / "7.png")}),
+            "(no clash)");
   // The camera's folder itself, and a plate among the outputs' frames.
   EXPECT_NE(clash({input("the camera's take", dir.path() / "take", true),
                    output("file:take/f%d.png", dir.path() / "take" / "f%d.png", true)}),
             "(no clash)");
-  EXPECT_NE(clash({input("the scene's plate", dir.path() / "out" / "plate.PNG"),
+  EXPECT_EQ(clash({input("the scene's plate", dir.path() / "out" / "plate.PNG"),
                    output("file:out/%d.png", dir.path() / "out" / "%d.png", true)}),
-            "(no clash)");
+            "file:out/%d.png: writes its frames into " + (dir.path() / "out").string() +
+                ", which holds the scene's plate (" + (dir.path() / "out" / "plate.PNG").string() +
+                ") that this run reads; give the sequence a folder of its own");
   // A folder of its own; a Y4M beside the sequence is no frame of it.
   EXPECT_EQ(clash({camera, output("file:out/%05d.png", dir.path() / "out" / "%05d.png", true),
                    input("the board", dir.path() / "out" / "board.json"),

@@ -87,7 +87,8 @@ private:
   bool ended_ = false;  // no frame follows: played once to its end, or failed
   bool failed_ = false; // ended by an error
   std::optional<std::int64_t> retry_at_ns_;
-  bool started_ = false;
+  bool started_ = false;         // a frame was delivered
+  bool scheduled_ = false;       // realtime: next_due_ns_ is set
   std::int64_t first_ns_ = 0;    // the first frame's stamp
   std::int64_t next_due_ns_ = 0; // realtime: when the next frame goes out
   std::uint64_t sequence_ = 0;
@@ -111,9 +112,14 @@ CaptureResult FileCamera::next_frame(std::chrono::milliseconds timeout, Captured
     return CaptureResult::timeout;
   if (realtime_) {
     const std::int64_t now = base::monotonic_ns();
-    // Over a frame behind: restart the schedule instead of bursting to catch up.
-    if (!started_ || next_due_ns_ + interval_ns_ < now)
+    // The first frame (and the first after a retry) once its exposure is
+    // over, as a camera's; over a frame behind, the schedule restarts
+    // instead of bursting to catch up.
+    if (!scheduled_)
+      next_due_ns_ = now + interval_ns_;
+    else if (next_due_ns_ + interval_ns_ < now)
       next_due_ns_ = now;
+    scheduled_ = true;
     if (next_due_ns_ > deadline) {
       sleep_until(deadline);
       return CaptureResult::timeout;
@@ -220,10 +226,14 @@ bool FileCamera::retry(std::int64_t deadline) {
   }
   retry_at_ns_.reset();
   frames_in_pass_ = 0;
+  scheduled_ = false;
   const std::lock_guard lock(status_mutex_);
   status_.connected = true;
   ++status_.reconnects;
-  status_.detail = name() + ": playing again from the first frame";
+  // The error stays said until the next one (the status line reports it).
+  const std::size_t cut = status_.detail.rfind("; playing again");
+  status_.detail =
+      name() + ": playing again from the first frame after " + status_.detail.substr(0, cut);
   return true;
 }
 
@@ -234,10 +244,11 @@ void FileCamera::set_detail(std::string detail) {
 
 std::unique_ptr<FrameReader> open_reader(const FileCameraOptions &options) {
   const std::filesystem::path &path = options.path;
+  const WantedSize wanted{options.width, options.height};
   std::error_code ec;
   if (video_file::FramePattern::is_pattern(path.string()) ||
       std::filesystem::is_directory(path, ec))
-    return open_png_sequence_reader(path);
+    return open_png_sequence_reader(path, wanted);
   // By content, not by name: a take renamed .yuv still plays.
   char magic[9] = {};
   {
@@ -248,14 +259,23 @@ std::unique_ptr<FrameReader> open_reader(const FileCameraOptions &options) {
     std::fclose(file);
     const std::string_view head(magic, got);
     if (head == "YUV4MPEG2")
-      return open_y4m_reader(path, options.fps > 0);
+      return open_y4m_reader(path, options.fps > 0, wanted);
     if (head.starts_with("\x89PNG\r\n\x1a\n"))
-      return open_png_sequence_reader(path);
+      return open_png_sequence_reader(path, wanted);
   }
   throw FileCameraError(path.string() + ": format: neither Y4M (YUV4MPEG2) nor PNG");
 }
 
 } // namespace
+
+void check_size(const std::string &file, int width, int height, WantedSize wanted) {
+  if ((wanted.width == 0 && wanted.height == 0) ||
+      (width == wanted.width && height == wanted.height))
+    return;
+  throw FileCameraError(file + ": size: its frames are " + std::to_string(width) + "x" +
+                        std::to_string(height) + ", the camera's are to be " +
+                        std::to_string(wanted.width) + "x" + std::to_string(wanted.height));
+}
 
 std::unique_ptr<CameraSource> open_file_camera(const FileCameraOptions &options) {
   const std::string source = options.path.string();

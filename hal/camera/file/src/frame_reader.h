@@ -36,13 +36,22 @@ public:
   [[nodiscard]] virtual bool rewind(std::string &error) = 0;
 };
 
+// The size a caller needs (FileCameraOptions::width, height; 0 x 0: any).
+struct WantedSize {
+  int width = 0, height = 0;
+};
+
+// Throws FileCameraError "FILE: size: ..." unless a frame of `width` x
+// `height` is what `wanted` asks for.
+void check_size(const std::string &file, int width, int height, WantedSize wanted);
+
 // A Y4M file. `rate_given`: the caller has its own rate, so a header without
 // one (no F, or F0:0) is fine.
 [[nodiscard]] std::unique_ptr<FrameReader> open_y4m_reader(const std::filesystem::path &path,
-                                                           bool rate_given);
+                                                           bool rate_given, WantedSize wanted = {});
 
 // A pattern, a folder of PNGs or one PNG (file_camera.h).
 [[nodiscard]] std::unique_ptr<FrameReader>
-open_png_sequence_reader(const std::filesystem::path &path);
+open_png_sequence_reader(const std::filesystem::path &path, WantedSize wanted = {});
 
 } // namespace camhead::hal::camera

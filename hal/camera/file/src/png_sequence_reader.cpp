@@ -31,7 +31,7 @@ bool is_png_name(const std::filesystem::path &path) {
 
 class PngSequenceReader final : public FrameReader {
 public:
-  explicit PngSequenceReader(const std::filesystem::path &path);
+  PngSequenceReader(const std::filesystem::path &path, WantedSize wanted);
 
   base::VideoFormat format() const override { return format_; }
   std::int64_t native_interval_ns() const override { return 0; }
@@ -54,7 +54,7 @@ private:
   std::vector<std::uint8_t> bytes_;
 };
 
-PngSequenceReader::PngSequenceReader(const std::filesystem::path &path) {
+PngSequenceReader::PngSequenceReader(const std::filesystem::path &path, WantedSize wanted) {
   const std::string text = path.string();
   std::error_code ec;
   if (FramePattern::is_pattern(text)) {
@@ -85,6 +85,7 @@ PngSequenceReader::PngSequenceReader(const std::filesystem::path &path) {
   format_.pixel = base::PixelFormat::rgb24;
   format_.width = size->width;
   format_.height = size->height;
+  check_size(first.string(), size->width, size->height, wanted);
   const std::string reason = base::check_video_format(format_);
   if (!reason.empty())
     throw FileCameraError(first.string() + ": PNG header: " + reason);
@@ -148,8 +149,9 @@ FrameReader::Read PngSequenceReader::read(std::span<std::uint8_t> frame, std::st
 
 } // namespace
 
-std::unique_ptr<FrameReader> open_png_sequence_reader(const std::filesystem::path &path) {
-  return std::make_unique<PngSequenceReader>(path);
+std::unique_ptr<FrameReader> open_png_sequence_reader(const std::filesystem::path &path,
+                                                      WantedSize wanted) {
+  return std::make_unique<PngSequenceReader>(path, wanted);
 }
 
 } // namespace camhead::hal::camera

@@ -47,7 +47,7 @@ std::string printable(std::string_view text) {
 
 class Y4mReader final : public FrameReader {
 public:
-  Y4mReader(const std::filesystem::path &path, bool rate_given);
+  Y4mReader(const std::filesystem::path &path, bool rate_given, WantedSize wanted);
 
   base::VideoFormat format() const override { return format_; }
   std::int64_t native_interval_ns() const override {
@@ -73,7 +73,8 @@ private:
   std::string line_;
 };
 
-Y4mReader::Y4mReader(const std::filesystem::path &path, bool rate_given) : file_(path.string()) {
+Y4mReader::Y4mReader(const std::filesystem::path &path, bool rate_given, WantedSize wanted)
+    : file_(path.string()) {
   stream_.reset(std::fopen(path.c_str(), "rbe"));
   if (!stream_)
     throw FileCameraError(file_ + ": open: " + std::strerror(errno));
@@ -102,6 +103,7 @@ Y4mReader::Y4mReader(const std::filesystem::path &path, bool rate_given) : file_
     throw FileCameraError(file_ + ": header: F missing or 0:0, the frame rate is unknown; " +
                           "give the camera a rate (fps)");
   format_ = video_file::y4m_video_format(header_);
+  check_size(file_, format_.width, format_.height, wanted);
   plane_bytes_ = video_file::y4m_plane_bytes(format_);
   data_start_ = ::ftello(stream_.get());
 
@@ -188,8 +190,9 @@ bool Y4mReader::rewind(std::string &error) {
 
 } // namespace
 
-std::unique_ptr<FrameReader> open_y4m_reader(const std::filesystem::path &path, bool rate_given) {
-  return std::make_unique<Y4mReader>(path, rate_given);
+std::unique_ptr<FrameReader> open_y4m_reader(const std::filesystem::path &path, bool rate_given,
+                                             WantedSize wanted) {
+  return std::make_unique<Y4mReader>(path, rate_given, wanted);
 }
 
 } // namespace camhead::hal::camera

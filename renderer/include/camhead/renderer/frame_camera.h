@@ -33,12 +33,15 @@ struct FrameCamera {
   float entrance_pupil_offset_m = 0.0f;
 };
 
-// Whether `up` gives the view from `position` to `look_at` no orientation:
-// parallel to it (within 1e-6 of the unit vectors' cross product), zero, or
-// the view itself of zero length, in the float32 the tracer builds its frame
-// in (make_frame_params() would divide by zero and render nothing). The
-// scene reader and the board reader both refuse such a camera.
-[[nodiscard]] bool view_has_no_orientation(glm::vec3 position, glm::vec3 look_at, glm::vec3 up);
+// What stops make_frame_params() from building a camera frame, in the
+// float32 it works in (it would divide by zero, and the frame render
+// nothing): `no_direction`, `look_at` too close to `position` for the view
+// to have a direction; `no_orientation`, `up` parallel to the view (within
+// 1e-6 of the unit vectors' cross product, the scene format's rule), zero,
+// or too short to give the picture a direction. The scene reader and the
+// board reader both refuse such a camera.
+enum class ViewProblem { none, no_direction, no_orientation };
+[[nodiscard]] ViewProblem view_problem(glm::vec3 position, glm::vec3 look_at, glm::vec3 up);
 
 // The scene file's camera: pupil at its position, no breathing.
 [[nodiscard]] FrameCamera scene_camera(const Scene &scene);

@@ -26,7 +26,8 @@ struct FrameTimings {
 };
 
 struct RenderResult {
-  Image composite; // I_f = M I_m + (1 - M)(I_c + I_m - I_r); I_m where there is no plate
+  Image composite; // I_f = M I_m + (1 - M)(I_c + I_m - I_r), not below black where I_c is
+                   // not (kernel.glsl); I_m where there is no plate
   Image mixed;     // I_m: real proxy and virtual objects
   Image real;      // I_r: real proxy alone
   Image mask;      // M: fraction of camera rays whose first hit is virtual (1 channel)

@@ -25,7 +25,8 @@
 // the first frame (a reconnect), and so on for as long as it fails.
 //
 // Timing: the rate is FileCameraOptions::fps, or else the Y4M's F, or 25
-// for PNGs. With `realtime`, frame i+1 is delivered one interval after frame
+// for PNGs. With `realtime`, frame 0 is delivered one interval after the
+// first wait_frame() (and after a retry), frame i+1 one interval after frame
 // i was due, as a camera delivers a frame once its exposure is over: stamped
 // with CLOCK_MONOTONIC when it is delivered, as the end of an exposure of a
 // whole interval (mark end_of_frame), so that its mid-exposure is half a
@@ -63,6 +64,10 @@ struct FileCameraOptions {
   // 0: the file's own rate (Y4M header), 25 for image sequences; otherwise
   // 0.01 to 1000 frames a second.
   double fps = 0;
+  // The frame size the caller needs; 0: the file's. A file of another size
+  // is refused as soon as its header is read ("take.y4m: size: ..."),
+  // before anything of its size is allocated.
+  int width = 0, height = 0;
 };
 
 // "FILE: FIELD: REASON", e.g. "take.y4m: header: W missing".
