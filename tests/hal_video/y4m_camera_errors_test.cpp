@@ -128,6 +128,29 @@ TEST(FileCameraErrors, FirstFrameIsCheckedAtOpen) {
   EXPECT_EQ(open_error(path), path.string() + ":frame 0: truncated: 100 of 402653184 bytes");
 }
 
+// The size the caller needs is checked against the header, before a frame
+// of the file's size is read or allocated (a file that held all of a
+// 16384 x 16384 frame's bytes would otherwise get its buffers first): the
+// size is the error, not the truncation further on.
+TEST(FileCameraErrors, ATakeOfAnotherSizeThanAskedIsRefusedFromItsHeader) {
+  const test::ScratchDir dir;
+  const auto path = dir / "a.y4m";
+  test::write_text(path, "YUV4MPEG2 W16384 H16384 F25:1\nFRAME\n" + std::string(100, 'x'));
+  FileCameraOptions options;
+  options.path = path;
+  options.width = 64;
+  options.height = 48;
+  try {
+    (void)hal::camera::open_file_camera(options);
+    FAIL() << "opened";
+  } catch (const FileCameraError &e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": size: its frames are 16384x16384, the "
+                                                     "camera's are to be 64x48");
+  }
+  test::write_text(path, "YUV4MPEG2 W64 H48 F25:1\nFRAME\n" + std::string(64 * 48 * 2, 'x'));
+  EXPECT_NO_THROW((void)hal::camera::open_file_camera(options));
+}
+
 TEST(FileCameraErrors, WhatIsNotATakeAtAll) {
   const test::ScratchDir dir;
   EXPECT_EQ(open_error(dir / "none.y4m"),

@@ -268,15 +268,6 @@ std::unique_ptr<FrameReader> open_reader(const FileCameraOptions &options) {
 
 } // namespace
 
-void check_size(const std::string &file, int width, int height, WantedSize wanted) {
-  if ((wanted.width == 0 && wanted.height == 0) ||
-      (width == wanted.width && height == wanted.height))
-    return;
-  throw FileCameraError(file + ": size: its frames are " + std::to_string(width) + "x" +
-                        std::to_string(height) + ", the camera's are to be " +
-                        std::to_string(wanted.width) + "x" + std::to_string(wanted.height));
-}
-
 std::unique_ptr<CameraSource> open_file_camera(const FileCameraOptions &options) {
   const std::string source = options.path.string();
   const double fps = options.fps;

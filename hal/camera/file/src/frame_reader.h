@@ -43,7 +43,14 @@ struct WantedSize {
 
 // Throws FileCameraError "FILE: size: ..." unless a frame of `width` x
 // `height` is what `wanted` asks for.
-void check_size(const std::string &file, int width, int height, WantedSize wanted);
+inline void check_size(const std::string &file, int width, int height, WantedSize wanted) {
+  if ((wanted.width == 0 && wanted.height == 0) ||
+      (width == wanted.width && height == wanted.height))
+    return;
+  throw FileCameraError(file + ": size: its frames are " + std::to_string(width) + "x" +
+                        std::to_string(height) + ", the camera's are to be " +
+                        std::to_string(wanted.width) + "x" + std::to_string(wanted.height));
+}
 
 // A Y4M file. `rate_given`: the caller has its own rate, so a header without
 // one (no F, or F0:0) is fine.
