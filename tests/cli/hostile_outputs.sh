@@ -8,21 +8,7 @@ camhead=$1
 src=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*"
-  failures=$((failures + 1))
-}
-# expect STATUS PATTERN COMMAND...: the command exits with STATUS and says PATTERN.
-expect() {
-  want=$1
-  pattern=$2
-  shift 2
-  "$@" >"$tmp/out" 2>&1
-  got=$?
-  [ "$got" -eq "$want" ] || fail "$* exited $got, not $want: $(cat "$tmp/out")"
-  grep -q -- "$pattern" "$tmp/out" || fail "$* did not say '$pattern': $(cat "$tmp/out")"
-}
+. "$(dirname "$0")/expect.sh"
 
 measurements=$src/scenes/lenses/example_35mm_measurements.csv
 scene=$src/bench/scenes/small_ball.json

@@ -186,17 +186,22 @@ void expect_fails_after(hal::camera::CameraSource &camera, std::size_t frames,
   EXPECT_EQ(status.detail, detail);
 }
 
+// The three frames with the last cut 10 bytes short, played offline.
+std::unique_ptr<hal::camera::CameraSource> cut_take(const test::ScratchDir &dir, bool loop) {
+  const std::string file = three_frames(dir);
+  test::write_text(dir / "take.y4m", file.substr(0, file.size() - 10));
+  FileCameraOptions options;
+  options.path = dir / "take.y4m";
+  options.realtime = false;
+  options.loop = loop;
+  return hal::camera::open_file_camera(options);
+}
+
 TEST(FileCameraErrors, ATruncatedLastFrameFailsATakePlayedOnceNamingIt) {
   const test::ScratchDir dir;
-  const std::string file = three_frames(dir);
-  const auto path = dir / "take.y4m";
-  test::write_text(path, file.substr(0, file.size() - 10));
-  FileCameraOptions options;
-  options.path = path;
-  options.realtime = false;
-  options.loop = false;
-  auto camera = hal::camera::open_file_camera(options);
-  expect_fails_after(*camera, 2, path.string() + ":frame 2: truncated: 38 of 48 bytes");
+  auto camera = cut_take(dir, false);
+  expect_fails_after(*camera, 2,
+                     (dir / "take.y4m").string() + ":frame 2: truncated: 38 of 48 bytes");
 }
 
 // A looping file stands in for a live camera: a frame it cannot read is a
@@ -204,14 +209,8 @@ TEST(FileCameraErrors, ATruncatedLastFrameFailsATakePlayedOnceNamingIt) {
 // its first frame, for as long as the show goes on.
 TEST(FileCameraErrors, ALoopingFileThatBreaksIsLostThenPlaysAgainFromItsFirstFrame) {
   const test::ScratchDir dir;
-  const std::string file = three_frames(dir);
   const auto path = dir / "take.y4m";
-  test::write_text(path, file.substr(0, file.size() - 10));
-  FileCameraOptions options;
-  options.path = path;
-  options.realtime = false;
-  options.loop = true;
-  auto camera = hal::camera::open_file_camera(options);
+  auto camera = cut_take(dir, true);
   const std::vector<std::vector<std::uint8_t>> first_pass = test::read_all(*camera);
   ASSERT_EQ(first_pass.size(), 2u);
   CapturedFrame frame;
