@@ -1,5 +1,6 @@
 #include "run_paths.h"
 
+#include <cctype>
 #include <optional>
 #include <system_error>
 #include <variant>
@@ -33,8 +34,8 @@ Identity identity_of(const fs::path &path) {
 
 bool same(const Identity &a, const Identity &b) {
   if (a.node && b.node) {
-    // Two device nodes for one device (a by-id link is followed already;
-    // a second node made by hand is not).
+    // One device, whatever node names it: stat() follows a by-id link, and
+    // a second node made with mknod has the same st_rdev.
     if (S_ISCHR(a.node->st_mode) && S_ISCHR(b.node->st_mode))
       return a.node->st_rdev == b.node->st_rdev;
     return a.node->st_dev == b.node->st_dev && a.node->st_ino == b.node->st_ino;
