@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -399,7 +400,12 @@ PoseVectors pose_vectors(const PoseConfig &pose) {
   const auto f = [](const std::array<double, 3> &a) {
     return glm::vec3(float(a[0]), float(a[1]), float(a[2]));
   };
-  const glm::dvec3 up(pose.up[0], pose.up[1], pose.up[2]);
+  // Scaled by its largest component first, so that a tiny `up` (1e-300)
+  // does not underflow to zero when squared.
+  glm::dvec3 up(pose.up[0], pose.up[1], pose.up[2]);
+  const double largest = std::max({std::abs(up.x), std::abs(up.y), std::abs(up.z)});
+  if (largest > 0.0)
+    up /= largest;
   const double length = glm::length(up);
   return {f(pose.position), f(pose.look_at),
           length > 0.0 ? glm::vec3(up / length) : glm::vec3(0.0f)};

@@ -212,6 +212,8 @@ TEST(BoardLive, APoseWithoutAViewOrAnOrientationIsRefused) {
   // A tiny up keeps its direction (made of unit length in double).
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 1e-30, 0])"),
             "(no error)");
+  EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [1e-300, 1e-300, 0])"),
+            "(no error)");
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 0, 0])"),
             file + "pose.up: must not be zero");
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2], "up": [0, 0, 3])"),
