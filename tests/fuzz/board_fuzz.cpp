@@ -1,9 +1,9 @@
 // libFuzzer target for the board-file reader (pipeline/board.h) and what
 // `camhead run` builds from a board before it opens a device: the output
 // URIs, the check of every path the run reads and writes against the others
-// (run_paths.h; it only looks at paths, with stat()), the camera's size and
-// the pose's view. Any text must be refused with the error of the step that
-// read it, or give a rig whose invariants hold; anything else is a finding.
+// (run_paths.h; it only looks at paths, with stat()), the camera's size,
+// the frame budget of its render section and the pose's view. Any text must be refused with the
+// error of the step that read it, or give a rig whose invariants hold; anything else is a finding.
 // Nothing is opened for writing and no device is started.
 #include <cmath>
 #include <cstddef>
@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "board.h"
+#include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/scene.h"
 #include "fuzz_check.h"
 #include "run/output_uri.h"
@@ -51,6 +52,15 @@ void build_rig(const pipeline::Board &board) {
     const auto &c = *board.camera;
     fuzz::check(c.width >= 2 && c.height >= 2 && c.width % 2 == 0 && c.height % 2 == 0 &&
                 std::int64_t(c.width) * c.height <= std::int64_t(1) << 25);
+    // The render section as the render thread takes it: a budget its
+    // constructor accepts (it throws on a range the reader let through).
+    const auto *sim = std::get_if<pipeline::SimCameraConfig>(&c.kind);
+    renderer::FrameBudgetSettings settings;
+    settings.target_s = 1.0 / (sim != nullptr ? sim->fps : 25.0);
+    settings.min_rpp = board.render.min_rays_per_pixel;
+    settings.max_rpp = board.render.max_rays_per_pixel;
+    const renderer::FrameBudget budget(settings);
+    fuzz::check(budget.rpp() >= settings.min_rpp && budget.rpp() <= settings.max_rpp);
   }
   if (board.pose)
     check_pose(*board.pose);
