@@ -199,7 +199,11 @@ void add_run_command(CLI::App &app) {
              "Examples:\n"
              "  camhead run --duration 5 --output file:sim.y4m\n"
              "  camhead run --output v4l2:/dev/video10 --output drm:card0:HDMI-A-1\n"
-             "  camhead run --board my-rig.json --frames 250 --record-stats stats.jsonl");
+             "  camhead run --board my-rig.json --frames 250 --record-stats stats.jsonl\n"
+             "Exit status: 0 done; 2 a wrong board, scene, take, output or option (nothing\n"
+             "written); 3 frames could not be rendered; 4 a file output lost frames (a full\n"
+             "disk, a size limit; what it holds is kept); 5 the camera's take broke off or a\n"
+             "device failed. The summary says what each output took.");
   cmd->add_option("--board", args->board,
                   "Board name in board/ (sim, ...) or a board file; its camera, scene,\n"
                   "lens and outputs")
