@@ -19,6 +19,7 @@
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
 #include "camhead/hal/camera/camera_source.h"
+#include "camhead/hal/camera/frame_lease.h"
 #include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/frame_renderer.h"
@@ -45,9 +46,10 @@ struct Slot {
   FrameRecord record;
 };
 
-// A camera frame and when the camera handed it over.
+// A camera frame and when the camera handed it over. Dropped on any path,
+// it gives the camera its buffer back (frame_lease.h).
 struct Delivered {
-  CapturedFrame frame;
+  hal::camera::FrameLease frame;
   std::int64_t at_ns = 0;
 };
 
@@ -243,13 +245,13 @@ void Pipeline::capture_loop() {
     if (result != CaptureResult::frame)
       continue;
     ++counters_.frames_in;
+    Delivered delivered{{*camera_, frame}, base::monotonic_ns()};
     if (lossless_) {
-      // A file played as fast as it is taken: every frame is rendered.
-      if (std::optional<Delivered> refused = captured_.push_waiting({frame, base::monotonic_ns()}))
-        camera_->release(refused->frame);
-    } else if (std::optional<Delivered> replaced = captured_.push({frame, base::monotonic_ns()})) {
-      ++counters_.render_busy;
-      camera_->release(replaced->frame);
+      // A file played as fast as it is taken: every frame is rendered (a
+      // frame refused by a closed queue goes back as its lease ends).
+      (void)captured_.push_waiting(std::move(delivered));
+    } else if (captured_.push(std::move(delivered))) {
+      ++counters_.render_busy; // the one it replaced has gone back
     }
   }
   captured_.close();
@@ -272,14 +274,13 @@ void Pipeline::render_loop() {
         break;
       continue;
     }
-    const CapturedFrame &frame = delivered->frame;
+    const CapturedFrame &frame = delivered->frame.frame();
     std::optional<int> slot_index = free_slots_.pop(200ms);
     while (lossless_ && !slot_index && !free_slots_.closed())
       slot_index = free_slots_.pop(200ms);
     if (!slot_index) {
       ++counters_.output_busy;
-      camera_->release(frame);
-      continue;
+      continue; // the frame goes back with its lease
     }
     Slot &slot = slots_[std::size_t(*slot_index)];
     FrameRecord &r = slot.record;
@@ -313,7 +314,7 @@ void Pipeline::render_loop() {
     const renderer::FrameReport report =
         renderer_->render(request, {frame.format, frame.bytes}, targets);
     r.render_end_ns = base::monotonic_ns();
-    camera_->release(frame);
+    delivered->frame.reset(); // the camera may fill the buffer again
     if (report.status != renderer::FrameStatus::ok) {
       ++counters_.render_failed;
       if (render_failure_.empty())

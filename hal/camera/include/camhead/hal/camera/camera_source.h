@@ -9,7 +9,8 @@
 // belong to the backend and stay valid, untouched, until release() is called
 // with that frame (a V4L2 buffer is queued again, a libcamera Request reused);
 // a backend has a fixed number of buffers, so a caller that holds them all
-// gets no new frame until it gives one back.
+// gets no new frame until it gives one back. Callers hold frames through a
+// FrameLease (frame_lease.h), which gives each back once, on every path.
 //
 // Thread safety: wait_frame() from one thread; release() and status() from
 // any thread.
