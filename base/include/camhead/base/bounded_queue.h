@@ -1,7 +1,8 @@
 // A bounded queue between two pipeline threads in which the newest item wins:
 // a full queue drops its oldest item to take a new one, and says so, so that
 // a stage slower than its producer works on the latest frame, never on a
-// backlog, and every drop is counted by whoever pushed.
+// backlog, and every drop is counted by whoever pushed. Its slots are made
+// with it: pushing and popping allocate nothing (the frame loop's rule).
 //
 // Thread safety: any number of producers and consumers.
 #pragma once
@@ -9,16 +10,16 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
-#include <deque>
 #include <mutex>
 #include <optional>
 #include <utility>
+#include <vector>
 
 namespace camhead::base {
 
 template <typename T> class BoundedQueue {
 public:
-  explicit BoundedQueue(std::size_t capacity) : capacity_(capacity > 0 ? capacity : 1) {}
+  explicit BoundedQueue(std::size_t capacity) : slots_(capacity > 0 ? capacity : 1) {}
 
   // Adds `item`; when the queue is full the oldest item is taken out and
   // returned (the caller counts it as dropped and releases what it holds).
@@ -29,11 +30,9 @@ public:
       std::lock_guard lock(mutex_);
       if (closed_)
         return std::optional<T>(std::move(item));
-      if (items_.size() == capacity_) {
-        dropped.emplace(std::move(items_.front()));
-        items_.pop_front();
-      }
-      items_.push_back(std::move(item));
+      if (size_ == slots_.size())
+        dropped.emplace(take_oldest());
+      put(std::move(item));
     }
     ready_.notify_one();
     return dropped;
@@ -45,10 +44,10 @@ public:
   std::optional<T> push_waiting(T item) {
     {
       std::unique_lock lock(mutex_);
-      room_.wait(lock, [&] { return closed_ || items_.size() < capacity_; });
+      room_.wait(lock, [&] { return closed_ || size_ < slots_.size(); });
       if (closed_)
         return std::optional<T>(std::move(item));
-      items_.push_back(std::move(item));
+      put(std::move(item));
     }
     ready_.notify_one();
     return std::nullopt;
@@ -58,12 +57,11 @@ public:
   // the queue is closed and drained.
   std::optional<T> pop(std::chrono::nanoseconds timeout) {
     std::unique_lock lock(mutex_);
-    if (!ready_.wait_for(lock, timeout, [&] { return !items_.empty() || closed_; }))
+    if (!ready_.wait_for(lock, timeout, [&] { return size_ > 0 || closed_; }))
       return std::nullopt;
-    if (items_.empty())
+    if (size_ == 0)
       return std::nullopt;
-    std::optional<T> item(std::move(items_.front()));
-    items_.pop_front();
+    std::optional<T> item(take_oldest());
     room_.notify_one();
     return item;
   }
@@ -89,15 +87,29 @@ public:
   // two (pushed just before the close).
   [[nodiscard]] bool drained() const {
     std::lock_guard lock(mutex_);
-    return closed_ && items_.empty();
+    return closed_ && size_ == 0;
   }
 
 private:
-  const std::size_t capacity_;
+  // A ring of slots, oldest at head_; with the lock held.
+  void put(T item) {
+    slots_[(head_ + size_) % slots_.size()].emplace(std::move(item));
+    ++size_;
+  }
+  T take_oldest() {
+    std::optional<T> &slot = slots_[head_];
+    T item(std::move(*slot));
+    slot.reset();
+    head_ = (head_ + 1) % slots_.size();
+    --size_;
+    return item;
+  }
+
   mutable std::mutex mutex_;
   std::condition_variable ready_;
   std::condition_variable room_;
-  std::deque<T> items_;
+  std::vector<std::optional<T>> slots_;
+  std::size_t head_ = 0, size_ = 0;
   bool closed_ = false;
 };
 
