@@ -69,9 +69,10 @@ int report(const pipeline::RunSummary &s) {
                (unsigned long long)s.camera_reconnects, (unsigned long long)s.lens_late);
   bool file_failed = false, device_failed = !s.camera_failure.empty();
   for (const pipeline::OutputSummary &o : s.outputs) {
-    // An output no frame reached (a run stopped while it started) and that
-    // therefore kept an earlier file is no failure; its close says so.
-    (o.file ? file_failed : device_failed) |= o.failed > 0 || (!o.closed && o.written > 0);
+    // A file output no frame reached (a run stopped while it started) keeps
+    // an earlier file of its name: no failure, and its close says so.
+    (o.file ? file_failed : device_failed) |=
+        o.failed > 0 || (!o.closed && (!o.file || o.written > 0));
     // Each failed frame's error was said as it happened; a failed close
     // (a file not completed) is said here.
     std::fprintf(stderr, "camhead run: %s: frames written %llu, lost %llu%s%s\n", o.name.c_str(),

@@ -535,8 +535,12 @@ RunSummary Pipeline::run() {
     threads.emplace_back([this] { render_loop(); });
     threads.emplace_back([this] { output_loop(); });
   } catch (...) {
-    // A thread that cannot start: stop the ones that did, then say so.
+    // A thread that cannot start: stop the ones that did (a capture thread
+    // waiting for room, a render thread for a slot), then say so.
     stopping_ = true;
+    captured_.close();
+    free_slots_.close();
+    ready_slots_.close();
     for (std::thread &thread : threads)
       thread.join();
     throw;

@@ -43,14 +43,19 @@ bool same(const Identity &a, const Identity &b) {
   return a.canonical == b.canonical;
 }
 
+// The folder a file is in; "." for a bare name.
+fs::path folder_of(const fs::path &path) {
+  const fs::path parent = path.parent_path();
+  return parent.empty() ? fs::path(".") : parent;
+}
+
 // The folder a PNG sequence's frames are in: the pattern's, or the folder
 // named.
 fs::path sequence_folder(const fs::path &path) {
   std::error_code error;
   if (!hal::video_file::FramePattern::is_pattern(path.string()) && fs::is_directory(path, error))
     return path;
-  const fs::path parent = path.parent_path();
-  return parent.empty() ? fs::path(".") : parent;
+  return folder_of(path);
 }
 
 bool is_png(const fs::path &path) {
@@ -68,7 +73,7 @@ bool clash(const RunPath &a, const RunPath &b) {
   if (a.sequence || b.sequence) {
     const RunPath &sequence = a.sequence ? a : b, &file = a.sequence ? b : a;
     return is_png(file.path) &&
-           same(identity_of(sequence_folder(sequence.path)), identity_of(file.path.parent_path()));
+           same(identity_of(sequence_folder(sequence.path)), identity_of(folder_of(file.path)));
   }
   return same(identity_of(a.path), identity_of(b.path));
 }

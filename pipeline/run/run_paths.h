@@ -9,10 +9,11 @@
 // Identity is the device and inode after following links, for what exists;
 // for what a run will create, the path made absolute with its links
 // resolved (std::filesystem::weakly_canonical). A PNG sequence is its
-// folder: no PNG the run reads or writes may lie in the folder of a
-// sequence it reads or writes (the camera's own frames, a plate, a PNG
-// named as the statistics file), since numbered names cannot be told from
-// theirs, and two sequences need two folders.
+// folder: no PNG the run writes may lie in the folder of a sequence it
+// reads or writes, nor any PNG it reads in the folder of a sequence it
+// writes (the camera's own frames, a plate, a PNG named as the statistics
+// file), since numbered names cannot be told from theirs; and a sequence
+// written needs a folder no other sequence uses.
 #pragma once
 
 #include <filesystem>

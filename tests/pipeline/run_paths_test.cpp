@@ -79,9 +79,15 @@ TEST(RunPaths, APngSequenceWritesIntoAFolderOfItsOwn) {
             "--record-stats: writes " + (dir.path() / "take" / "00001.png").string() +
                 " among the frames the camera's take reads (" + camera.path.string() +
                 "); write somewhere else");
-  EXPECT_NE(clash({output("file:out/%d.png", dir.path() / "out" / "%d.png", true),
+  EXPECT_EQ(clash({output("file:out/%d.png", dir.path() / "out" / "%d.png", true),
                    output("--record-stats", dir.path() / "out" / "7.png")}),
-            "(no clash)");
+            "--record-stats: writes " + (dir.path() / "out" / "7.png").string() +
+                " among the frames file:out/%d.png writes (" +
+                (dir.path() / "out" / "%d.png").string() + "); write somewhere else");
+  // Bare names are in the working folder.
+  EXPECT_EQ(clash({output("file:%05d.png", "%05d.png", true), output("--record-stats", "1.png")}),
+            "--record-stats: writes 1.png among the frames file:%05d.png writes (%05d.png); write "
+            "somewhere else");
   // The camera's folder itself, and a plate among the outputs' frames.
   EXPECT_NE(clash({input("the camera's take", dir.path() / "take", true),
                    output("file:take/f%d.png", dir.path() / "take" / "f%d.png", true)}),

@@ -146,6 +146,27 @@ TEST(SceneLoader, AKeyGivenTwiceIsRefusedOnItsField) {
   }
 }
 
+// A camera whose axes the tracer cannot build in float32 is refused, not
+// rendered as a frame of nothing: an up whose square overflows, a target
+// whose distance's square does.
+TEST(SceneLoader, ACameraWithoutAxesInFloatIsRefused) {
+  for (const auto &[camera, field] :
+       {std::pair{R"("position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1e20, 0])", "up"},
+        std::pair{R"("position": [0, 0, 0], "look_at": [0, 0, -1e20])", "look_at"}}) {
+    const std::string text = std::string(R"({"render": {"width": 1, "height": 1, "samples": 1},
+      "camera": {)") + camera +
+                             R"(, "focal_length_mm": 35, "sensor_width_mm": 36},
+      "materials": {"a": {"type": "mirror"}},
+      "objects": [{"type": "sphere", "center": [0, 0, -1], "radius": 1, "material": "a"}]})";
+    try {
+      (void)parse_scene(text, "far.json");
+      ADD_FAILURE() << "accepted " << camera;
+    } catch (const SceneError &e) {
+      EXPECT_EQ(e.field(), std::string("camera.") + field) << camera;
+    }
+  }
+}
+
 TEST(SceneLoader, ErrorNamesFileFieldAndReason) {
   Json j = base_scene();
   j["objects"][2]["radius"] = -1;

@@ -12,12 +12,17 @@
 #include <cstddef>
 #include <mutex>
 #include <optional>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace camhead::base {
 
 template <typename T> class BoundedQueue {
+  // Items move in and out of the slots under the lock: a move that threw
+  // (or allocated) would break the queue's promise.
+  static_assert(std::is_nothrow_move_constructible_v<T>);
+
 public:
   explicit BoundedQueue(std::size_t capacity) : slots_(capacity > 0 ? capacity : 1) {}
 

@@ -36,10 +36,11 @@ struct FrameCamera {
 // What stops make_frame_params() from building a camera frame, in the
 // float32 it works in (it would divide by zero, and the frame render
 // nothing): `no_direction`, `look_at` too close to `position` for the view
-// to have a direction; `no_orientation`, `up` parallel to the view (within
-// 1e-6 of the unit vectors' cross product, the scene format's rule), zero,
-// or too short to give the picture a direction. The scene reader and the
-// board reader both refuse such a camera.
+// (or too far: float squares overflow) for the view to have a direction;
+// `no_orientation`, `up` parallel to the view (within 1e-6 of the unit
+// vectors' cross product, the scene format's rule), zero, or too short or
+// too long to give the picture a direction. The scene reader and the board
+// reader both refuse such a camera.
 enum class ViewProblem { none, no_direction, no_orientation };
 [[nodiscard]] ViewProblem view_problem(glm::vec3 position, glm::vec3 look_at, glm::vec3 up);
 
