@@ -101,4 +101,18 @@ OutputSpec parse_output_uri(std::string_view uri) {
   return spec;
 }
 
+std::vector<OutputSpec> parse_output_uris(const std::vector<std::string> &uris) {
+  std::vector<OutputSpec> specs;
+  for (const std::string &uri : uris) {
+    OutputSpec spec = parse_output_uri(uri);
+    for (const OutputSpec &earlier : specs)
+      if (spec.kind == OutputKind::drm && earlier.kind == OutputKind::drm &&
+          spec.target == earlier.target && spec.connector == earlier.connector)
+        throw OutputError(uri, "drives " + spec.target + " as " + earlier.uri +
+                                   " does; give each output its own connector");
+    specs.push_back(std::move(spec));
+  }
+  return specs;
+}
+
 } // namespace camhead::pipeline

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "camhead/base/video_format.h"
 
@@ -37,5 +38,10 @@ struct OutputSpec {
 
 // Throws OutputError naming the URI and what is wrong with it.
 [[nodiscard]] OutputSpec parse_output_uri(std::string_view uri);
+
+// A run's outputs; two on one DRM connector would fight over it and the
+// second is refused (files and device nodes are checked with every other
+// path of the run: run_paths.h).
+[[nodiscard]] std::vector<OutputSpec> parse_output_uris(const std::vector<std::string> &uris);
 
 } // namespace camhead::pipeline

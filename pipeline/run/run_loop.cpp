@@ -130,19 +130,9 @@ private:
   std::int64_t last_output_ns_ = 0; // output thread only
 };
 
-// Two outputs on one connector would fight over it; files and device nodes
-// are checked with every other path of the run (run_paths.h).
 std::vector<OutputSpec> output_specs(const RunOptions &options) {
-  std::vector<OutputSpec> specs;
-  for (const std::string &uri : options.outputs.empty() ? options.board.outputs : options.outputs) {
-    OutputSpec spec = parse_output_uri(uri);
-    for (const OutputSpec &earlier : specs)
-      if (spec.kind == OutputKind::drm && earlier.kind == OutputKind::drm &&
-          spec.target == earlier.target && spec.connector == earlier.connector)
-        throw OutputError(uri, "drives " + spec.target + " as " + earlier.uri +
-                                   " does; give each output its own connector");
-    specs.push_back(std::move(spec));
-  }
+  std::vector<OutputSpec> specs =
+      parse_output_uris(options.outputs.empty() ? options.board.outputs : options.outputs);
   if (specs.empty())
     throw OutputError(options.board.file.string(),
                       "no output: give --output URI, or \"outputs\" in the board");

@@ -1,6 +1,13 @@
-# What the hostile-input scripts share (sourced, after setting `tmp`):
-# fail MESSAGE counts a failure; expect STATUS PATTERN COMMAND... runs the
-# command and checks that it exits with STATUS and says PATTERN.
+# What the hostile-input scripts share (sourced, with the script's own
+# arguments CAMHEAD SOURCE_DIR): `camhead`, `src`, a scratch folder `tmp`
+# removed on exit; fail MESSAGE counts a failure; expect STATUS PATTERN
+# COMMAND... runs the command and checks that it exits with STATUS and says
+# PATTERN.
+set -u
+camhead=$1
+src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
 failures=0
 fail() {
   echo "FAIL: $*"

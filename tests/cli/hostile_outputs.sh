@@ -3,11 +3,6 @@
 # device node where a file goes, a folder, a file-size limit, a profile that
 # fails after the output was named. Each must be refused or leave what was
 # there as it was. Usage: hostile_outputs.sh CAMHEAD SOURCE_DIR
-set -u
-camhead=$1
-src=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
 . "$(dirname "$0")/expect.sh"
 
 measurements=$src/scenes/lenses/example_35mm_measurements.csv

@@ -6,11 +6,6 @@
 # named error with its documented exit status (docs/input-errors.md), and
 # leave every file that was there as it was.
 # Usage: hostile_run.sh CAMHEAD SOURCE_DIR
-set -u
-camhead=$1
-src=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
 . "$(dirname "$0")/expect.sh"
 
 # y4m FILE FRAMES [BAD]: a 64x48 4:2:2 take of FRAMES mid-grey frames (6144

@@ -38,9 +38,7 @@ void check_pose(const pipeline::PoseConfig &pose) {
 }
 
 void build_rig(const pipeline::Board &board) {
-  std::vector<pipeline::OutputSpec> outputs;
-  for (const std::string &uri : board.outputs)
-    outputs.push_back(pipeline::parse_output_uri(uri));
+  const std::vector<pipeline::OutputSpec> outputs = pipeline::parse_output_uris(board.outputs);
   renderer::Scene scene;
   if (board.scene)
     scene.source = *board.scene;
