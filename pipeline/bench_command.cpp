@@ -312,9 +312,10 @@ void add_bench_command(CLI::App &app) {
   cmd->add_flag("--cpu-peer", args->cpu_peer,
                 "Also time the CPU reference on the same frames and print the ratio");
   add_bench_chart_command(*cmd);
-  // `bench chart ...` runs the chart alone.
+  add_bench_live_command(*cmd);
+  // `bench chart ...` and `bench live ...` run alone.
   cmd->callback([args, cmd] {
-    if (!cmd->got_subcommand("chart"))
+    if (!cmd->got_subcommand("chart") && !cmd->got_subcommand("live"))
       set_exit_code(run_bench(*args));
   });
 }

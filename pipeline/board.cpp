@@ -241,8 +241,8 @@ private:
   }
 
   static RenderConfig read_render(const JsonValue &d) {
-    d.object(
-        {}, {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel", "adaptive"});
+    d.object({}, {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel",
+                  "adaptive", "accumulate", "accumulate_tolerance_px", "accumulate_max_samples"});
     RenderConfig render;
     if (const auto executor = d.find("executor")) {
       const std::string e = executor->string();
@@ -267,6 +267,16 @@ private:
                                               std::to_string(render.max_rays_per_pixel) + ")");
     if (d.has("adaptive"))
       render.adaptive = d.at("adaptive").boolean();
+    // An adaptive frame shares its rays by what its own pilot saw: it keeps
+    // no history, so adaptive turns accumulation off unless both are asked.
+    render.accumulate = d.has("accumulate") ? d.at("accumulate").boolean() : !render.adaptive;
+    if (render.accumulate && render.adaptive)
+      d.fail_member("accumulate", "cannot be true with \"adaptive\": true (an adaptive frame "
+                                  "shares its own rays and keeps no history); choose one");
+    if (d.has("accumulate_tolerance_px"))
+      render.accumulate_tolerance_px = d.at("accumulate_tolerance_px").number(Range::within(0.0, 100.0));
+    if (d.has("accumulate_max_samples"))
+      render.accumulate_max_samples = rpp("accumulate_max_samples");
     return render;
   }
 

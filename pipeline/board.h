@@ -33,6 +33,7 @@
 
 #include "camhead/base/config_error.h"
 #include "camhead/base/video_format.h"
+#include "camhead/renderer/frame_history.h"
 
 namespace camhead::pipeline {
 
@@ -186,6 +187,11 @@ struct RenderConfig {
   std::uint32_t max_rays_per_pixel = 64;
   std::optional<std::uint32_t> rays_per_pixel;
   bool adaptive = false;
+  // While the lens and pose hold still, each frame's rays add to the last
+  // frames' (renderer/frame_history.h); off with `adaptive`.
+  bool accumulate = true;
+  double accumulate_tolerance_px = renderer::AccumulationSettings{}.tolerance_px;
+  std::uint32_t accumulate_max_samples = renderer::AccumulationSettings{}.max_samples;
 };
 
 struct Board {

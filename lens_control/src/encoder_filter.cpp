@@ -71,11 +71,19 @@ SpikeRejector::Released SpikeRejector::push(TimedCounts s) {
   return out;
 }
 
+double StillHold::hold(double counts) {
+  if (!primed_ || !(std::abs(counts - held_) <= band_)) {
+    held_ = counts;
+    primed_ = true;
+  }
+  return held_;
+}
+
 SpikeRejector::Released EncoderFilter::push(std::int64_t t_ns, std::int32_t counts) {
   SpikeRejector::Released r = spikes_.push({t_ns, double(counts)});
   for (int i = 0; i < r.count; ++i) {
     TimedCounts &c = r.samples[std::size_t(i)];
-    c.counts = smooth_.filter(c.t_ns, c.counts);
+    c.counts = still_.hold(smooth_.filter(c.t_ns, c.counts));
     last_ = c;
   }
   return r;

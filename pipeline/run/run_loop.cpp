@@ -296,6 +296,9 @@ void Pipeline::render_loop() {
     request.adaptive = board_.render.adaptive;
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     request.influence_region = options_.influence_region;
+    request.accumulation.enabled = board_.render.accumulate;
+    request.accumulation.tolerance_px = board_.render.accumulate_tolerance_px;
+    request.accumulation.max_samples = board_.render.accumulate_max_samples;
     r.rpp = request.rays_per_pixel;
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
@@ -320,7 +323,14 @@ void Pipeline::render_loop() {
     r.decode_s = report.decode_s;
     r.trace_s = report.trace_s;
     r.encode_s = report.encode_s;
-    budget.measured(request.rays_per_pixel, report.decode_s + report.trace_s + report.encode_s);
+    r.history_samples = report.history_samples;
+    // What the frame cost for the rays it traced: a full history traces none,
+    // and its cost says nothing of what the next new one's rays will.
+    const std::uint32_t traced_rpp =
+        !request.accumulation.enabled ? request.rays_per_pixel
+        : report.traced_pixels > 0    ? std::uint32_t(report.camera_rays / report.traced_pixels)
+                                      : 0u;
+    budget.measured(traced_rpp, report.decode_s + report.trace_s + report.encode_s);
     counters_.rpp = request.rays_per_pixel;
     (void)ready_slots_.push(*slot_index);
   }

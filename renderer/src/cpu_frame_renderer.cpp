@@ -29,13 +29,23 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// Accumulating frames: samples every pixel gets before the shares follow
+// the noise (enough for a first estimate of it); a frame's most rays for one
+// pixel, in units of the frame's rays per pixel (no pixel takes a whole
+// frame's budget on one estimate); and the noise floor, relative to the
+// pixel's luminance and absolute.
+constexpr std::uint32_t kPilotSamples = 4;
+constexpr std::uint32_t kMostRaysAPixel = 16;
+constexpr float kNoiseFloor = 0.01f;
+
 class CpuFrameRenderer final : public FrameRenderer {
 public:
   CpuFrameRenderer(const Scene &scene, int threads)
       : scene_(without_plate(scene)), compiled_(compile_scene(scene_)), pool_(threads),
         pixels_(std::size_t(scene_.render.width) * std::size_t(scene_.render.height)),
         plate_(pixels_), composite_(pixels_), mixed_(pixels_, glm::vec4(0.0f)),
-        real_(pixels_, glm::vec4(0.0f)), aux_(pixels_, glm::vec4(0.0f)) {
+        real_(pixels_, glm::vec4(0.0f)), aux_(pixels_, glm::vec4(0.0f)),
+        history_counts_(pixels_, 0u), shares_(pixels_, 0u), noise_(pixels_, 0.0f) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 2 != 0 || h % 2 != 0)
@@ -61,23 +71,50 @@ public:
     if (request.rays_per_pixel == 0)
       return bad_frame("0 rays per pixel");
 
+    if (request.adaptive && request.accumulation.enabled)
+      return bad_frame("adaptive frames do not accumulate");
+
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
     if (request.seed != 0)
       frame.sampling.w = request.seed;
+    const bool continues = request.accumulation.enabled && continues_history(request, frame);
+    if (request.accumulation.enabled) {
+      if (continues) {
+        frame = history_; // its camera and seed, so that the samples stay one pattern's
+      } else {
+        frame.tracing.z = SAMPLER_SOBOL; // progressive: sample i does not depend on the count
+        frame.sampling.z = request.accumulation.max_samples; // the pattern's size
+        history_ = frame;
+        history_valid_ = true;
+        history_by_noise_ = request.accumulation.share_by_noise;
+        history_uniform_ = 0;
+        history_rays_ = 0;
+        history_frames_ = 0;
+      }
+      ++history_frames_;
+      report.history_restarted = !continues;
+    } else {
+      history_valid_ = false;
+    }
     cpu::set_cpu_frame(kernel_, compiled_, frame);
+    if (request.accumulation.enabled) // every sample traced on its own: see trace_pixel
+      kernel_.frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
 
     Clock::time_point start = Clock::now();
-    region_ = request.influence_region ? influence_region(compiled_, frame)
-                                       : whole_frame_region(frame.image.x, frame.image.y);
-    spans_.clear();
-    blocks_.clear();
-    for (const PixelRect &rect : region_.rects)
-      for (std::uint32_t y = rect.y0; y < rect.y1; ++y) {
-        spans_.push_back({y, rect.x0, rect.x1});
-        if ((y - rect.y0) % 2 == 0) // whole tiles: an even number of rows
-          blocks_.push_back({y, rect.x0, rect.x1});
-      }
+    if (!continues) {
+      region_ = request.influence_region ? influence_region(compiled_, frame)
+                                         : whole_frame_region(frame.image.x, frame.image.y);
+      region_kind_ = request.influence_region;
+      spans_.clear();
+      blocks_.clear();
+      for (const PixelRect &rect : region_.rects)
+        for (std::uint32_t y = rect.y0; y < rect.y1; ++y) {
+          spans_.push_back({y, rect.x0, rect.x1});
+          if ((y - rect.y0) % 2 == 0) // whole tiles: an even number of rows
+            blocks_.push_back({y, rect.x0, rect.x1});
+        }
+    }
     report.traced_pixels = region_.pixels();
     report.frame_pixels = pixels_;
     // Outside the region the composite is the camera image, and in the
@@ -103,9 +140,15 @@ public:
     report.decode_s = seconds_since(start);
 
     start = Clock::now();
-    clear_traced();
+    if (!continues)
+      clear_traced();
     const std::uint32_t total = frame.sampling.z;
-    if (!request.adaptive) {
+    if (request.accumulation.enabled) {
+      report.camera_rays = share_rays(request);
+      trace_shares(has_plate);
+      history_rays_ += report.camera_rays;
+      report.history_samples = std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_.pixels(), 1));
+    } else if (!request.adaptive) {
       trace(0u, total, has_plate);
       report.camera_rays = region_.pixels() * total;
     } else {
@@ -127,12 +170,14 @@ public:
     report.trace_s = seconds_since(start);
 
     start = Clock::now();
-    const bool adaptive = request.adaptive;
+    const std::uint32_t *per_pixel = request.accumulation.enabled ? history_counts_.data()
+                                     : request.adaptive             ? counts_.data()
+                                                                    : nullptr;
     // Blocks of two rows: an nv12 chroma row is made from two image rows.
     auto resolve = [&](int y0, int y1, int x0, int x1) {
       for (int y = y0; y < y1; ++y)
         for (std::size_t i = std::size_t(y) * width + x0; i < std::size_t(y) * width + x1; ++i) {
-          const std::uint32_t samples = adaptive ? counts_[i] : kernel_.frame.sampling.z;
+          const std::uint32_t samples = per_pixel != nullptr ? per_pixel[i] : total;
           composite_[i] = glm::vec4(
               kernel_.resolve_pixel(mixed_[i], real_[i], aux_[i], plate_[i], has_plate, samples)
                   .composite,
@@ -162,10 +207,23 @@ public:
     return report;
   }
 
+  std::span<const glm::vec4> last_composite() const override { return composite_; }
+
 private:
   static Scene without_plate(Scene scene) {
     scene.plate.reset();
     return scene;
+  }
+
+  // Whether `frame` may add to the history: the one before accumulated, with
+  // the same settings, and the camera moved less than the tolerance.
+  bool continues_history(const FrameRequest &request, const gpu::FrameParams &frame) const {
+    if (!history_valid_ || request.accumulation.max_samples != history_.sampling.z ||
+        request.accumulation.share_by_noise != history_by_noise_ ||
+        region_kind_ != request.influence_region)
+      return false;
+    const double change = frame_change_px(history_, frame, nearest_depth_m(compiled_, history_));
+    return change <= request.accumulation.tolerance_px;
   }
 
   // Rows of every plane (nv12's chroma rows after the luma rows).
@@ -194,9 +252,109 @@ private:
       std::fill(&mixed_[row + span.x0], &mixed_[row + span.x1], glm::vec4(0.0f));
       std::fill(&real_[row + span.x0], &real_[row + span.x1], glm::vec4(0.0f));
       std::fill(&aux_[row + span.x0], &aux_[row + span.x1], glm::vec4(0.0f));
+      std::fill(&history_counts_[row + span.x0], &history_counts_[row + span.x1], 0u);
     };
     pool_.run(int(traced_spans_.size()), clear);
     traced_spans_ = spans_; // what this frame leaves in them
+  }
+
+  // An accumulating frame's rays, pixel by pixel (shares_), within the
+  // frame's budget of rays_per_pixel for each pixel of the region; returns
+  // their sum. The first kPilotSamples of a history go to every pixel alike;
+  // from there, with share_by_noise, each frame's rays go where the image
+  // still lacks them: toward each pixel holding a share of all the rays so
+  // far proportional to its noise (the standard deviation of its samples'
+  // composite luminance, the largest in its 3x3 neighbourhood so that an edge
+  // that a few samples missed still gets rays, plus a floor), which for
+  // noise sigma_i minimises the sum of sigma_i^2 / n_i for the rays given.
+  std::uint64_t share_rays(const FrameRequest &request) {
+    const std::uint32_t most = request.accumulation.max_samples;
+    const std::uint32_t rpp = request.rays_per_pixel;
+    const bool by_noise = request.accumulation.share_by_noise && history_uniform_ >= kPilotSamples;
+    std::uint64_t rays = 0;
+    if (!by_noise) {
+      const std::uint32_t k = std::min(rpp, most - std::min(most, history_uniform_));
+      for (const RowSpan &span : spans_)
+        for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i)
+          shares_[i] = k;
+      history_uniform_ += k;
+      return region_.pixels() * k;
+    }
+    const int width = scene_.render.width;
+    const int height = scene_.render.height;
+    double noise_sum = 0.0;
+    double samples_sum = 0.0;
+    for (const RowSpan &span : spans_)
+      for (std::uint32_t x = span.x0; x < span.x1; ++x) {
+        float sigma = 0.0f;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = int(x) + dx, ny = int(span.y) + dy;
+            if (nx >= 0 && ny >= 0 && nx < width && ny < height)
+              sigma = std::max(sigma, luminance_sigma(index(std::uint32_t(ny), std::uint32_t(nx))));
+          }
+        const std::size_t i = index(span.y, x);
+        const float n = float(history_counts_[i]);
+        noise_[i] = sigma + kNoiseFloor * (aux_[i].z / n) + kNoiseFloor;
+        noise_sum += noise_[i];
+        samples_sum += n;
+      }
+    // Each pixel's way to its share of the rays after this frame.
+    const double after = samples_sum + double(region_.pixels()) * rpp;
+    double lack_sum = 0.0;
+    for (const RowSpan &span : spans_)
+      for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
+        const double lack = std::max(0.0, after * noise_[i] / noise_sum - history_counts_[i]);
+        noise_[i] = float(lack);
+        lack_sum += lack;
+      }
+    const double scale = lack_sum > 0.0 ? double(region_.pixels()) * rpp / lack_sum : 0.0;
+    for (const RowSpan &span : spans_)
+      for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
+        // Rounded up or down at random (a hash of the pixel and the frame),
+        // so that the shares add up to the budget on average.
+        const double want = noise_[i] * scale;
+        const double whole = std::floor(want);
+        const double u = double(kernel_.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ history_frames_)) *
+                         (1.0 / 4294967296.0);
+        const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
+        shares_[i] = std::min({k, kMostRaysAPixel * rpp, most - history_counts_[i]});
+        rays += shares_[i];
+      }
+    return rays;
+  }
+
+  // The standard deviation of pixel i's samples' composite luminance (aux.z
+  // and aux.w hold its sum and sum of squares); 0 outside the history.
+  float luminance_sigma(std::size_t i) const {
+    const float n = float(history_counts_[i]);
+    if (n < 2.0f)
+      return 0.0f;
+    const float mean = aux_[i].z / n;
+    const float variance = (aux_[i].w / n - mean * mean) * n / (n - 1.0f);
+    return std::sqrt(std::max(variance, 0.0f));
+  }
+
+  std::size_t index(std::uint32_t y, std::uint32_t x) const {
+    return std::size_t(y) * std::size_t(scene_.render.width) + x;
+  }
+
+  // Each pixel's share of the frame's rays, the samples after those it holds.
+  void trace_shares(bool has_plate) {
+    auto row = [&](int k) {
+      const RowSpan &span = spans_[std::size_t(k)];
+      cpu::CpuKernel kernel = kernel_; // its own sample range per pixel
+      for (std::uint32_t x = span.x0; x < span.x1; ++x) {
+        const std::size_t i = index(span.y, x);
+        if (shares_[i] == 0)
+          continue;
+        kernel.frame.sampling.x = history_counts_[i];
+        kernel.frame.sampling.y = history_counts_[i] + shares_[i];
+        kernel.trace_pixel(x, span.y, plate_[i], has_plate, mixed_[i], real_[i], aux_[i]);
+        history_counts_[i] += shares_[i];
+      }
+    };
+    pool_.run(int(spans_.size()), row);
   }
 
   // Samples [first, end) of the region's pixels into the accumulators.
@@ -227,6 +385,17 @@ private:
   std::vector<RowSpan> spans_;                // this frame's region, row by row
   std::vector<RowSpan> blocks_;               // ... and by pairs of rows
   std::vector<RowSpan> traced_spans_;         // what the accumulators hold
+  // The history: the accumulators' camera and pattern, and what they hold.
+  gpu::FrameParams history_{};
+  bool history_valid_ = false;
+  bool history_by_noise_ = false;
+  std::uint32_t history_uniform_ = 0; // samples every pixel has (the uniform frames')
+  std::uint64_t history_rays_ = 0;
+  std::uint32_t history_frames_ = 0;
+  std::vector<std::uint32_t> history_counts_; // samples per pixel
+  std::vector<std::uint32_t> shares_;         // this frame's rays per pixel
+  std::vector<float> noise_;                  // each pixel's noise, for the shares
+  bool region_kind_ = true;                   // the region's: request.influence_region
 };
 
 } // namespace

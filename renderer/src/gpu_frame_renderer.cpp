@@ -56,6 +56,12 @@ public:
       const RenderResult result = tracer_.render_video(
           frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, &region_);
       report.camera_rays = result.camera_rays;
+      // No history on this executor yet: an accumulating frame starts one
+      // and ends it, which is what the report says.
+      if (request.accumulation.enabled) {
+        report.history_samples = request.rays_per_pixel;
+        report.history_restarted = true;
+      }
       // The conversions run on the device inside the frame's one
       // submission: their time is part of the trace time here.
       report.trace_s = result.timings.device_s > 0.0 ? result.timings.device_s : result.seconds;

@@ -85,14 +85,18 @@ TEST(EncoderFilter, StepLatency) {
     // Counted from the first sample that shows the step: 0 means that sample's
     // output already reached 90 %.
     std::printf("[ lens ] step of %5.0f counts: 90%% after %2d samples (%3.0f ms) One Euro alone, "
-                "%2d samples (%3.0f ms) with spike rejection\n",
+                "%2d samples (%3.0f ms) through the whole chain\n",
                 size, a, a * kDtS * 1e3, b, b * kDtS * 1e3);
     if (size == 2000.0) {
       large_euro = a;
       large_chain = b;
     }
-    // The spike rejector adds at most one sample, and only to jumps above its threshold.
-    EXPECT_LE(b - a, size > params.spike_threshold_counts ? 1 : 0) << size;
+    // The spike rejector adds at most one sample, and only to jumps above
+    // its threshold; the still hold at most one (it trails the filter by
+    // less than its band).
+    const int spike_hold = size > params.spike_threshold_counts ? 1 : 0;
+    const int still_hold = params.hold_counts > 0.0 ? 1 : 0;
+    EXPECT_LE(b - a, spike_hold + still_hold) << size;
   }
   // A large step drives the speed estimate up at once: the first update's
   // cutoff is min_cutoff + beta * alpha_d * step / dt, which for these
@@ -159,6 +163,56 @@ TEST(EncoderFilter, StillLensJitter) {
   EXPECT_GT(raw_sd / out_sd, 3.0);
   EXPECT_LT(raw_sd / out_sd, floor_factor * 1.5);
   EXPECT_EQ(chain.spikes_rejected(), 0u);
+}
+
+// The lens state a renderer sees at 25 fps, read from the filtered stream
+// (every fourth of the 100 Hz samples), for the raw counts `raw`.
+std::vector<double> frame_reads(const EncoderFilterParams &params, const std::vector<double> &raw) {
+  EncoderFilter chain(params);
+  const std::vector<double> y = run(
+      int(raw.size()), [&](int i) { return raw[std::size_t(i)]; }, full_chain(chain));
+  std::vector<double> frames;
+  for (std::size_t i = 0; i < y.size(); i += 4)
+    frames.push_back(y[i]);
+  return frames;
+}
+
+TEST(EncoderFilter, AStillRingGivesTheSameValueFrameAfterFrame) {
+  // StillLensJitter's noise, 30 s of it: the One Euro output alone moves
+  // every frame, and a renderer would start its history afresh every frame
+  // (frame_history.h); with the still hold it changes on few frames.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_int_distribution<int> lsb(-1, 1);
+  std::vector<double> raw;
+  for (int i = 0; i < 3000; ++i)
+    raw.push_back(std::round(2000.4 + gauss(rng)) + lsb(rng));
+  const auto changed = [](const std::vector<double> &frames) {
+    int n = 0;
+    for (std::size_t i = 26; i < frames.size(); ++i) // from the second second on
+      n += frames[i] != frames[i - 1];
+    return double(n) / double(frames.size() - 26);
+  };
+  EncoderFilterParams no_hold;
+  no_hold.hold_counts = 0.0;
+  const EncoderFilterParams held;
+  const double without = changed(frame_reads(no_hold, raw));
+  const double with = changed(frame_reads(held, raw));
+  std::printf("[ lens ] still ring, 1-count noise: the value changes on %.1f %% of frames "
+              "without the hold, %.1f %% with a %.2f-count hold\n",
+              100.0 * without, 100.0 * with, held.hold_counts);
+  EXPECT_GT(without, 0.99);
+  EXPECT_LT(with, 0.05);
+
+  // Without noise, a ring that moved and stopped is exactly still once the
+  // filter is within the band, and stays within the band of where it
+  // stopped.
+  std::vector<double> move(400, 3000.0);
+  for (int i = 0; i < 100; ++i)
+    move[std::size_t(i)] = 2000.0 + 10.0 * i;
+  const std::vector<double> frames = frame_reads(held, move);
+  EXPECT_EQ(frames.back(), frames[frames.size() - 25]); // the last second: one value
+  EXPECT_LE(std::abs(frames.back() - 3000.0), held.hold_counts);
 }
 
 TEST(EncoderFilter, RejectsSingleSpikesOnStillAndMovingLens) {

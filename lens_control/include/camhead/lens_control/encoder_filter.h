@@ -1,5 +1,6 @@
 // Per-axis encoder filtering, in raw counts: a spike rejector, then a One Euro
-// filter (Casiraghi, Roussel & Vogel, CHI 2012), then dropout detection.
+// filter (Casiraghi, Roussel & Vogel, CHI 2012), then a still hold, then
+// dropout detection.
 //
 // Why filter counts and not distances: the noise is in the counts (one count
 // of quantisation, electrical noise, a missed quadrature edge). After the
@@ -79,18 +80,43 @@ private:
   std::uint64_t rejected_ = 0;
 };
 
+// Holds the filtered value exactly while it stays within `band` counts of
+// the value last let through. A ring at rest then gives the renderer the same
+// lens state frame after frame, so that its samples can add up
+// (renderer/frame_history.h); the One Euro output alone creeps by fractions
+// of a count for seconds after a move and jitters with encoder noise for
+// ever. A move passes once it leaves the band, trailing it by at most `band`
+// counts, and a ring that stops is reported within `band` counts of where
+// the filter settles. A band of 0 holds nothing.
+class StillHold {
+public:
+  explicit StillHold(double band_counts) : band_(band_counts) {}
+  [[nodiscard]] double hold(double counts);
+  void reset() { primed_ = false; }
+
+private:
+  double band_;
+  bool primed_ = false;
+  double held_ = 0.0;
+};
+
 struct EncoderFilterParams {
   OneEuroParams one_euro;
+  // StillHold's band: below the encoder's own resolution (1 count), above
+  // most of the filtered noise (0.28 counts rms for 1-count Gaussian noise
+  // on the raw counts, bench/RESULTS.md).
+  double hold_counts = 1.0;
   double spike_threshold_counts = 64.0;
   // No sample for longer than this: the held value is reported stale.
   std::int64_t stale_after_ns = 50'000'000;
 };
 
-// Spike rejector, One Euro filter and dropout detection for one axis.
+// Spike rejector, One Euro filter, still hold and dropout detection for one
+// axis.
 class EncoderFilter {
 public:
   explicit EncoderFilter(EncoderFilterParams p = {})
-      : p_(p), spikes_(p.spike_threshold_counts), smooth_(p.one_euro) {}
+      : p_(p), spikes_(p.spike_threshold_counts), smooth_(p.one_euro), still_(p.hold_counts) {}
 
   // Feeds one raw sample; returns the filtered samples it releases (0 to 2,
   // oldest first, at their own timestamps) for the time alignment.
@@ -107,6 +133,7 @@ private:
   EncoderFilterParams p_;
   SpikeRejector spikes_;
   OneEuroFilter smooth_;
+  StillHold still_;
   std::optional<TimedCounts> last_;
 };
 

@@ -14,9 +14,12 @@
 #include <span>
 #include <string>
 
+#include <glm/vec4.hpp>
+
 #include "camhead/base/video_format.h"
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/frame_camera.h"
+#include "camhead/renderer/frame_history.h"
 #include "camhead/renderer/scene.h"
 
 namespace camhead::renderer {
@@ -36,8 +39,14 @@ struct FrameRequest {
   std::uint32_t rays_per_pixel = 1; // the mean, for adaptive frames
   bool adaptive = false;
   AdaptiveSampling adaptive_settings;
-  // The frame's own noise pattern; 0 takes the scene's render.seed.
+  // The frame's own noise pattern; 0 takes the scene's render.seed. An
+  // accumulating frame that continues a history keeps the history's.
   std::uint32_t seed = 0;
+  // Add this frame's `rays_per_pixel` samples to those of the frames before
+  // while the camera stays within the tolerance (frame_history.h); not with
+  // `adaptive`. The GPU executor keeps no history yet: each of its frames
+  // starts one afresh (FrameReport says so).
+  AccumulationSettings accumulation;
   // Trace only where the virtual objects can change the composite
   // (influence_region.h); the outputs are the same bit for bit. False
   // traces every pixel, for comparison.
@@ -57,6 +66,11 @@ struct FrameReport {
   // Pixels traced (the influence region's) of the frame's.
   std::uint64_t traced_pixels = 0;
   std::uint64_t frame_pixels = 0;
+  // Accumulating frames: the samples per pixel the image holds, and whether
+  // this frame started a new history (the camera moved, or the one before
+  // did not accumulate).
+  std::uint32_t history_samples = 0;
+  bool history_restarted = false;
   // Where the frame's time went, seconds: converting the plate in, tracing
   // (and compositing), converting the composite out.
   double decode_s = 0.0;
@@ -80,6 +94,11 @@ public:
   // without bytes is none, and the outputs get I_m (the scene as rendered).
   [[nodiscard]] virtual FrameReport render(const FrameRequest &request, const VideoFrame &plate,
                                            std::span<const VideoBuffer> outputs) = 0;
+
+  // The last frame's composite in linear RGB (alpha unused), row by row, for
+  // measurement before the outputs' 8-bit rounding: set over the frame's
+  // influence region only. Empty on an executor that keeps it on the device.
+  [[nodiscard]] virtual std::span<const glm::vec4> last_composite() const { return {}; }
 };
 
 // The CPU reference tracer (cpu_tracer.h) as a frame renderer, on `threads`

@@ -1,0 +1,362 @@
+// camhead bench live: the live frame's virtual image as a viewer sees it, as
+// error against time (issue 24's targets). For each lens state the live
+// renderer (the CPU reference frame renderer that `camhead run` drives)
+// renders a still shot frame after frame at the rays per frame the rig holds
+// at the camera's rate, accumulating (frame_history.h), and each frame's
+// composite is measured against a converged render of the same camera; so
+// are fresh frames of 1, 9 and 49 rays per pixel (the paper's settings, in
+// the same run), and the frames of a focus pull, where every frame starts a
+// new history. Error = relative RMSE of the composite over the influence
+// region (elsewhere the composite is the camera image, exactly), in linear
+// light before the outputs' 8-bit rounding.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "camhead/base/video_format.h"
+#include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/image.h"
+#include "camhead/renderer/image_io.h"
+#include "camhead/renderer/influence_region.h"
+#include "camhead/renderer/scene_loader.h"
+#include "chart_plot.h"
+#include "commands.h"
+#include "data_dir.h"
+#include "progress.h"
+
+namespace camhead::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace renderer;
+
+struct LiveArgs {
+  fs::path scene;
+  fs::path out_dir = "bench";
+  int ref_rpp = 1024;
+  std::uint32_t rpp = 1; // rays per live frame
+  int frames = 50;
+  double fps = 25.0;
+  int threads = 0;
+};
+
+// A lens state of the rig (scenes/lenses/make_sim_focus_pull.py's holds).
+struct LensPoint {
+  std::string name;
+  float focus_m;
+  float f_number;
+};
+
+base::VideoFormat rgb24(const Scene &scene) {
+  base::VideoFormat f;
+  f.pixel = base::PixelFormat::rgb24;
+  f.width = scene.render.width;
+  f.height = scene.render.height;
+  f.range = base::ColorRange::full;
+  return f;
+}
+
+FrameCamera camera_at(const Scene &scene, const LensPoint &lens) {
+  FrameCamera camera = scene_camera(scene);
+  camera.focus_distance_m = lens.focus_m;
+  camera.f_number = lens.f_number;
+  return camera;
+}
+
+// One lens state's measurements: a renderer, the camera frame it composites
+// into (the real proxy as this lens sees it, standing in for the camera),
+// the reference and the region.
+class Shot {
+public:
+  Shot(const Scene &scene, const CompiledScene &compiled, const LensPoint &lens,
+       const LiveArgs &args)
+      : scene_(scene), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
+        renderer_(make_cpu_frame_renderer(scene, args.threads)) {
+    // The camera image: the proxy alone through the same lens, 16 rpp.
+    Scene real = scene;
+    std::erase_if(real.objects, [](const Object &o) { return !o.real; });
+    auto real_renderer = make_cpu_frame_renderer(real, args.threads);
+    plate_.resize(base::frame_bytes(format_));
+    out_.resize(base::frame_bytes(format_));
+    FrameRequest plate_request;
+    plate_request.camera = camera_;
+    plate_request.rays_per_pixel = 16;
+    const VideoBuffer plate_target{format_, plate_};
+    check(real_renderer->render(plate_request, {}, std::span(&plate_target, 1)), "the plate");
+
+    gpu::FrameParams frame = make_frame_params(scene, camera_);
+    frame.image.z = 1u;
+    const InfluenceRegion region = influence_region(compiled, frame);
+    for (const PixelRect &r : region.rects)
+      for (std::uint32_t y = r.y0; y < r.y1; ++y)
+        for (std::uint32_t x = r.x0; x < r.x1; ++x)
+          region_pixels_.push_back(std::size_t(y) * std::size_t(scene.render.width) + x);
+
+    ProgressLine progress(lens.name + ": reference, " + std::to_string(args.ref_rpp) + " rpp");
+    FrameRequest reference;
+    reference.camera = camera_;
+    reference.rays_per_pixel = std::uint32_t(args.ref_rpp);
+    reference.seed = 0x5eedu;
+    render(reference, "the reference");
+    progress.finish();
+    const std::span<const glm::vec4> c = renderer_->last_composite();
+    reference_.assign(c.begin(), c.end());
+  }
+
+  // A fresh frame of `rpp`, nothing accumulated (the live default before).
+  double uniform_error(std::uint32_t rpp, std::uint32_t seed) {
+    FrameRequest request;
+    request.camera = camera_;
+    request.rays_per_pixel = rpp;
+    request.seed = seed;
+    render(request, std::to_string(rpp) + " rpp");
+    return error();
+  }
+
+  // The live frame: `rpp` more rays while the camera holds still.
+  double live_error(std::uint32_t rpp, std::uint32_t seed, std::uint32_t *history) {
+    FrameRequest request;
+    request.camera = camera_;
+    request.rays_per_pixel = rpp;
+    request.seed = seed;
+    request.accumulation.enabled = true;
+    *history = render(request, "a live frame").history_samples;
+    return error();
+  }
+
+  [[nodiscard]] double region_fraction() const {
+    return double(region_pixels_.size()) / double(std::size_t(format_.width) * format_.height);
+  }
+
+private:
+  static void check(const FrameReport &report, const std::string &what) {
+    if (report.status != FrameStatus::ok)
+      throw std::runtime_error(what + ": " + report.detail);
+  }
+
+  FrameReport render(const FrameRequest &request, const std::string &what) {
+    const VideoBuffer target{format_, out_};
+    const FrameReport report = renderer_->render(request, {format_, plate_}, std::span(&target, 1));
+    check(report, what);
+    return report;
+  }
+
+  // Relative RMSE (compare.py's: RMSE / RMS of the reference) of the last
+  // composite over the region.
+  double error() const {
+    const std::span<const glm::vec4> c = renderer_->last_composite();
+    double diff = 0.0, ref = 0.0;
+    for (const std::size_t i : region_pixels_)
+      for (int k = 0; k < 3; ++k) {
+        const double a = reference_[i][k], b = c[i][k];
+        diff += (a - b) * (a - b);
+        ref += a * a;
+      }
+    return std::sqrt(diff / ref);
+  }
+
+  const Scene &scene_;
+  FrameCamera camera_;
+  base::VideoFormat format_;
+  std::unique_ptr<FrameRenderer> renderer_;
+  std::vector<std::uint8_t> plate_, out_;
+  std::vector<std::size_t> region_pixels_;
+  std::vector<glm::vec4> reference_;
+};
+
+struct RestCurve {
+  LensPoint lens;
+  double region = 0.0;
+  double uniform1 = 0.0, uniform9 = 0.0, uniform49 = 0.0;
+  std::vector<double> seconds, error;
+  std::vector<std::uint32_t> samples;
+};
+
+std::string fmt(double v, const char *f = "%.4f") {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+// The first frame (1-based) whose error is at most `target`, or 0.
+std::size_t frames_to(const RestCurve &c, double target) {
+  for (std::size_t k = 0; k < c.error.size(); ++k)
+    if (c.error[k] <= target)
+      return k + 1;
+  return 0;
+}
+
+void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
+                   const std::vector<RestCurve> &pull) {
+  fs::create_directories(args.out_dir);
+  const fs::path csv_path = args.out_dir / "live.csv";
+  std::ofstream csv(csv_path);
+  if (!csv)
+    throw std::runtime_error("cannot write " + csv_path.string());
+  csv << "shot,lens,frame,seconds,history_samples,error,uniform_1,uniform_9,uniform_49\n";
+  for (const auto *set : {&rest, &pull})
+    for (const RestCurve &c : *set)
+      for (std::size_t k = 0; k < c.error.size(); ++k)
+        csv << (set == &rest ? "still" : "pull") << "," << c.lens.name << "," << k + 1 << ","
+            << fmt(c.seconds[k]) << "," << c.samples[k] << "," << fmt(c.error[k], "%.6g") << ","
+            << fmt(c.uniform1, "%.6g") << "," << fmt(c.uniform9, "%.6g") << ","
+            << fmt(c.uniform49, "%.6g") << "\n";
+  std::printf("wrote %s\n", csv_path.string().c_str());
+
+  std::vector<chart::Panel> panels;
+  for (const RestCurve &c : rest) {
+    chart::Panel panel;
+    panel.title = c.lens.name;
+    panel.x_label = "seconds since the lens came to rest";
+    panel.y_label = "rel. RMSE over the region";
+    chart::Series live{"live, " + std::to_string(args.rpp) + " rpp a frame, accumulated",
+                       {30, 90, 200}, chart::Marker::circle, c.seconds, c.error, {}};
+    const double x0 = c.seconds.front(), x1 = c.seconds.back();
+    chart::Series u9{"uniform 9 rpp", {200, 120, 30}, chart::Marker::square, {x0, x1},
+                     {c.uniform9, c.uniform9}, {}};
+    chart::Series u49{"uniform 49 rpp", {30, 150, 60}, chart::Marker::diamond, {x0, x1},
+                      {c.uniform49, c.uniform49}, {}};
+    panel.series = {live, u9, u49};
+    panels.push_back(std::move(panel));
+  }
+  const chart::Canvas canvas =
+      chart::plot_log_log("camhead run, still shots: error against time", panels, 520, 420);
+  Image image(canvas.width, canvas.height, 3);
+  for (std::size_t i = 0; i < canvas.rgb.size(); ++i)
+    image.data[i] = srgb_to_linear(canvas.rgb[i] / 255.0f);
+  const fs::path png = args.out_dir / "live.png";
+  write_image(png, image);
+  std::printf("wrote %s\n", png.string().c_str());
+}
+
+int run_live(const LiveArgs &args) {
+  try {
+    const fs::path scene_file =
+        args.scene.empty() ? pipeline::data_dir() / "scenes" / "sim_rig.json" : args.scene;
+    const Scene scene = load_scene(scene_file);
+    const CompiledScene compiled = compile_scene(scene);
+    const double frame_s = 1.0 / args.fps;
+    // The rig's holds and its pull (make_sim_focus_pull.py): far at f/4,
+    // near at f/2, and the scene's own focus.
+    const std::vector<LensPoint> still = {
+        {"far 14 m f/4", 14.0f, 4.0f},
+        {"scene " + fmt(scene.camera.focus_distance_m, "%.1f") + " m f/" +
+             fmt(scene.camera.f_number, "%.1f"),
+         scene.camera.focus_distance_m, scene.camera.f_number},
+        {"near 0.4 m f/2", 0.4f, 2.0f}};
+    std::vector<LensPoint> pulling;
+    for (int k = 0; k < 5; ++k) {
+      const float w = 1.0f / 14.0f + (1.0f / 0.4f - 1.0f / 14.0f) * float(k) / 4.0f;
+      pulling.push_back({"pull " + fmt(1.0 / w, "%.2f") + " m f/2.8", 1.0f / w, 2.8f});
+    }
+
+    std::vector<RestCurve> rest, pull;
+    for (const bool is_still : {true, false})
+      for (const LensPoint &lens : is_still ? still : pulling) {
+        Shot shot(scene, compiled, lens, args);
+        RestCurve c;
+        c.lens = lens;
+        c.region = shot.region_fraction();
+        c.uniform1 = shot.uniform_error(1, 0x1001u);
+        c.uniform9 = shot.uniform_error(9, 0x1009u);
+        c.uniform49 = shot.uniform_error(49, 0x1049u);
+        // Still: frame after frame; pulling: each frame a new history, one.
+        const int frames = is_still ? args.frames : 1;
+        for (int k = 0; k < frames; ++k) {
+          std::uint32_t samples = 0;
+          c.error.push_back(shot.live_error(args.rpp, 0x2000u + std::uint32_t(k), &samples));
+          c.samples.push_back(samples);
+          c.seconds.push_back((k + 1) * frame_s);
+        }
+        (is_still ? rest : pull).push_back(std::move(c));
+      }
+
+    std::printf("\n%s, %dx%d, reference %d rpp; live: %u rpp a frame at %.0f fps\n\n",
+                scene_file.string().c_str(), scene.render.width, scene.render.height,
+                args.ref_rpp, args.rpp, args.fps);
+    std::printf("| still shot | region | uniform 1 / 9 / 49 rpp | live after 1 / 5 / 12 / 25 / "
+                "%d frames | frames to 9 rpp's error | frames to 49 rpp's |\n|---|---|---|---|---|"
+                "---|\n",
+                args.frames);
+    for (const RestCurve &c : rest) {
+      const auto at = [&](int k) {
+        return k <= int(c.error.size()) ? fmt(c.error[std::size_t(k - 1)]) : std::string("-");
+      };
+      const auto when = [&](double target) {
+        const std::size_t k = frames_to(c, target);
+        return k == 0 ? std::string("not in ") + std::to_string(c.error.size())
+                      : std::to_string(k) + " (" + fmt(double(k) * frame_s, "%.2f") + " s)";
+      };
+      std::printf("| %s | %.1f %% | %s / %s / %s | %s / %s / %s / %s / %s | %s | %s |\n",
+                  c.lens.name.c_str(), 100.0 * c.region, fmt(c.uniform1).c_str(),
+                  fmt(c.uniform9).c_str(), fmt(c.uniform49).c_str(), at(1).c_str(), at(5).c_str(),
+                  at(12).c_str(), at(25).c_str(), at(args.frames).c_str(),
+                  when(c.uniform9).c_str(), when(c.uniform49).c_str());
+    }
+    std::printf("\n| pull frame | region | uniform 1 / 9 / 49 rpp | live frame |\n|---|---|---|---|\n");
+    for (const RestCurve &c : pull)
+      std::printf("| %s | %.1f %% | %s / %s / %s | %s |\n", c.lens.name.c_str(), 100.0 * c.region,
+                  fmt(c.uniform1).c_str(), fmt(c.uniform9).c_str(), fmt(c.uniform49).c_str(),
+                  fmt(c.error.front()).c_str());
+    std::printf("\n");
+    write_outputs(args, rest, pull);
+    return 0;
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "bench live: %s\n", e.what());
+    return 1;
+  }
+}
+
+} // namespace
+
+void add_bench_live_command(CLI::App &bench) {
+  auto args = std::make_shared<LiveArgs>();
+  CLI::App *cmd = bench.add_subcommand(
+      "live",
+      "The live frame's error against time, as camhead run renders it on the CPU\n"
+      "reference: for three still lens states (the simulated rig's far and near\n"
+      "holds and the scene's own focus) each frame's composite after the lens\n"
+      "came to rest, accumulating --rpp rays a frame, and for five states of a\n"
+      "focus pull a frame that starts afresh; each against a --ref-rpp reference\n"
+      "of the same camera and against fresh frames of 1, 9 and 49 rays per pixel\n"
+      "measured in the same run. Error: relative RMSE of the composite over the\n"
+      "influence region, linear light. Writes DIR/live.csv and DIR/live.png.\n"
+      "About 5 minutes on 2 cores for the simulated rig.\n"
+      "Example:\n"
+      "  camhead bench live -o /tmp/live");
+  cmd->add_option("--scene", args->scene, "Scene file (default: the simulated rig's)")
+      ->check(path_text() & CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->out_dir, "Output folder (created if absent)")
+      ->capture_default_str()
+      ->check(path_text());
+  cmd->add_option("--rpp", args->rpp,
+                  "Rays per pixel of each live frame: what the frame budget holds at the\n"
+                  "camera's rate (camhead run's status line; 1 on 2 cores)")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  cmd->add_option("--frames", args->frames, "Still frames after rest")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  cmd->add_option("--fps", args->fps, "The camera's rate, for the time axis")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  cmd->add_option("--ref-rpp", args->ref_rpp, "Rays per pixel of the reference")
+      ->check(CLI::Range(2, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "CPU threads (0 = all cores)")
+      ->capture_default_str();
+  cmd->callback([args] { set_exit_code(run_live(*args)); });
+}
+
+} // namespace camhead::cli

@@ -1,0 +1,79 @@
+#include "camhead/renderer/frame_history.h"
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+namespace camhead::renderer {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+glm::dvec3 xyz(const gpu::vec4 &v) { return {v.x, v.y, v.z}; }
+
+// Blur-circle radius, pixels, of a point at inverse depth w (1/m): a point
+// at depth z is seen by the pixels within f A |1/z - 1/F| of its pinhole
+// projection (influence_region.cpp, step 2).
+double blur_radius_px(const gpu::FrameParams &f, double w) {
+  return double(f.lens.x) * double(f.lens.z) * std::abs(w - 1.0 / double(f.lens.y));
+}
+
+} // namespace
+
+double nearest_depth_m(const CompiledScene &scene, const gpu::FrameParams &frame) {
+  if (scene.nodes.empty())
+    return kNearestDepthM;
+  const gpu::BvhNode &root = scene.nodes.front();
+  const glm::dvec3 lo = xyz(root.bmin);
+  const glm::dvec3 hi = xyz(root.bmax);
+  if (!(std::abs(lo.x) < 1e30)) // the empty BVH: nothing to see
+    return kNearestDepthM;
+  const glm::dvec3 pupil = xyz(frame.cam_position) - glm::dvec3(scene.origin);
+  const glm::dvec3 forward = xyz(frame.cam_forward);
+  double nearest = kInfinity;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 p((corner & 1) != 0 ? hi.x : lo.x, (corner & 2) != 0 ? hi.y : lo.y,
+                       (corner & 4) != 0 ? hi.z : lo.z);
+    nearest = std::min(nearest, glm::dot(p - pupil, forward));
+  }
+  return std::max(nearest, kNearestDepthM);
+}
+
+double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, double nearest_m) {
+  // What no tolerance covers: the view turning (its axes are compared
+  // exactly: only a pose source turns them, and a tracked pose that jitters
+  // is issue 25's to model), and what is not the camera.
+  if (a.cam_right != b.cam_right || a.cam_up != b.cam_up || a.cam_forward != b.cam_forward ||
+      a.lens.w != b.lens.w || a.world_color != b.world_color || a.image != b.image ||
+      a.tracing.x != b.tracing.x)
+    return kInfinity;
+  const double width = a.image.x;
+  const double height = a.image.y;
+  const double f = a.lens.z;
+  // The farthest a visible point lies from the image centre, as a tangent.
+  const double max_tan = 0.5 * std::hypot(width, height) / f;
+  // 1. Position. A point at depth z >= nearest seen at u = f x / z moves by
+  //    (f / z)(|dx| + max_tan |dz|) <= |dp| (f + f max_tan) / nearest when
+  //    the pupil moves by dp (the entrance pupil follows focus and zoom),
+  //    and by |df| max_tan when the image scale f breathes.
+  const double moved = glm::length(xyz(b.cam_position) - xyz(a.cam_position));
+  double change = moved * f * (1.0 + max_tan) / nearest_m;
+  change += std::abs(double(b.lens.z) - f) * max_tan;
+  // 2. Blur. The difference of the two radii is piecewise linear in w = 1/z
+  //    over [0, 1/nearest], with kinks at the focal planes: its largest
+  //    magnitude is at an end or a kink.
+  const double w_far = 0.0;
+  const double w_near = 1.0 / nearest_m;
+  double blur = 0.0;
+  for (const double w : {w_far, w_near, 1.0 / double(a.lens.y), 1.0 / double(b.lens.y)})
+    if (w >= w_far && w <= w_near)
+      blur = std::max(blur, std::abs(blur_radius_px(b, w) - blur_radius_px(a, w)));
+  change += blur;
+  return std::isfinite(change) ? change : kInfinity;
+}
+
+} // namespace camhead::renderer

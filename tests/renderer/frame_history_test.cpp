@@ -1,0 +1,328 @@
+// Accumulation while the camera holds still (frame_history.h): N still frames
+// of one sample each are one frame of N samples, bit for bit; a change of
+// focus, aperture, image scale or pose beyond the tolerance starts afresh, so
+// the first frame after a jump carries nothing of the frames before it; and
+// pass-through and the influence region stay exact with it on.
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "camhead/base/video_format.h"
+#include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/frame_history.h"
+#include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/influence_region.h"
+#include "test_scenes.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::renderer {
+namespace {
+
+constexpr int kWidth = 64;
+constexpr int kHeight = 48;
+
+// A virtual ball defocused in front of a real crate on a real floor, lit by
+// a point light: blur, a shadow on the proxy, and a depth edge.
+Scene ball_scene() {
+  Scene scene = test::empty_scene("history", 2.0f, 2.0f, kWidth, kHeight);
+  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
+  scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
+  scene.objects.push_back(test::box("crate", {0.3f, -0.3f, -3.0f}, glm::vec3(0.4f), 0, true));
+  scene.objects.push_back(test::sphere("ball", {-0.2f, -0.25f, -1.2f}, 0.2f, 1, false));
+  Light light;
+  light.type = LightType::point;
+  light.position = {-1.0f, 2.0f, -1.0f};
+  light.power_W = 200.0f;
+  scene.lights.push_back(light);
+  return scene;
+}
+
+base::VideoFormat rgb24() {
+  base::VideoFormat f;
+  f.pixel = base::PixelFormat::rgb24;
+  f.width = kWidth;
+  f.height = kHeight;
+  f.range = base::ColorRange::full;
+  return f;
+}
+
+std::vector<std::uint8_t> camera_frame() {
+  std::vector<std::uint8_t> bytes(base::frame_bytes(rgb24()));
+  std::mt19937 rng(11);
+  for (std::uint8_t &b : bytes)
+    b = std::uint8_t(64 + rng() % 128);
+  return bytes;
+}
+
+// Renders frames with one renderer and keeps what the last one gave.
+class Frames {
+public:
+  explicit Frames(const Scene &scene) : renderer_(make_cpu_frame_renderer(scene, 2)) {}
+
+  FrameReport render(const FrameRequest &request) {
+    out_.assign(base::frame_bytes(rgb24()), 0);
+    const VideoBuffer target{rgb24(), out_};
+    const FrameReport report =
+        renderer_->render(request, {rgb24(), plate_}, std::span(&target, 1));
+    EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
+    return report;
+  }
+  [[nodiscard]] const std::vector<std::uint8_t> &out() const { return out_; }
+
+private:
+  std::unique_ptr<FrameRenderer> renderer_;
+  std::vector<std::uint8_t> plate_ = camera_frame();
+  std::vector<std::uint8_t> out_;
+};
+
+FrameRequest still(const Scene &scene, std::uint32_t rpp, std::uint32_t seed = 5) {
+  FrameRequest request;
+  request.camera = scene_camera(scene);
+  request.rays_per_pixel = rpp;
+  request.seed = seed;
+  request.accumulation.enabled = true;
+  return request;
+}
+
+// Every pixel alike, frame after frame.
+FrameRequest still_uniform(const Scene &scene, std::uint32_t rpp, std::uint32_t seed = 5) {
+  FrameRequest request = still(scene, rpp, seed);
+  request.accumulation.share_by_noise = false;
+  return request;
+}
+
+std::size_t bytes_differing(const std::vector<std::uint8_t> &a, const std::vector<std::uint8_t> &b) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    n += a[i] != b[i];
+  return n;
+}
+
+TEST(FrameHistory, NStillFramesOfOneSampleAreOneFrameOfN) {
+  const Scene scene = ball_scene();
+  Frames one_at_a_time(scene);
+  for (std::uint32_t n = 1; n <= 16; ++n) {
+    // Each frame has its own seed, as the run loop's do: a continuing
+    // history keeps its own.
+    const FrameReport report = one_at_a_time.render(still_uniform(scene, 1, 100 + n));
+    EXPECT_EQ(report.history_samples, n);
+    EXPECT_EQ(report.history_restarted, n == 1);
+  }
+  Frames at_once(scene);
+  const FrameReport report = at_once.render(still_uniform(scene, 16, 101));
+  EXPECT_EQ(report.history_samples, 16u);
+  EXPECT_EQ(bytes_differing(one_at_a_time.out(), at_once.out()), 0u);
+
+  // In uneven steps too.
+  Frames uneven(scene);
+  for (const std::uint32_t rpp : {3u, 1u, 7u, 5u})
+    (void)uneven.render(still_uniform(scene, rpp, 101));
+  EXPECT_EQ(bytes_differing(uneven.out(), at_once.out()), 0u);
+
+  // The comparison can tell: 16 frames that do not accumulate end with a
+  // 1-sample image, and 16 of the same first sample are not 16 samples.
+  Frames fresh(scene);
+  for (int n = 0; n < 16; ++n) {
+    FrameRequest request = still_uniform(scene, 1, 101);
+    request.accumulation.enabled = false;
+    (void)fresh.render(request);
+  }
+  EXPECT_GT(bytes_differing(fresh.out(), at_once.out()), 100u);
+}
+
+// The changes that start a history afresh, each the size of a real move.
+struct Change {
+  const char *name;
+  void (*apply)(FrameCamera &);
+};
+
+class FrameHistoryChange : public ::testing::TestWithParam<Change> {};
+
+TEST_P(FrameHistoryChange, TheFirstFrameAfterItCarriesNothingOfTheFramesBefore) {
+  const Scene scene = ball_scene();
+  Frames held(scene);
+  for (int n = 0; n < 8; ++n)
+    (void)held.render(still(scene, 1, 200 + n));
+  FrameRequest moved = still(scene, 2, 300);
+  GetParam().apply(moved.camera);
+  const FrameReport report = held.render(moved);
+  EXPECT_TRUE(report.history_restarted);
+  EXPECT_EQ(report.history_samples, 2u);
+
+  Frames fresh(scene);
+  (void)fresh.render(moved);
+  EXPECT_EQ(bytes_differing(held.out(), fresh.out()), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Changes, FrameHistoryChange,
+    ::testing::Values(
+        Change{"focus", [](FrameCamera &c) { c.focus_distance_m = 1.2f; }},
+        Change{"aperture", [](FrameCamera &c) { c.f_number = 2.8f; }},
+        Change{"breathing", [](FrameCamera &c) { c.projection_focal_length_mm = 50.5f; }},
+        Change{"pupil", [](FrameCamera &c) { c.entrance_pupil_offset_m = 0.01f; }},
+        Change{"position",
+               [](FrameCamera &c) {
+                 c.position.x += 0.01f;
+                 c.look_at.x += 0.01f;
+               }},
+        Change{"direction", [](FrameCamera &c) { c.look_at.x += 0.01f; }}),
+    [](const ::testing::TestParamInfo<Change> &change) { return change.param.name; });
+
+TEST(FrameHistory, AChangeWithinTheToleranceKeepsTheHistoryAndItsCamera) {
+  const Scene scene = ball_scene();
+  Frames held(scene);
+  Frames steady(scene);
+  for (int n = 0; n < 6; ++n) {
+    FrameRequest request = still_uniform(scene, 1, 400 + n);
+    (void)steady.render(request);
+    // Encoder noise after the filter: a few micrometres of focus.
+    request.camera.focus_distance_m += (n % 2 == 0 ? 1e-5f : -1e-5f);
+    const FrameReport report = held.render(request);
+    EXPECT_EQ(report.history_samples, std::uint32_t(n + 1));
+  }
+  EXPECT_EQ(bytes_differing(held.out(), steady.out()), 0u);
+}
+
+TEST(FrameHistory, ANonAccumulatingFrameEndsTheHistory) {
+  const Scene scene = ball_scene();
+  Frames frames(scene);
+  (void)frames.render(still(scene, 4));
+  FrameRequest plain = still(scene, 1);
+  plain.accumulation.enabled = false;
+  EXPECT_EQ(frames.render(plain).history_samples, 0u);
+  const FrameReport report = frames.render(still(scene, 1));
+  EXPECT_TRUE(report.history_restarted);
+  EXPECT_EQ(report.history_samples, 1u);
+}
+
+TEST(FrameHistory, AFullHistoryTracesNothingMore) {
+  const Scene scene = ball_scene();
+  Frames frames(scene);
+  FrameRequest request = still_uniform(scene, 3);
+  request.accumulation.max_samples = 8;
+  EXPECT_EQ(frames.render(request).history_samples, 3u);
+  EXPECT_EQ(frames.render(request).history_samples, 6u);
+  const FrameReport third = frames.render(request);
+  EXPECT_EQ(third.history_samples, 8u);
+  EXPECT_EQ(third.camera_rays, third.traced_pixels * 2);
+  const std::vector<std::uint8_t> full = frames.out();
+  const FrameReport fourth = frames.render(request);
+  EXPECT_EQ(fourth.history_samples, 8u);
+  EXPECT_EQ(fourth.camera_rays, 0u);
+  EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
+}
+
+TEST(FrameHistory, TheRegionStaysExact) {
+  // Over eight accumulating frames of every pixel alike, the region gives
+  // what tracing every pixel gives.
+  const Scene scene = ball_scene();
+  Frames region(scene);
+  Frames whole(scene);
+  for (int n = 0; n < 8; ++n) {
+    FrameRequest request = still_uniform(scene, 1, 500 + n);
+    (void)region.render(request);
+    request.influence_region = false;
+    (void)whole.render(request);
+    EXPECT_EQ(bytes_differing(region.out(), whole.out()), 0u) << "frame " << n;
+  }
+}
+
+TEST(FrameHistory, PixelsOutsideTheRegionPassThrough) {
+  // With the rays shared by noise, a pixel that nothing virtual touches is
+  // the camera's, byte for byte, in every frame.
+  const Scene scene = ball_scene();
+  gpu::FrameParams frame = make_frame_params(scene, scene_camera(scene));
+  frame.image.z = 1u;
+  const InfluenceRegion region = influence_region(compile_scene(scene), frame);
+  std::vector<bool> inside(std::size_t(kWidth * kHeight), false);
+  for (const PixelRect &r : region.rects)
+    for (std::uint32_t y = r.y0; y < r.y1; ++y)
+      for (std::uint32_t x = r.x0; x < r.x1; ++x)
+        inside[std::size_t(y) * kWidth + x] = true;
+  ASSERT_LT(region.pixels(), std::uint64_t(kWidth * kHeight)) << "the region must leave pixels out";
+  const std::vector<std::uint8_t> plate = camera_frame();
+  Frames frames(scene);
+  for (int n = 0; n < 12; ++n) {
+    (void)frames.render(still(scene, 2, 600 + n));
+    std::size_t differ = 0;
+    for (std::size_t p = 0; p < inside.size(); ++p)
+      for (std::size_t c = 0; c < 3; ++c)
+        differ += !inside[p] && frames.out()[p * 3 + c] != plate[p * 3 + c];
+    EXPECT_EQ(differ, 0u) << "frame " << n;
+  }
+}
+
+// The error of `frames`' last composite against `reference`'s, over the
+// pixels where the reference differs from the camera (what the virtual
+// objects change), as a relative RMSE.
+double virtual_error(const Frames &frames, const Frames &reference) {
+  const std::vector<std::uint8_t> plate = camera_frame();
+  double diff = 0.0, ref = 0.0;
+  for (std::size_t i = 0; i < plate.size(); ++i) {
+    const double a = reference.out()[i], b = frames.out()[i];
+    diff += (a - b) * (a - b);
+    ref += a * a;
+  }
+  return std::sqrt(diff / ref);
+}
+
+TEST(FrameHistory, SharingByNoiseConvergesFasterThanEveryPixelAlike) {
+  // The same rays (2 a frame for 16 frames), given where the samples
+  // disagree: the blurred rim of the ball and its shadow.
+  const Scene scene = ball_scene();
+  Frames reference(scene);
+  FrameRequest converged = still_uniform(scene, 1024, 77);
+  converged.accumulation.max_samples = 1024;
+  (void)reference.render(converged);
+  Frames alike(scene);
+  Frames by_noise(scene);
+  std::uint64_t rays_alike = 0, rays_by_noise = 0;
+  for (int n = 0; n < 16; ++n) {
+    rays_alike += alike.render(still_uniform(scene, 2, 700 + n)).camera_rays;
+    rays_by_noise += by_noise.render(still(scene, 2, 700 + n)).camera_rays;
+  }
+  const double e_alike = virtual_error(alike, reference);
+  const double e_by_noise = virtual_error(by_noise, reference);
+  std::printf("[ history ] 16 frames of 2 rpp: error %.4f every pixel alike, %.4f by noise "
+              "(rays %llu, %llu)\n",
+              e_alike, e_by_noise, static_cast<unsigned long long>(rays_alike),
+              static_cast<unsigned long long>(rays_by_noise));
+  EXPECT_LT(e_by_noise, 0.8 * e_alike);
+  // The budget holds: the shares round at random, so within a few percent.
+  EXPECT_NEAR(double(rays_by_noise), double(rays_alike), 0.03 * double(rays_alike));
+}
+
+TEST(FrameChange, IsTheLargestMoveOfABlurCircleOrAPoint) {
+  const Scene scene = ball_scene();
+  const CompiledScene compiled = compile_scene(scene);
+  const FrameCamera camera = scene_camera(scene);
+  const gpu::FrameParams a = make_frame_params(scene, camera);
+  const double nearest = nearest_depth_m(compiled, a);
+  EXPECT_EQ(frame_change_px(a, a, nearest), 0.0);
+
+  // Focus 2 m -> 3 m at f/2: every radius changes by f A (1/2 - 1/3) (the
+  // test helper's diameter at infinity, halved), whatever the depth.
+  FrameCamera refocused = camera;
+  refocused.focus_distance_m = 3.0f;
+  Scene refocused_scene = scene;
+  refocused_scene.camera.focus_distance_m = 3.0f;
+  const double expected =
+      0.5 * std::abs(test::coc_px(scene, 1e9f) - test::coc_px(refocused_scene, 1e9f));
+  EXPECT_NEAR(frame_change_px(a, make_frame_params(scene, refocused), nearest), expected,
+              1e-3 * expected);
+
+  // A turn of the view is no small change.
+  FrameCamera turned = camera;
+  turned.look_at.x += 1e-3f;
+  EXPECT_TRUE(std::isinf(frame_change_px(a, make_frame_params(scene, turned), nearest)));
+}
+
+} // namespace
+} // namespace camhead::renderer
