@@ -52,7 +52,12 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
   return bytes;
 }
 
-void live_frame(benchmark::State &state, bool gpu, bool region) {
+// How the frames are made: each afresh (the live path before issue 24); as
+// camhead run makes them, accumulating with the reconstruction, during the
+// pull (each frame starts a new history); the same with the lens still.
+enum class Method { fresh, pull, still };
+
+void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   const renderer::Scene scene = sim_rig_scene();
   std::unique_ptr<renderer::FrameRenderer> frames;
   try {
@@ -74,11 +79,12 @@ void live_frame(benchmark::State &state, bool gpu, bool region) {
   request.camera = renderer::scene_camera(scene);
   request.rays_per_pixel = 1;
   request.influence_region = region;
+  request.accumulation.enabled = method != Method::fresh;
   std::uint64_t frame = 0;
   double traced = 0.0;
   for (auto _ : state) {
     // Equal steps of 1 / distance (the way a focus scale runs), one a frame.
-    const int step = int(frame % (2 * kLensStates - 2));
+    const int step = method == Method::still ? 0 : int(frame % (2 * kLensStates - 2));
     const double t =
         double(step < kLensStates ? step : 2 * kLensStates - 2 - step) / double(kLensStates - 1);
     request.camera.focus_distance_m = float(1.0 / (1.0 / 14.0 + t * (1.0 / 0.4 - 1.0 / 14.0)));
@@ -102,14 +108,23 @@ void live_frame(benchmark::State &state, bool gpu, bool region) {
 void register_live_frame_benchmarks() {
   for (const bool gpu : {false, true})
     for (const bool region : {true, false})
-      benchmark::RegisterBenchmark(
-          (std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") + "/sim_rig/720x576/rpp:1/" +
-           (region ? "region" : "every_pixel"))
-              .c_str(),
-          [gpu, region](benchmark::State &state) { live_frame(state, gpu, region); })
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime()
-          ->MinTime(2.0);
+      for (const Method method : {Method::fresh, Method::pull, Method::still}) {
+        if (method != Method::fresh && (gpu || !region))
+          continue; // the history lives in the CPU reference, over the region
+        const char *name = method == Method::fresh  ? "fresh"
+                           : method == Method::pull ? "live_pull"
+                                                    : "live_still";
+        benchmark::RegisterBenchmark((std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
+                                      "/sim_rig/720x576/rpp:1/" +
+                                      (region ? "region" : "every_pixel") + "/" + name)
+                                         .c_str(),
+                                     [gpu, region, method](benchmark::State &state) {
+                                       live_frame(state, gpu, region, method);
+                                     })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime()
+            ->MinTime(2.0);
+      }
 }
 
 } // namespace camhead::bench

@@ -241,8 +241,9 @@ private:
   }
 
   static RenderConfig read_render(const JsonValue &d) {
-    d.object({}, {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel",
-                  "adaptive", "accumulate", "accumulate_tolerance_px", "accumulate_max_samples"});
+    d.object({},
+             {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel", "adaptive",
+              "accumulate", "accumulate_tolerance_px", "accumulate_max_samples", "reconstruct"});
     RenderConfig render;
     if (const auto executor = d.find("executor")) {
       const std::string e = executor->string();
@@ -274,9 +275,12 @@ private:
       d.fail_member("accumulate", "cannot be true with \"adaptive\": true (an adaptive frame "
                                   "shares its own rays and keeps no history); choose one");
     if (d.has("accumulate_tolerance_px"))
-      render.accumulate_tolerance_px = d.at("accumulate_tolerance_px").number(Range::within(0.0, 100.0));
+      render.accumulate_tolerance_px =
+          d.at("accumulate_tolerance_px").number(Range::within(0.0, 100.0));
     if (d.has("accumulate_max_samples"))
       render.accumulate_max_samples = rpp("accumulate_max_samples");
+    if (d.has("reconstruct"))
+      render.reconstruct = d.at("reconstruct").boolean();
     return render;
   }
 

@@ -192,6 +192,8 @@ struct RenderConfig {
   bool accumulate = true;
   double accumulate_tolerance_px = renderer::AccumulationSettings{}.tolerance_px;
   std::uint32_t accumulate_max_samples = renderer::AccumulationSettings{}.max_samples;
+  // Accumulating frames borrow their neighbours' samples within their blur.
+  bool reconstruct = renderer::AccumulationSettings{}.reconstruct;
 };
 
 struct Board {

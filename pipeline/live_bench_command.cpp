@@ -49,6 +49,7 @@ struct LiveArgs {
   int frames = 50;
   double fps = 25.0;
   int threads = 0;
+  double reconstruct = 1.0; // the filter's strength; 0: off
 };
 
 // A lens state of the rig (scenes/lenses/make_sim_focus_pull.py's holds).
@@ -81,7 +82,7 @@ class Shot {
 public:
   Shot(const Scene &scene, const CompiledScene &compiled, const LensPoint &lens,
        const LiveArgs &args)
-      : scene_(scene), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
+      : scene_(scene), args_(args), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
         renderer_(make_cpu_frame_renderer(scene, args.threads)) {
     // The camera image: the proxy alone through the same lens, 16 rpp.
     Scene real = scene;
@@ -131,6 +132,8 @@ public:
     request.rays_per_pixel = rpp;
     request.seed = seed;
     request.accumulation.enabled = true;
+    request.accumulation.reconstruct = args_.reconstruct > 0.0;
+    request.accumulation.reconstruct_strength = args_.reconstruct;
     *history = render(request, "a live frame").history_samples;
     return error();
   }
@@ -167,6 +170,7 @@ private:
   }
 
   const Scene &scene_;
+  const LiveArgs &args_;
   FrameCamera camera_;
   base::VideoFormat format_;
   std::unique_ptr<FrameRenderer> renderer_;
@@ -221,11 +225,16 @@ void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
     panel.x_label = "seconds since the lens came to rest";
     panel.y_label = "rel. RMSE over the region";
     chart::Series live{"live, " + std::to_string(args.rpp) + " rpp a frame, accumulated",
-                       {30, 90, 200}, chart::Marker::circle, c.seconds, c.error, {}};
+                       {30, 90, 200},
+                       chart::Marker::circle,
+                       c.seconds,
+                       c.error,
+                       {}};
     const double x0 = c.seconds.front(), x1 = c.seconds.back();
-    chart::Series u9{"uniform 9 rpp", {200, 120, 30}, chart::Marker::square, {x0, x1},
-                     {c.uniform9, c.uniform9}, {}};
-    chart::Series u49{"uniform 49 rpp", {30, 150, 60}, chart::Marker::diamond, {x0, x1},
+    chart::Series u9{"uniform 9 rpp", {200, 120, 30},           chart::Marker::square,
+                     {x0, x1},        {c.uniform9, c.uniform9}, {}};
+    chart::Series u49{"uniform 49 rpp",           {30, 150, 60},
+                      chart::Marker::diamond,     {x0, x1},
                       {c.uniform49, c.uniform49}, {}};
     panel.series = {live, u9, u49};
     panels.push_back(std::move(panel));
@@ -249,12 +258,11 @@ int run_live(const LiveArgs &args) {
     const double frame_s = 1.0 / args.fps;
     // The rig's holds and its pull (make_sim_focus_pull.py): far at f/4,
     // near at f/2, and the scene's own focus.
-    const std::vector<LensPoint> still = {
-        {"far 14 m f/4", 14.0f, 4.0f},
-        {"scene " + fmt(scene.camera.focus_distance_m, "%.1f") + " m f/" +
-             fmt(scene.camera.f_number, "%.1f"),
-         scene.camera.focus_distance_m, scene.camera.f_number},
-        {"near 0.4 m f/2", 0.4f, 2.0f}};
+    const std::vector<LensPoint> still = {{"far 14 m f/4", 14.0f, 4.0f},
+                                          {"scene " + fmt(scene.camera.focus_distance_m, "%.1f") +
+                                               " m f/" + fmt(scene.camera.f_number, "%.1f"),
+                                           scene.camera.focus_distance_m, scene.camera.f_number},
+                                          {"near 0.4 m f/2", 0.4f, 2.0f}};
     std::vector<LensPoint> pulling;
     for (int k = 0; k < 5; ++k) {
       const float w = 1.0f / 14.0f + (1.0f / 0.4f - 1.0f / 14.0f) * float(k) / 4.0f;
@@ -283,8 +291,8 @@ int run_live(const LiveArgs &args) {
       }
 
     std::printf("\n%s, %dx%d, reference %d rpp; live: %u rpp a frame at %.0f fps\n\n",
-                scene_file.string().c_str(), scene.render.width, scene.render.height,
-                args.ref_rpp, args.rpp, args.fps);
+                scene_file.string().c_str(), scene.render.width, scene.render.height, args.ref_rpp,
+                args.rpp, args.fps);
     std::printf("| still shot | region | uniform 1 / 9 / 49 rpp | live after 1 / 5 / 12 / 25 / "
                 "%d frames | frames to 9 rpp's error | frames to 49 rpp's |\n|---|---|---|---|---|"
                 "---|\n",
@@ -301,10 +309,11 @@ int run_live(const LiveArgs &args) {
       std::printf("| %s | %.1f %% | %s / %s / %s | %s / %s / %s / %s / %s | %s | %s |\n",
                   c.lens.name.c_str(), 100.0 * c.region, fmt(c.uniform1).c_str(),
                   fmt(c.uniform9).c_str(), fmt(c.uniform49).c_str(), at(1).c_str(), at(5).c_str(),
-                  at(12).c_str(), at(25).c_str(), at(args.frames).c_str(),
-                  when(c.uniform9).c_str(), when(c.uniform49).c_str());
+                  at(12).c_str(), at(25).c_str(), at(args.frames).c_str(), when(c.uniform9).c_str(),
+                  when(c.uniform49).c_str());
     }
-    std::printf("\n| pull frame | region | uniform 1 / 9 / 49 rpp | live frame |\n|---|---|---|---|\n");
+    std::printf(
+        "\n| pull frame | region | uniform 1 / 9 / 49 rpp | live frame |\n|---|---|---|---|\n");
     for (const RestCurve &c : pull)
       std::printf("| %s | %.1f %% | %s / %s / %s | %s |\n", c.lens.name.c_str(), 100.0 * c.region,
                   fmt(c.uniform1).c_str(), fmt(c.uniform9).c_str(), fmt(c.uniform49).c_str(),
@@ -323,18 +332,17 @@ int run_live(const LiveArgs &args) {
 void add_bench_live_command(CLI::App &bench) {
   auto args = std::make_shared<LiveArgs>();
   CLI::App *cmd = bench.add_subcommand(
-      "live",
-      "The live frame's error against time, as camhead run renders it on the CPU\n"
-      "reference: for three still lens states (the simulated rig's far and near\n"
-      "holds and the scene's own focus) each frame's composite after the lens\n"
-      "came to rest, accumulating --rpp rays a frame, and for five states of a\n"
-      "focus pull a frame that starts afresh; each against a --ref-rpp reference\n"
-      "of the same camera and against fresh frames of 1, 9 and 49 rays per pixel\n"
-      "measured in the same run. Error: relative RMSE of the composite over the\n"
-      "influence region, linear light. Writes DIR/live.csv and DIR/live.png.\n"
-      "About 5 minutes on 2 cores for the simulated rig.\n"
-      "Example:\n"
-      "  camhead bench live -o /tmp/live");
+      "live", "The live frame's error against time, as camhead run renders it on the CPU\n"
+              "reference: for three still lens states (the simulated rig's far and near\n"
+              "holds and the scene's own focus) each frame's composite after the lens\n"
+              "came to rest, accumulating --rpp rays a frame, and for five states of a\n"
+              "focus pull a frame that starts afresh; each against a --ref-rpp reference\n"
+              "of the same camera and against fresh frames of 1, 9 and 49 rays per pixel\n"
+              "measured in the same run. Error: relative RMSE of the composite over the\n"
+              "influence region, linear light. Writes DIR/live.csv and DIR/live.png.\n"
+              "About 5 minutes on 2 cores for the simulated rig.\n"
+              "Example:\n"
+              "  camhead bench live -o /tmp/live");
   cmd->add_option("--scene", args->scene, "Scene file (default: the simulated rig's)")
       ->check(path_text() & CLI::ExistingFile);
   cmd->add_option("-o,--output", args->out_dir, "Output folder (created if absent)")
@@ -354,7 +362,11 @@ void add_bench_live_command(CLI::App &bench) {
   cmd->add_option("--ref-rpp", args->ref_rpp, "Rays per pixel of the reference")
       ->check(CLI::Range(2, 1 << 20))
       ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "CPU threads (0 = all cores)")
+  cmd->add_option("--threads", args->threads, "CPU threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--reconstruct", args->reconstruct,
+                  "Strength of the reconstruction from neighbours' samples (renderer\n"
+                  "defocus_filter.h: sigma = strength sqrt(blur radius / samples)); 0 = off")
+      ->check(CLI::Range(0.0, 4.0))
       ->capture_default_str();
   cmd->callback([args] { set_exit_code(run_live(*args)); });
 }

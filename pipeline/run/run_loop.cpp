@@ -299,6 +299,7 @@ void Pipeline::render_loop() {
     request.accumulation.enabled = board_.render.accumulate;
     request.accumulation.tolerance_px = board_.render.accumulate_tolerance_px;
     request.accumulation.max_samples = board_.render.accumulate_max_samples;
+    request.accumulation.reconstruct = board_.render.reconstruct;
     r.rpp = request.rays_per_pixel;
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
@@ -326,10 +327,10 @@ void Pipeline::render_loop() {
     r.history_samples = report.history_samples;
     // What the frame cost for the rays it traced: a full history traces none,
     // and its cost says nothing of what the next new one's rays will.
-    const std::uint32_t traced_rpp =
-        !request.accumulation.enabled ? request.rays_per_pixel
-        : report.traced_pixels > 0    ? std::uint32_t(report.camera_rays / report.traced_pixels)
-                                      : 0u;
+    const std::uint32_t traced_rpp = !request.accumulation.enabled ? request.rays_per_pixel
+                                     : report.traced_pixels > 0
+                                         ? std::uint32_t(report.camera_rays / report.traced_pixels)
+                                         : 0u;
     budget.measured(traced_rpp, report.decode_s + report.trace_s + report.encode_s);
     counters_.rpp = request.rays_per_pixel;
     (void)ready_slots_.push(*slot_index);

@@ -16,6 +16,7 @@
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/influence_region.h"
 #include "cpu_kernel.h"
+#include "defocus_filter.h"
 #include "frame_checks.h"
 #include "video_codec.h"
 #include "worker_pool.h"
@@ -45,7 +46,9 @@ public:
         pixels_(std::size_t(scene_.render.width) * std::size_t(scene_.render.height)),
         plate_(pixels_), composite_(pixels_), mixed_(pixels_, glm::vec4(0.0f)),
         real_(pixels_, glm::vec4(0.0f)), aux_(pixels_, glm::vec4(0.0f)),
-        history_counts_(pixels_, 0u), shares_(pixels_, 0u), noise_(pixels_, 0.0f) {
+        history_counts_(pixels_, 0u), shares_(pixels_, 0u), noise_(pixels_, 0.0f),
+        filtered_mixed_(pixels_), filtered_real_(pixels_), scratch_mixed_(pixels_),
+        scratch_real_(pixels_), scratch_weight_(pixels_), blur_(pixels_) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 2 != 0 || h % 2 != 0)
@@ -71,8 +74,10 @@ public:
     if (request.rays_per_pixel == 0)
       return bad_frame("0 rays per pixel");
 
-    if (request.adaptive && request.accumulation.enabled)
+    if (request.accumulation.enabled && request.adaptive)
       return bad_frame("adaptive frames do not accumulate");
+    if (request.accumulation.enabled && request.accumulation.max_samples == 0)
+      return bad_frame("a history of at most 0 samples");
 
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
@@ -147,7 +152,8 @@ public:
       report.camera_rays = share_rays(request);
       trace_shares(has_plate);
       history_rays_ += report.camera_rays;
-      report.history_samples = std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_.pixels(), 1));
+      report.history_samples =
+          std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_.pixels(), 1));
     } else if (!request.adaptive) {
       trace(0u, total, has_plate);
       report.camera_rays = region_.pixels() * total;
@@ -167,20 +173,36 @@ public:
       for (const std::uint32_t n : counts_)
         report.camera_rays += n;
     }
+    // Reconstructed layers are means already.
+    const bool filtered = request.accumulation.enabled && request.accumulation.reconstruct;
+    if (filtered) {
+      cpu::DefocusFilterSettings settings;
+      settings.strength = request.accumulation.reconstruct_strength;
+      cpu::filter_defocus(
+          kernel_.frame, spans_, mixed_, real_, aux_, history_counts_, settings,
+          {filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_, scratch_weight_, blur_},
+          pool_);
+    }
     report.trace_s = seconds_since(start);
 
     start = Clock::now();
     const std::uint32_t *per_pixel = request.accumulation.enabled ? history_counts_.data()
-                                     : request.adaptive             ? counts_.data()
-                                                                    : nullptr;
+                                     : request.adaptive           ? counts_.data()
+                                                                  : nullptr;
     // Blocks of two rows: an nv12 chroma row is made from two image rows.
     auto resolve = [&](int y0, int y1, int x0, int x1) {
       for (int y = y0; y < y1; ++y)
         for (std::size_t i = std::size_t(y) * width + x0; i < std::size_t(y) * width + x1; ++i) {
           const std::uint32_t samples = per_pixel != nullptr ? per_pixel[i] : total;
           composite_[i] = glm::vec4(
-              kernel_.resolve_pixel(mixed_[i], real_[i], aux_[i], plate_[i], has_plate, samples)
-                  .composite,
+              filtered
+                  ? kernel_
+                        .resolve_pixel(filtered_mixed_[i], filtered_real_[i], aux_[i], plate_[i],
+                                       has_plate, samples > 0 ? 1u : 0u)
+                        .composite
+                  : kernel_
+                        .resolve_pixel(mixed_[i], real_[i], aux_[i], plate_[i], has_plate, samples)
+                        .composite,
               0.0f);
         }
       for (const VideoBuffer &out : outputs)
@@ -238,9 +260,7 @@ private:
   }
 
   // A row's stretch of the region.
-  struct RowSpan {
-    std::uint32_t y, x0, x1;
-  };
+  using RowSpan = cpu::PixelSpan;
 
   // Zeroes the accumulators of the previous frame's region: outside the
   // frame's own they must be zero, as the resolve (the camera image there)
@@ -315,8 +335,9 @@ private:
         // so that the shares add up to the budget on average.
         const double want = noise_[i] * scale;
         const double whole = std::floor(want);
-        const double u = double(kernel_.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ history_frames_)) *
-                         (1.0 / 4294967296.0);
+        const double u =
+            double(kernel_.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ history_frames_)) *
+            (1.0 / 4294967296.0);
         const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
         shares_[i] = std::min({k, kMostRaysAPixel * rpp, most - history_counts_[i]});
         rays += shares_[i];
@@ -395,7 +416,10 @@ private:
   std::vector<std::uint32_t> history_counts_; // samples per pixel
   std::vector<std::uint32_t> shares_;         // this frame's rays per pixel
   std::vector<float> noise_;                  // each pixel's noise, for the shares
-  bool region_kind_ = true;                   // the region's: request.influence_region
+  // The reconstruction's means and passes (defocus_filter.h).
+  std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_;
+  std::vector<float> scratch_weight_, blur_;
+  bool region_kind_ = true; // the region's: request.influence_region
 };
 
 } // namespace

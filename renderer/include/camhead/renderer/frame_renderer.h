@@ -66,13 +66,14 @@ struct FrameReport {
   // Pixels traced (the influence region's) of the frame's.
   std::uint64_t traced_pixels = 0;
   std::uint64_t frame_pixels = 0;
-  // Accumulating frames: the samples per pixel the image holds, and whether
-  // this frame started a new history (the camera moved, or the one before
-  // did not accumulate).
+  // Accumulating frames: the samples per pixel the image holds (the mean
+  // over the region), and whether this frame started a new history (the
+  // camera moved, or the one before did not accumulate).
   std::uint32_t history_samples = 0;
   bool history_restarted = false;
   // Where the frame's time went, seconds: converting the plate in, tracing
-  // (and compositing), converting the composite out.
+  // (and the reconstruction; on the GPU the compositing too), compositing
+  // and converting the composite out.
   double decode_s = 0.0;
   double trace_s = 0.0;
   double encode_s = 0.0;

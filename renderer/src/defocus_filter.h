@@ -1,0 +1,60 @@
+// Reconstruction of a live frame's layers from few samples, with what the
+// renderer knows of each pixel: its depth, hence its blur circle. Where the
+// lens blurs a surface over c pixels the picture there is smooth at that
+// scale, and a pixel's samples may stand in for its neighbours'. So each
+// pixel's layers (I_m with the mask, and I_r) become the sample-weighted
+// mean of its neighbours' within a Gaussian, among neighbours whose signed
+// blur circles are alike (defocus_filter.cpp), in two passes, rows then
+// columns.
+//
+// The Gaussian's sigma is strength sqrt(|c| / n) pixels (n the pixel's
+// samples). Widening a blur disk of radius c by a Gaussian of sigma widens
+// it by about 2 sigma^2 / c pixels, so this sigma adds the same 2
+// strength^2 / n pixels of blur whatever c is: a sigma proportional to c
+// (tried first) over-blurred the most defocused parts or left the others
+// noisy (bench/RESULTS.md). It fades as the history grows, and below
+// min_sigma_px a pixel keeps its own samples.
+//
+// Only traced pixels take part and only the layers are filtered, never the
+// camera image: a pixel whose neighbourhood saw nothing virtual (I_m == I_r,
+// no mask) keeps I_m == I_r, and its composite stays the camera's.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include <glm/vec4.hpp>
+
+#include "camhead/renderer/gpu_layout.h"
+#include "worker_pool.h"
+
+namespace camhead::renderer::cpu {
+
+// A row's stretch of the pixels to filter.
+struct PixelSpan {
+  std::uint32_t y, x0, x1;
+};
+
+struct DefocusFilterSettings {
+  double strength = 1.0;
+  double min_sigma_px = 0.5; // below it a pixel keeps its own samples
+  int max_radius_px = 16;    // the widest reach of a pass
+};
+
+// Sums in, means out: `mixed`, `real` are the accumulators (sums of
+// `counts` samples, layout.h), `aux` holds the depth sum and hit count;
+// writes each span pixel's filtered means to `out_mixed`, `out_real`, with
+// `scratch_*` (the frame's size each) for the passes between.
+struct DefocusFilterBuffers {
+  std::span<glm::vec4> out_mixed, out_real;
+  std::span<glm::vec4> scratch_mixed, scratch_real;
+  std::span<float> scratch_weight, blur;
+};
+
+void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
+                    std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,
+                    std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,
+                    const DefocusFilterSettings &settings, const DefocusFilterBuffers &buffers,
+                    WorkerPool &pool);
+
+} // namespace camhead::renderer::cpu
