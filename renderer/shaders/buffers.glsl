@@ -6,6 +6,7 @@
 #define INOUT(T) inout T
 #define OUT(T) out T
 #define PRECISE precise
+#define KERNEL_TABLE const // a constant array
 #define CAMHEAD_PI 3.14159265358979f
 
 layout(constant_id = 0) const uint KERNEL_FEATURES = KERNEL_ALL; // layout.h

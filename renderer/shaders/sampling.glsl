@@ -117,45 +117,42 @@ vec2 sample_dimension(uint s, uint n, uint pixel_pattern, uint dimension) {
 // than each in 2-D. Progressive: a sample does not depend on n, and the
 // first 2^k samples of a pixel are a scrambled aligned block of the sequence.
 
-// Sobol' dimension d (0..3) of sample i, as 32-bit fixed point. The
-// direction numbers come from their recurrences (primitive polynomials 1,
-// x + 1, x^2 + x + 1, x^3 + x + 1; initial m = {1}, {1, 3}, {1, 3, 1}), one
-// per bit of i, so no table is needed in either language.
-uint sobol_u32(uint i, uint d) {
-  if (d == 0u) {
-    return bitfieldReverse(i);
-  }
-  uint result = 0u;
-  uint v1 = 0u; // V_{k-1}
-  uint v2 = 0u; // V_{k-2}
-  uint v3 = 0u; // V_{k-3}
+// Sobol' dimensions 1, 2 and 3 of sample i, as 32-bit fixed point
+// (dimension 0 is the bit reversal of i): the XOR of the direction numbers
+// of i's set bits. The numbers are those of the primitive polynomials
+// x + 1, x^2 + x + 1 and x^3 + x + 1 with initial m = {1}, {1, 3},
+// {1, 3, 1} (Joe and Kuo), 32 a dimension; the loop visits the set bits
+// only, and the three dimensions share it.
+KERNEL_TABLE uint SOBOL_DIRECTIONS[96] = {
+    0x80000000u, 0xc0000000u, 0xa0000000u, 0xf0000000u, 0x88000000u, 0xcc000000u,
+    0xaa000000u, 0xff000000u, 0x80800000u, 0xc0c00000u, 0xa0a00000u, 0xf0f00000u,
+    0x88880000u, 0xcccc0000u, 0xaaaa0000u, 0xffff0000u, 0x80008000u, 0xc000c000u,
+    0xa000a000u, 0xf000f000u, 0x88008800u, 0xcc00cc00u, 0xaa00aa00u, 0xff00ff00u,
+    0x80808080u, 0xc0c0c0c0u, 0xa0a0a0a0u, 0xf0f0f0f0u, 0x88888888u, 0xccccccccu,
+    0xaaaaaaaau, 0xffffffffu, 0x80000000u, 0xc0000000u, 0x60000000u, 0x90000000u,
+    0xe8000000u, 0x5c000000u, 0x8e000000u, 0xc5000000u, 0x68800000u, 0x9cc00000u,
+    0xee600000u, 0x55900000u, 0x80680000u, 0xc09c0000u, 0x60ee0000u, 0x90550000u,
+    0xe8808000u, 0x5cc0c000u, 0x8e606000u, 0xc5909000u, 0x6868e800u, 0x9c9c5c00u,
+    0xeeee8e00u, 0x5555c500u, 0x8000e880u, 0xc0005cc0u, 0x60008e60u, 0x9000c590u,
+    0xe8006868u, 0x5c009c9cu, 0x8e00eeeeu, 0xc5005555u, 0x80000000u, 0xc0000000u,
+    0x20000000u, 0x50000000u, 0xf8000000u, 0x74000000u, 0xa2000000u, 0x93000000u,
+    0xd8800000u, 0x25400000u, 0x59e00000u, 0xe6d00000u, 0x78080000u, 0xb40c0000u,
+    0x82020000u, 0xc3050000u, 0x208f8000u, 0x51474000u, 0xfbea2000u, 0x75d93000u,
+    0xa0858800u, 0x914e5400u, 0xdbe79e00u, 0x25db6d00u, 0x58800080u, 0xe54000c0u,
+    0x79e00020u, 0xb6d00050u, 0x800800f8u, 0xc00c0074u, 0x200200a2u, 0x50050093u,
+};
+
+uvec3 sobol_u32_123(uint i) {
+  uvec3 result = uvec3(0u, 0u, 0u);
   if (i == 0u) {
     return result;
   }
-  uint k = 1u;
   do { // bottom-tested, as every loop here (kernel.glsl)
-    uint v;
-    if (k == 1u) {
-      v = 0x80000000u;
-    } else if (d == 1u) {
-      v = v1 ^ (v1 >> 1u);
-    } else if (k == 2u) {
-      v = 0xc0000000u;
-    } else if (d == 2u) {
-      v = v2 ^ (v2 >> 2u) ^ v1;
-    } else if (k == 3u) {
-      v = 0x20000000u;
-    } else {
-      v = v3 ^ (v3 >> 3u) ^ v2;
-    }
-    if ((i & 1u) != 0u) {
-      result ^= v;
-    }
-    v3 = v2;
-    v2 = v1;
-    v1 = v;
-    i >>= 1u;
-    ++k;
+    uint k = uint(findLSB(i));
+    result.x ^= SOBOL_DIRECTIONS[k];
+    result.y ^= SOBOL_DIRECTIONS[32u + k];
+    result.z ^= SOBOL_DIRECTIONS[64u + k];
+    i &= i - 1u;
   } while (i != 0u);
   return result;
 }
@@ -180,10 +177,11 @@ uint nested_uniform_scramble(uint x, uint seed) {
 vec4 sobol_owen_4d(uint s, uint p) {
   uint i = nested_uniform_scramble(s, hash_u32(p ^ 0x3c6ef372u));
   float scale = 1.0f / 4294967296.0f;
-  float x = float(nested_uniform_scramble(sobol_u32(i, 0u), hash_u32(p + 0x9e3779b9u)) >> 8u);
-  float y = float(nested_uniform_scramble(sobol_u32(i, 1u), hash_u32(p + 0x7f4a7c15u)) >> 8u);
-  float z = float(nested_uniform_scramble(sobol_u32(i, 2u), hash_u32(p + 0xf39cc060u)) >> 8u);
-  float w = float(nested_uniform_scramble(sobol_u32(i, 3u), hash_u32(p + 0x5ced1fb7u)) >> 8u);
+  uvec3 d123 = sobol_u32_123(i);
+  float x = float(nested_uniform_scramble(bitfieldReverse(i), hash_u32(p + 0x9e3779b9u)) >> 8u);
+  float y = float(nested_uniform_scramble(d123.x, hash_u32(p + 0x7f4a7c15u)) >> 8u);
+  float z = float(nested_uniform_scramble(d123.y, hash_u32(p + 0xf39cc060u)) >> 8u);
+  float w = float(nested_uniform_scramble(d123.z, hash_u32(p + 0x5ced1fb7u)) >> 8u);
   // 24 bits each, so that the float is exact and below 1.
   return vec4(x, y, z, w) * (256.0f * scale);
 }

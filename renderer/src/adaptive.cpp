@@ -23,6 +23,8 @@ using namespace glm; // the GLSL built-ins adaptive.glsl calls unqualified
 using gpu::FrameParams;
 using uint = std::uint32_t;
 
+#define KERNEL_TABLE static constexpr // sampling.glsl's constant arrays, members
+
 #ifndef CAMHEAD_PI
 #define CAMHEAD_PI 3.14159265358979f
 #endif

@@ -31,7 +31,8 @@ using uint = std::uint32_t;
 
 #define INOUT(T) T &
 #define OUT(T) T &
-#define PRECISE // C++ without -ffast-math keeps the order as written
+#define PRECISE                       // C++ without -ffast-math keeps the order as written
+#define KERNEL_TABLE static constexpr // a constant array, a member of the struct
 #define CAMHEAD_PI 3.14159265358979f
 
 struct CpuKernel {
@@ -56,6 +57,7 @@ struct CpuKernel {
 #undef INOUT
 #undef OUT
 #undef PRECISE
+#undef KERNEL_TABLE
 
 // The kernel as the CPU reference runs it: `scene` with `frame` moved into
 // the compiled scene's frame, uniform sampling (tracing.y = 0), pixels no
