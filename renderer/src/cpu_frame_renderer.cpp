@@ -46,9 +46,9 @@ public:
         pixels_(std::size_t(scene_.render.width) * std::size_t(scene_.render.height)),
         plate_(pixels_), composite_(pixels_), mixed_(pixels_, glm::vec4(0.0f)),
         real_(pixels_, glm::vec4(0.0f)), aux_(pixels_, glm::vec4(0.0f)),
-        history_counts_(pixels_, 0u), shares_(pixels_, 0u), noise_(pixels_, 0.0f),
-        filtered_mixed_(pixels_), filtered_real_(pixels_), scratch_mixed_(pixels_),
-        scratch_real_(pixels_), scratch_weight_(pixels_), blur_(pixels_) {
+        history_counts_(pixels_, 0u), shares_(pixels_, 0u), sigma_(pixels_, 0.0f),
+        noise_(pixels_, 0.0f), filtered_mixed_(pixels_), filtered_real_(pixels_),
+        scratch_mixed_(pixels_), scratch_real_(pixels_), scratch_weight_(pixels_), blur_(pixels_) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 2 != 0 || h % 2 != 0)
@@ -302,6 +302,12 @@ private:
     }
     const int width = scene_.render.width;
     const int height = scene_.render.height;
+    auto own_sigma = [&](int k) {
+      const RowSpan &span = spans_[std::size_t(k)];
+      for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i)
+        sigma_[i] = luminance_sigma(i);
+    };
+    pool_.run(int(spans_.size()), own_sigma);
     double noise_sum = 0.0;
     double samples_sum = 0.0;
     for (const RowSpan &span : spans_)
@@ -310,8 +316,11 @@ private:
         for (int dy = -1; dy <= 1; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
             const int nx = int(x) + dx, ny = int(span.y) + dy;
-            if (nx >= 0 && ny >= 0 && nx < width && ny < height)
-              sigma = std::max(sigma, luminance_sigma(index(std::uint32_t(ny), std::uint32_t(nx))));
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height)
+              continue;
+            const std::size_t j = index(std::uint32_t(ny), std::uint32_t(nx));
+            if (history_counts_[j] > 0) // traced this frame: sigma_ is its own
+              sigma = std::max(sigma, sigma_[j]);
           }
         const std::size_t i = index(span.y, x);
         const float n = float(history_counts_[i]);
@@ -415,7 +424,7 @@ private:
   std::uint32_t history_frames_ = 0;
   std::vector<std::uint32_t> history_counts_; // samples per pixel
   std::vector<std::uint32_t> shares_;         // this frame's rays per pixel
-  std::vector<float> noise_;                  // each pixel's noise, for the shares
+  std::vector<float> sigma_, noise_;          // each pixel's noise, for the shares
   // The reconstruction's means and passes (defocus_filter.h).
   std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_;
   std::vector<float> scratch_weight_, blur_;

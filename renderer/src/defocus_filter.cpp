@@ -29,9 +29,12 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   };
   pool.run(int(spans.size()), blur_of);
 
+  // At most the reach (a hit at depth 0 would make it infinite); NaN, which
+  // no comparison passes, leaves the pixel its own samples.
   const auto sigma_of = [&](std::size_t i) {
-    return float(settings.strength) *
-           std::sqrt(std::abs(buffers.blur[i]) / float(std::max(counts[i], 1u)));
+    return std::min(float(settings.strength) *
+                        std::sqrt(std::abs(buffers.blur[i]) / float(std::max(counts[i], 1u))),
+                    float(settings.max_radius_px));
   };
   // Neighbours whose blur circles are alike: differing by no more than the
   // larger of the two (or a pixel), which keeps a sharp surface's samples
@@ -46,8 +49,8 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   };
 
   // Adds the neighbours at +-1 .. +-reach steps of `step` (whose offsets
-  // `valid` allows) with Gaussian weights, the exponential computed twice
-  // per pixel: exp(f (k+1)^2) = exp(f k^2) exp(f (2k + 1)).
+  // `valid` allows) with Gaussian weights, three exponentials a pixel for
+  // all of them: exp(f (k+1)^2) = exp(f k^2) exp(f (2k + 1)).
   const auto gather = [&](std::size_t i, float sigma, int reach, std::ptrdiff_t step,
                           const auto &valid, const glm::vec4 *m_in, const glm::vec4 *r_in,
                           const auto &n_in, glm::vec4 &m, glm::vec4 &r, float &n) {
