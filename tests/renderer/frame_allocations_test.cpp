@@ -33,18 +33,54 @@ std::atomic<std::uint64_t> allocations{0};
 
 } // namespace
 
-// The replacements count while `counting` is on, on whatever thread.
-void *operator new(std::size_t bytes) {
+// The replacements count while `counting` is on, on whatever thread. Every
+// unaligned form is replaced, so that whatever the process allocates with
+// one (a sanitizer's runtime, lavapipe's LLVM) it frees with its own kind;
+// the aligned forms stay the library's, a matched pair.
+namespace {
+
+void *counted(std::size_t bytes) noexcept {
   if (counting.load(std::memory_order_relaxed))
     allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void *p = std::malloc(bytes == 0 ? 1 : bytes))
+  return std::malloc(bytes == 0 ? 1 : bytes);
+}
+
+void *counted_or_throw(std::size_t bytes) {
+  if (void *p = counted(bytes))
     return p;
   throw std::bad_alloc();
+}
+
+} // namespace
+
+void *operator new(std::size_t bytes) {
+  return counted_or_throw(bytes);
+}
+void *operator new[](std::size_t bytes) {
+  return counted_or_throw(bytes);
+}
+void *operator new(std::size_t bytes, const std::nothrow_t &) noexcept {
+  return counted(bytes);
+}
+void *operator new[](std::size_t bytes, const std::nothrow_t &) noexcept {
+  return counted(bytes);
 }
 void operator delete(void *p) noexcept {
   std::free(p);
 }
+void operator delete[](void *p) noexcept {
+  std::free(p);
+}
 void operator delete(void *p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void *p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete(void *p, const std::nothrow_t &) noexcept {
+  std::free(p);
+}
+void operator delete[](void *p, const std::nothrow_t &) noexcept {
   std::free(p);
 }
 
