@@ -20,15 +20,16 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
                ",\"render_end_ns\":%" PRId64 ",\"output_ns\":%" PRId64
                ",\"focus_m\":%s,\"f_number\":%.6g"
                ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
-               ",\"camera_rays\":%" PRIu64 ",\"history_samples\":%u,\"traced\":%.4f,\"dropped_before\":%" PRIu64
+               ",\"camera_rays\":%" PRIu64
+               ",\"history_samples\":%u,\"traced\":%.4f,\"dropped_before\":%" PRIu64
                ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
                ",\"encode_ms\":%.3f,\"executor\":\"%s\"}\n",
                output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns,
                r.render_start_ns, r.render_end_ns, output_ns,
                std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
                r.focal_length_mm, r.lens_fresh ? "true" : "false", 1e3 * r.lens_wait_s, r.rpp,
-               r.camera_rays, r.history_samples, r.traced, r.dropped_before, 1e3 * r.decode_s, 1e3 * r.trace_s,
-               1e3 * r.encode_s, executor.c_str());
+               r.camera_rays, r.history_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
+               1e3 * r.trace_s, 1e3 * r.encode_s, executor.c_str());
 }
 
 } // namespace camhead::pipeline

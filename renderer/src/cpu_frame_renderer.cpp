@@ -1,8 +1,10 @@
 // The CPU reference as a live frame renderer (frame_renderer.h): the scene
 // compiled and the kernel bound once, the per-pixel buffers and the threads
-// made once, then per frame four passes over the rows: the camera frame into
-// the linear plate, the samples (a pilot and a second pass when adaptive),
-// and the resolve with each output's encoding.
+// made once, then per frame passes over the rows: the camera frame into the
+// linear plate, the samples (a pilot and a second pass when adaptive; each
+// pixel's share of the rays when accumulating, frame_history.h), the
+// reconstruction (accumulating frames, defocus_filter.h), and the resolve
+// with each output's encoding.
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
@@ -161,8 +163,7 @@ public:
       const std::uint32_t pilot = adaptive_pilot(request.adaptive_settings, total);
       kernel_.frame.sampling = gpu::uvec4(0u, pilot, pilot, frame.sampling.w);
       trace(0u, pilot, has_plate);
-      // allocate_samples() returns a new vector: the one allocation a live
-      // frame makes, adaptive frames only.
+      // allocate_samples() returns a new vector (adaptive frames only).
       counts_ = allocate_samples(aux_, frame, pilot, request.adaptive_settings, &region_);
       const std::uint32_t most = *std::max_element(counts_.begin(), counts_.end());
       kernel_.sample_counts = counts_.data();

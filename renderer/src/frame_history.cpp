@@ -13,7 +13,9 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-glm::dvec3 xyz(const gpu::vec4 &v) { return {v.x, v.y, v.z}; }
+glm::dvec3 xyz(const gpu::vec4 &v) {
+  return {v.x, v.y, v.z};
+}
 
 // Blur-circle radius, pixels, of a point at inverse depth w (1/m): a point
 // at depth z is seen by the pixels within f A |1/z - 1/F| of its pinhole

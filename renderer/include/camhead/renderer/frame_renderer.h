@@ -2,9 +2,12 @@
 // frame at a time, each with its own camera (pose and lens at mid-exposure)
 // and its own plate (the camera frame in the camera's own pixel format), and
 // the composite written straight into each output's buffer in that output's
-// format. Everything a frame needs is made when the renderer is created:
-// nothing is allocated, compiled or thrown per frame; what goes wrong is the
-// returned status.
+// format. The scene, the kernels and the per-pixel buffers are made when the
+// renderer is created, and nothing is thrown per frame: what goes wrong is
+// the returned status. Allocation, as far as it is held: a frame of a held
+// shot on the CPU reference allocates nothing (tests/renderer/
+// frame_allocations_test.cpp); a frame that starts a new history builds its
+// influence region, which does, and so does every GPU frame (issue 24).
 //
 // Thread safety: one thread renders at a time.
 #pragma once
