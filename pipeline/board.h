@@ -33,7 +33,7 @@
 
 #include "camhead/base/config_error.h"
 #include "camhead/base/video_format.h"
-#include "camhead/renderer/frame_history.h"
+#include "camhead/renderer/accumulation.h"
 
 namespace camhead::pipeline {
 

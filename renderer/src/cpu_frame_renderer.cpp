@@ -15,6 +15,7 @@
 
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/frame_history.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/influence_region.h"
 #include "cpu_kernel.h"

@@ -16,39 +16,11 @@
 // the lens by at most that much.
 #pragma once
 
-#include <cstdint>
-
+#include "camhead/renderer/accumulation.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/gpu_layout.h"
 
 namespace camhead::renderer {
-
-struct AccumulationSettings {
-  bool enabled = false;
-  // The largest movement, in pixels, of any point's blur circle or position
-  // that keeps a history: below what a viewer can see (the blur follows a
-  // focus pull within 0.1 px), above encoder noise after the lens chain's
-  // filter and hold.
-  double tolerance_px = 0.05;
-  // Samples per pixel at which a history stops growing: from there a still
-  // frame traces nothing (the reference at 1024 is only 4x less noisy).
-  std::uint32_t max_samples = 256;
-  // After a few samples everywhere, give each frame's rays to the pixels
-  // whose samples disagree most (the blurred edges and shadows) rather than
-  // to every pixel alike. Off, N still frames of k rays are exactly one
-  // frame of N k rays (tests/renderer/frame_history_test.cpp); on, each
-  // pixel's picture is exactly one of its own count of samples.
-  bool share_by_noise = true;
-  // Let each pixel borrow its neighbours' samples within a Gaussian of
-  // sigma = strength sqrt(blur radius / samples) pixels, among neighbours of
-  // alike blur (renderer/src/defocus_filter.h): a 1-rpp frame of a strongly
-  // defocused shot is as clean as 9 rpp. Only the traced pixels take part,
-  // so with it on the influence region and the whole frame give different
-  // (equally valid) estimates; the camera image outside the region stays
-  // exact.
-  bool reconstruct = true;
-  double reconstruct_strength = 1.0;
-};
 
 // The nearest depth along the view axis from `frame`'s entrance pupil at
 // which `scene` has anything: its bounds' nearest corner, but never nearer

@@ -20,9 +20,9 @@
 #include <glm/vec4.hpp>
 
 #include "camhead/base/video_format.h"
+#include "camhead/renderer/accumulation.h"
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/frame_camera.h"
-#include "camhead/renderer/frame_history.h"
 #include "camhead/renderer/scene.h"
 
 namespace camhead::renderer {

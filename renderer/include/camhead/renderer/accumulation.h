@@ -1,0 +1,38 @@
+// How a live frame accumulates (frame_history.h): the settings alone, free of
+// the renderer's other headers, for the board reader.
+#pragma once
+
+#include <cstdint>
+
+namespace camhead::renderer {
+
+struct AccumulationSettings {
+  bool enabled = false;
+  // The largest movement, in pixels, of any point's blur circle or position
+  // that keeps a history: below what a viewer can see (the blur follows a
+  // focus pull within 0.1 px), above encoder noise after the lens chain's
+  // filter and hold.
+  double tolerance_px = 0.05;
+  // Samples per pixel at which a history stops growing: from there a still
+  // frame traces nothing (a 1024-rpp reference is only half as noisy).
+  std::uint32_t max_samples = 256;
+  // After a few samples everywhere, give each frame's rays to the pixels
+  // whose samples disagree most (the blurred edges and shadows) rather than
+  // to every pixel alike. Off, N still frames of k rays are exactly one
+  // frame of N k rays (tests/renderer/frame_history_test.cpp); on, each
+  // pixel's picture is exactly one of its own count of samples.
+  bool share_by_noise = true;
+  // Let each pixel borrow its neighbours' samples within a Gaussian of
+  // sigma = strength sqrt(blur radius / samples) pixels, among neighbours of
+  // alike blur (renderer/src/defocus_filter.h): at the simulated rig's near
+  // focus a 1-rpp frame has less error than 9 rpp (bench/RESULTS.md), at the
+  // price of about 2 strength^2 / samples pixels of extra blur. Only the
+  // traced pixels take part,
+  // so with it on the influence region and the whole frame give different
+  // (equally valid) estimates; the camera image outside the region stays
+  // exact.
+  bool reconstruct = true;
+  double reconstruct_strength = 1.0;
+};
+
+} // namespace camhead::renderer
