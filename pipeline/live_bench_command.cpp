@@ -83,7 +83,7 @@ class Shot {
 public:
   Shot(const Scene &scene, const CompiledScene &compiled, const LensPoint &lens,
        const LiveArgs &args)
-      : scene_(scene), args_(args), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
+      : args_(args), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
         renderer_(make_cpu_frame_renderer(scene, args.threads)) {
     // The camera image: the proxy alone through the same lens, 16 rpp.
     Scene real = scene;
@@ -177,7 +177,6 @@ private:
     return std::sqrt(diff / ref);
   }
 
-  const Scene &scene_;
   const LiveArgs &args_;
   FrameCamera camera_;
   base::VideoFormat format_;
@@ -278,7 +277,10 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
   const int x0 = std::clamp(cx - crop_w / 2, 0, w - crop_w);
   const int y0 = std::clamp(cy - crop_h / 2, 0, h - crop_h);
 
-  const char *titles[] = {"1 RPP, BEFORE", "LIVE: 1 RPP RECONSTRUCTED", "9 RPP", "REFERENCE"};
+  const std::string titles[] = {"1 RPP, FRESH (BEFORE)",
+                                "LIVE: " + std::to_string(args.rpp) + " RPP" +
+                                    (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : ""),
+                                "9 RPP", std::to_string(args.ref_rpp) + " RPP (REFERENCE)"};
   const int gap = 6, left = 120, top = 24;
   chart::Canvas canvas(left + 4 * (crop_w + gap), top + int(pull.size()) * (crop_h + gap),
                        {255, 255, 255});

@@ -1,4 +1,5 @@
-// One Euro filter, spike rejection and dropout detection: see encoder_filter.h.
+// Spike rejection, One Euro filter, still hold and dropout detection: see
+// encoder_filter.h.
 #include "camhead/lens_control/encoder_filter.h"
 
 #include <cmath>

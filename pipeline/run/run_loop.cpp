@@ -325,12 +325,13 @@ void Pipeline::render_loop() {
     r.trace_s = report.trace_s;
     r.encode_s = report.encode_s;
     r.history_samples = report.history_samples;
-    // What the frame cost for the rays it traced: a full history traces none,
-    // and its cost says nothing of what the next new one's rays will.
-    const std::uint32_t traced_rpp = !request.accumulation.enabled ? request.rays_per_pixel
-                                     : report.traced_pixels > 0
-                                         ? std::uint32_t(report.camera_rays / report.traced_pixels)
-                                         : 0u;
+    // What the frame cost for the rays it traced (an accumulating frame's
+    // shares give some pixels more and some none; a full history traces
+    // none, and its cost says nothing of what the next new one's rays will).
+    const double traced_rpp = !request.accumulation.enabled ? double(request.rays_per_pixel)
+                              : report.traced_pixels > 0
+                                  ? double(report.camera_rays) / double(report.traced_pixels)
+                                  : 0.0;
     budget.measured(traced_rpp, report.decode_s + report.trace_s + report.encode_s);
     counters_.rpp = request.rays_per_pixel;
     (void)ready_slots_.push(*slot_index);

@@ -197,10 +197,10 @@ public:
         for (std::size_t i = std::size_t(y) * width + x0; i < std::size_t(y) * width + x1; ++i) {
           const std::uint32_t samples = per_pixel != nullptr ? per_pixel[i] : total;
           composite_[i] = glm::vec4(
-              filtered
+              filtered && samples > 0 // outside the region the layers are the zeros
                   ? kernel_
                         .resolve_pixel(filtered_mixed_[i], filtered_real_[i], aux_[i], plate_[i],
-                                       has_plate, samples > 0 ? 1u : 0u)
+                                       has_plate, 1u)
                         .composite
                   : kernel_
                         .resolve_pixel(mixed_[i], real_[i], aux_[i], plate_[i], has_plate, samples)
@@ -326,11 +326,14 @@ private:
           }
         const std::size_t i = index(span.y, x);
         const float n = float(history_counts_[i]);
-        noise_[i] = sigma + kNoiseFloor * (aux_[i].z / n) + kNoiseFloor;
+        const float noise = sigma + kNoiseFloor * std::abs(aux_[i].z / n) + kNoiseFloor;
+        // A sample of inf or NaN must not take every other pixel's rays.
+        noise_[i] = std::isfinite(noise) ? noise : kNoiseFloor;
         noise_sum += noise_[i];
         samples_sum += n;
       }
-    // Each pixel's way to its share of the rays after this frame.
+    // Each pixel's way to its share of the rays after this frame (noise_
+    // holds it from here on).
     const double after = samples_sum + double(region_.pixels()) * rpp;
     double lack_sum = 0.0;
     for (const RowSpan &span : spans_)
@@ -344,7 +347,7 @@ private:
       for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
         // Rounded up or down at random (a hash of the pixel and the frame),
         // so that the shares add up to the budget on average.
-        const double want = noise_[i] * scale;
+        const double want = std::min(double(noise_[i]) * scale, double(kMostRaysAPixel * rpp));
         const double whole = std::floor(want);
         const double u =
             double(kernel_.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ history_frames_)) *

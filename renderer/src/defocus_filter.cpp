@@ -29,12 +29,13 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   };
   pool.run(int(spans.size()), blur_of);
 
-  // At most the reach (a hit at depth 0 would make it infinite); NaN, which
-  // no comparison passes, leaves the pixel its own samples.
+  // At most half the reach, so that the Gaussian is cut at 2 sigma (and a
+  // hit at depth 0, an infinite blur, is bounded); NaN, which no comparison
+  // passes, leaves the pixel its own samples.
   const auto sigma_of = [&](std::size_t i) {
     return std::min(float(settings.strength) *
                         std::sqrt(std::abs(buffers.blur[i]) / float(std::max(counts[i], 1u))),
-                    float(settings.max_radius_px));
+                    0.5f * float(settings.max_radius_px));
   };
   // Neighbours whose blur circles are alike: differing by no more than the
   // larger of the two (or a pixel), which keeps a sharp surface's samples

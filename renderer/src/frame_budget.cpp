@@ -17,8 +17,8 @@ FrameBudget::FrameBudget(const FrameBudgetSettings &settings)
                                 std::to_string(settings.max_rpp) + " is empty or 0");
 }
 
-void FrameBudget::measured(std::uint32_t rpp, double seconds) {
-  if (rpp == 0 || !(seconds > 0.0) || !std::isfinite(seconds))
+void FrameBudget::measured(double rpp, double seconds) {
+  if (!(rpp > 0.0) || !std::isfinite(rpp) || !(seconds > 0.0) || !std::isfinite(seconds))
     return;
   const double per_rpp = seconds / rpp;
   seconds_per_rpp_ = seconds_per_rpp_ == 0.0 ? per_rpp
@@ -27,7 +27,7 @@ void FrameBudget::measured(std::uint32_t rpp, double seconds) {
   // A frame that came out dear counts at once, not averaged away.
   const double cost = std::max(seconds_per_rpp_, per_rpp);
   const double fits = settings_.headroom * settings_.target_s / cost;
-  const double most = std::max(double(rpp) + 1.0, double(rpp) * settings_.max_growth);
+  const double most = std::max(rpp + 1.0, rpp * settings_.max_growth);
   const double next = std::clamp(std::floor(std::min(fits, most)), double(settings_.min_rpp),
                                  double(settings_.max_rpp));
   rpp_ = static_cast<std::uint32_t>(next);

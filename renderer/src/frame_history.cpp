@@ -53,11 +53,23 @@ double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, dou
       a.lens.w != b.lens.w || a.world_color != b.world_color || a.image != b.image ||
       a.tracing.x != b.tracing.x)
     return kInfinity;
+  for (const gpu::FrameParams *frame : {&a, &b})
+    for (int k = 0; k < 4; ++k)
+      if (!std::isfinite(frame->lens[k]) || !std::isfinite(frame->cam_position[k]))
+        return kInfinity; // no bound to give
   const double width = a.image.x;
   const double height = a.image.y;
   const double f = a.lens.z;
+  const double w_far = 0.0;
+  const double w_near = 1.0 / nearest_m;
+  // The largest blur radius of either frame: a point that far outside the
+  // picture still reaches its edge.
+  double widest = 0.0;
+  for (const gpu::FrameParams *frame : {&a, &b})
+    for (const double w : {w_far, w_near})
+      widest = std::max(widest, blur_radius_px(*frame, w));
   // The farthest a visible point lies from the image centre, as a tangent.
-  const double max_tan = 0.5 * std::hypot(width, height) / f;
+  const double max_tan = (0.5 * std::hypot(width, height) + widest + a.lens.w) / f;
   // 1. Position. A point at depth z >= nearest seen at u = f x / z moves by
   //    (f / z)(|dx| + max_tan |dz|) <= |dp| (f + f max_tan) / nearest when
   //    the pupil moves by dp (the entrance pupil follows focus and zoom),
@@ -65,16 +77,17 @@ double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, dou
   const double moved = glm::length(xyz(b.cam_position) - xyz(a.cam_position));
   double change = moved * f * (1.0 + max_tan) / nearest_m;
   change += std::abs(double(b.lens.z) - f) * max_tan;
-  // 2. Blur. The difference of the two radii is piecewise linear in w = 1/z
-  //    over [0, 1/nearest], with kinks at the focal planes: its largest
-  //    magnitude is at an end or a kink.
-  const double w_far = 0.0;
-  const double w_near = 1.0 / nearest_m;
+  // 2. Blur. At one depth, the difference of the two radii is piecewise
+  //    linear in w = 1/z over [0, 1/nearest], with kinks at the focal
+  //    planes: its largest magnitude is at an end or a kink.
   double blur = 0.0;
   for (const double w : {w_far, w_near, 1.0 / double(a.lens.y), 1.0 / double(b.lens.y)})
     if (w >= w_far && w <= w_near)
       blur = std::max(blur, std::abs(blur_radius_px(b, w) - blur_radius_px(a, w)));
   change += blur;
+  // ... and the pupil moving along the view changes every depth, so every
+  // 1/z by up to |dp| / nearest^2, and a radius by A f times that.
+  change += moved * f * std::max(double(a.lens.x), double(b.lens.x)) / (nearest_m * nearest_m);
   return std::isfinite(change) ? change : kInfinity;
 }
 

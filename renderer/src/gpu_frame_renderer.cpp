@@ -43,6 +43,8 @@ public:
                        std::to_string(VIDEO_MAX_OUTPUTS));
     if (request.rays_per_pixel == 0)
       return bad_frame("0 rays per pixel");
+    if (request.accumulation.enabled && request.adaptive)
+      return bad_frame("adaptive frames do not accumulate");
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
     if (request.seed != 0)
       frame.sampling.w = request.seed;

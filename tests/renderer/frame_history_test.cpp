@@ -70,14 +70,24 @@ std::vector<std::uint8_t> camera_frame() {
 }
 
 // Renders frames with one renderer and keeps what the last one gave.
+// Renders frames with one renderer and keeps what the last one gave: RGB,
+// the camera's format, and with `and_yuyv` a YUYV output too, which makes
+// the renderer resolve every pixel rather than copy the camera's bytes
+// outside the influence region.
 class Frames {
 public:
-  explicit Frames(const Scene &scene) : renderer_(make_cpu_frame_renderer(scene, 2)) {}
+  explicit Frames(const Scene &scene, bool and_yuyv = false)
+      : renderer_(make_cpu_frame_renderer(scene, 2)), and_yuyv_(and_yuyv) {}
 
   FrameReport render(const FrameRequest &request) {
     out_.assign(base::frame_bytes(rgb24()), 0);
-    const VideoBuffer target{rgb24(), out_};
-    const FrameReport report = renderer_->render(request, {rgb24(), plate_}, std::span(&target, 1));
+    base::VideoFormat yuyv = rgb24();
+    yuyv.pixel = base::PixelFormat::yuyv;
+    yuyv.range = base::ColorRange::limited;
+    yuyv_.assign(base::frame_bytes(yuyv), 0);
+    const VideoBuffer targets[] = {{rgb24(), out_}, {yuyv, yuyv_}};
+    const FrameReport report =
+        renderer_->render(request, {rgb24(), plate_}, std::span(targets, and_yuyv_ ? 2 : 1));
     EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
     return report;
   }
@@ -85,8 +95,9 @@ public:
 
 private:
   std::unique_ptr<FrameRenderer> renderer_;
+  bool and_yuyv_;
   std::vector<std::uint8_t> plate_ = camera_frame();
-  std::vector<std::uint8_t> out_;
+  std::vector<std::uint8_t> out_, yuyv_;
 };
 
 FrameRequest still(const Scene &scene, std::uint32_t rpp, std::uint32_t seed = 5) {
@@ -113,13 +124,12 @@ std::size_t bytes_differing(const std::vector<std::uint8_t> &a,
   return n;
 }
 
-// The error of `frames`' last composite against `reference`'s, over the
-// pixels where the reference differs from the camera (what the virtual
-// objects change), as a relative RMSE.
+// The relative RMSE of `frames`' last output against `reference`'s, over
+// every byte (outside the influence region both are the camera's: the
+// errors are diluted alike).
 double virtual_error(const Frames &frames, const Frames &reference) {
-  const std::vector<std::uint8_t> plate = camera_frame();
   double diff = 0.0, ref = 0.0;
-  for (std::size_t i = 0; i < plate.size(); ++i) {
+  for (std::size_t i = 0; i < reference.out().size(); ++i) {
     const double a = reference.out()[i], b = frames.out()[i];
     diff += (a - b) * (a - b);
     ref += a * a;
@@ -148,15 +158,15 @@ TEST(FrameHistory, NStillFramesOfOneSampleAreOneFrameOfN) {
     (void)uneven.render(still_uniform(scene, rpp, 101));
   EXPECT_EQ(bytes_differing(uneven.out(), at_once.out()), 0u);
 
-  // The comparison can tell: 16 frames that do not accumulate end with a
-  // 1-sample image, and 16 of the same first sample are not 16 samples.
-  Frames fresh(scene);
+  // The comparison can tell: 16 frames of a history held at one sample
+  // (the same pattern, the same first sample) are not 16 samples.
+  Frames one(scene);
   for (int n = 0; n < 16; ++n) {
     FrameRequest request = still_uniform(scene, 1, 101);
-    request.accumulation.enabled = false;
-    (void)fresh.render(request);
+    request.accumulation.max_samples = 1;
+    (void)one.render(request);
   }
-  EXPECT_GT(bytes_differing(fresh.out(), at_once.out()), 100u);
+  EXPECT_GT(bytes_differing(one.out(), at_once.out()), 100u);
 }
 
 // The changes that start a history afresh, each the size of a real move.
@@ -213,6 +223,31 @@ TEST(FrameHistory, AChangeWithinTheToleranceKeepsTheHistoryAndItsCamera) {
   EXPECT_EQ(bytes_differing(held.out(), steady.out()), 0u);
 }
 
+TEST(FrameHistory, TheToleranceIsWhereTheHistoryEnds) {
+  // Focus changes that move the blur circles by 80 % and by 120 % of the
+  // tolerance (found by frame_change_px, a few secant steps).
+  const Scene scene = ball_scene();
+  const gpu::FrameParams a = make_frame_params(scene, scene_camera(scene));
+  const double nearest = nearest_depth_m(compile_scene(scene), a);
+  const auto change_for = [&](double delta_m) {
+    FrameCamera moved = scene_camera(scene);
+    moved.focus_distance_m += float(delta_m);
+    return frame_change_px(a, make_frame_params(scene, moved), nearest);
+  };
+  const double tolerance = AccumulationSettings{}.tolerance_px;
+  for (const double fraction : {0.8, 1.2}) {
+    double delta = 1e-3;
+    for (int step = 0; step < 4; ++step)
+      delta *= fraction * tolerance / change_for(delta);
+    ASSERT_NEAR(change_for(delta), fraction * tolerance, 0.01 * tolerance);
+    Frames frames(scene);
+    (void)frames.render(still_uniform(scene, 1));
+    FrameRequest moved = still_uniform(scene, 1);
+    moved.camera.focus_distance_m += float(delta);
+    EXPECT_EQ(frames.render(moved).history_restarted, fraction > 1.0) << fraction;
+  }
+}
+
 TEST(FrameHistory, ANonAccumulatingFrameEndsTheHistory) {
   const Scene scene = ball_scene();
   Frames frames(scene);
@@ -263,7 +298,9 @@ TEST(FrameHistory, TheRegionStaysExact) {
 TEST(FrameHistory, PixelsOutsideTheRegionPassThrough) {
   // With the rays shared by noise and the reconstruction borrowing samples
   // across the blur, a pixel that nothing virtual touches is the camera's,
-  // byte for byte, in every frame.
+  // byte for byte, in every frame, also where the renderer resolves every
+  // pixel (a second output in another format), so that what the filter
+  // leaves outside the region is read there.
   const Scene scene = defocused_ball_scene();
   gpu::FrameParams frame = make_frame_params(scene, scene_camera(scene));
   frame.image.z = 1u;
@@ -275,9 +312,11 @@ TEST(FrameHistory, PixelsOutsideTheRegionPassThrough) {
         inside[std::size_t(y) * kWidth + x] = true;
   ASSERT_LT(region.pixels(), std::uint64_t(kWidth * kHeight)) << "the region must leave pixels out";
   const std::vector<std::uint8_t> plate = camera_frame();
-  Frames frames(scene);
+  Frames frames(scene, true);
   for (int n = 0; n < 12; ++n) {
-    (void)frames.render(still(scene, 2, 600 + n));
+    FrameRequest request = still(scene, 2, 600 + n);
+    request.camera.focus_distance_m += n % 6 == 5 ? 0.05f : 0.0f; // and new histories
+    (void)frames.render(request);
     std::size_t differ = 0;
     for (std::size_t p = 0; p < inside.size(); ++p)
       for (std::size_t c = 0; c < 3; ++c)
@@ -328,8 +367,11 @@ TEST(FrameHistory, SharingByNoiseConvergesFasterThanEveryPixelAlike) {
   Frames by_noise(scene);
   std::uint64_t rays_alike = 0, rays_by_noise = 0;
   for (int n = 0; n < 16; ++n) {
-    rays_alike += alike.render(still_uniform(scene, 2, 700 + n)).camera_rays;
-    rays_by_noise += by_noise.render(still(scene, 2, 700 + n)).camera_rays;
+    FrameRequest uniform = still_uniform(scene, 2, 700 + n);
+    FrameRequest shared = still(scene, 2, 700 + n);
+    uniform.accumulation.reconstruct = shared.accumulation.reconstruct = false; // sharing alone
+    rays_alike += alike.render(uniform).camera_rays;
+    rays_by_noise += by_noise.render(shared).camera_rays;
   }
   const double e_alike = virtual_error(alike, reference);
   const double e_by_noise = virtual_error(by_noise, reference);

@@ -92,7 +92,6 @@ class StillHold {
 public:
   explicit StillHold(double band_counts) : band_(band_counts) {}
   [[nodiscard]] double hold(double counts);
-  void reset() { primed_ = false; }
 
 private:
   double band_;

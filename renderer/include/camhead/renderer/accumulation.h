@@ -28,9 +28,9 @@ struct AccumulationSettings {
   // focus a 1-rpp frame has less error than 9 rpp (bench/RESULTS.md), at the
   // price of about 2 strength^2 / samples pixels of extra blur. Only the
   // traced pixels take part,
-  // so with it on the influence region and the whole frame give different
-  // (equally valid) estimates; the camera image outside the region stays
-  // exact.
+  // so with it (or share_by_noise) on the influence region and the whole
+  // frame give different (equally valid) estimates; the camera image
+  // outside the region stays exact.
   bool reconstruct = true;
   double reconstruct_strength = 1.0;
 };

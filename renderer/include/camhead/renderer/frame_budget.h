@@ -39,8 +39,9 @@ public:
 
   // Rays per pixel for the next frame.
   [[nodiscard]] std::uint32_t rpp() const { return rpp_; }
-  // A frame of `rpp` rays per pixel took `seconds`; ignored unless both > 0.
-  void measured(std::uint32_t rpp, double seconds);
+  // A frame of `rpp` rays per pixel (a mean: an accumulating frame shares
+  // its rays unevenly) took `seconds`; ignored unless both > 0.
+  void measured(double rpp, double seconds);
   // The average seconds per ray per pixel so far (0 before any frame).
   [[nodiscard]] double seconds_per_rpp() const { return seconds_per_rpp_; }
 

@@ -51,8 +51,10 @@ struct FrameRequest {
   // starts one afresh (FrameReport says so).
   AccumulationSettings accumulation;
   // Trace only where the virtual objects can change the composite
-  // (influence_region.h); the outputs are the same bit for bit. False
-  // traces every pixel, for comparison.
+  // (influence_region.h); the outputs are the same bit for bit, except for
+  // accumulating frames that share rays by noise or reconstruct (both look
+  // at the traced pixels only: accumulation.h). False traces every pixel,
+  // for comparison.
   bool influence_region = true;
 };
 
