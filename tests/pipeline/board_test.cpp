@@ -170,6 +170,13 @@ TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
   expect(live(R"({"type": "sim"})",
               R"(, "render": {"min_rays_per_pixel": 9, "max_rays_per_pixel": 4})"),
          "render.min_rays_per_pixel: must not exceed max_rays_per_pixel (4)");
+  expect(live(R"({"type": "sim"})", R"(, "render": {"adaptive": true, "accumulate": true})"),
+         "render.accumulate: cannot be true with \"adaptive\": true (an adaptive frame shares "
+         "its own rays and keeps no history); choose one");
+  expect(live(R"({"type": "sim"})", R"(, "render": {"accumulate_max_samples": 0})"),
+         "render.accumulate_max_samples: must be an integer within 1 .. 4096");
+  expect(live(R"({"type": "sim"})", R"(, "render": {"accumulate_tolerance_px": -1})"),
+         "render.accumulate_tolerance_px: must be within 0 .. 100");
   EXPECT_EQ(
       error_of(with_source(
           R"({"type": "trace", "file": "a.csv", "clock_origin": "monotonic", "loop": false})")),
@@ -192,6 +199,22 @@ TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
                         "lens": {"sources": [{"type": "freed"}]}, "camera": {"type": "sim"}})"),
             "/rigs/test.json: scene: missing: a board with a camera needs the scene of its "
             "virtual objects");
+}
+
+// A live frame accumulates and reconstructs unless the board says otherwise,
+// and an adaptive one does neither (it keeps no history).
+TEST(BoardLive, AccumulationIsOnUnlessAdaptive) {
+  const auto render = [](const std::string &fields) {
+    return parse_board(live(R"({"type": "sim"})", R"(, "render": )" + fields), "/rigs/test.json")
+        .render;
+  };
+  EXPECT_TRUE(render("{}").accumulate);
+  EXPECT_TRUE(render("{}").reconstruct);
+  EXPECT_FALSE(render(R"({"adaptive": true})").accumulate);
+  EXPECT_FALSE(render(R"({"accumulate": false})").accumulate);
+  EXPECT_FALSE(render(R"({"reconstruct": false})").reconstruct);
+  EXPECT_EQ(render(R"({"accumulate_max_samples": 64})").accumulate_max_samples, 64u);
+  EXPECT_EQ(render(R"({"accumulate_tolerance_px": 0.2})").accumulate_tolerance_px, 0.2);
 }
 
 // A pose the tracer cannot build a view from would render no virtual object
