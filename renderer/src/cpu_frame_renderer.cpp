@@ -21,6 +21,7 @@
 #include "cpu_kernel.h"
 #include "defocus_filter.h"
 #include "frame_checks.h"
+#include "ray_shares.h"
 #include "video_codec.h"
 #include "worker_pool.h"
 
@@ -34,13 +35,8 @@ double seconds_since(Clock::time_point start) {
 }
 
 // Accumulating frames: samples every pixel gets before the shares follow
-// the noise (enough for a first estimate of it); a frame's most rays for one
-// pixel, in units of the frame's rays per pixel (no pixel takes a whole
-// frame's budget on one estimate); and the noise floor, relative to the
-// pixel's luminance and absolute.
+// the noise (enough for a first estimate of it, ray_shares.h).
 constexpr std::uint32_t kPilotSamples = 4;
-constexpr std::uint32_t kMostRaysAPixel = 16;
-constexpr float kNoiseFloor = 0.01f;
 
 class CpuFrameRenderer final : public FrameRenderer {
 public:
@@ -283,17 +279,12 @@ private:
   // An accumulating frame's rays, pixel by pixel (shares_), within the
   // frame's budget of rays_per_pixel for each pixel of the region; returns
   // their sum. The first kPilotSamples of a history go to every pixel alike;
-  // from there, with share_by_noise, each frame's rays go where the image
-  // still lacks them: toward each pixel holding a share of all the rays so
-  // far proportional to its noise (the standard deviation of its samples'
-  // composite luminance, the largest in its 3x3 neighbourhood so that an edge
-  // that a few samples missed still gets rays, plus a floor), which for
-  // noise sigma_i minimises the sum of sigma_i^2 / n_i for the rays given.
+  // from there, with share_by_noise, where the image still lacks them
+  // (ray_shares.h).
   std::uint64_t share_rays(const FrameRequest &request) {
     const std::uint32_t most = request.accumulation.max_samples;
     const std::uint32_t rpp = request.rays_per_pixel;
     const bool by_noise = request.accumulation.share_by_noise && history_uniform_ >= kPilotSamples;
-    std::uint64_t rays = 0;
     if (!by_noise) {
       const std::uint32_t k = std::min(rpp, most - std::min(most, history_uniform_));
       for (const RowSpan &span : spans_)
@@ -302,72 +293,9 @@ private:
       history_uniform_ += k;
       return region_.pixels() * k;
     }
-    const int width = scene_.render.width;
-    const int height = scene_.render.height;
-    auto own_sigma = [&](int k) {
-      const RowSpan &span = spans_[std::size_t(k)];
-      for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i)
-        sigma_[i] = luminance_sigma(i);
-    };
-    pool_.run(int(spans_.size()), own_sigma);
-    double noise_sum = 0.0;
-    double samples_sum = 0.0;
-    for (const RowSpan &span : spans_)
-      for (std::uint32_t x = span.x0; x < span.x1; ++x) {
-        float sigma = 0.0f;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = int(x) + dx, ny = int(span.y) + dy;
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height)
-              continue;
-            const std::size_t j = index(std::uint32_t(ny), std::uint32_t(nx));
-            if (history_counts_[j] > 0) // traced this frame: sigma_ is its own
-              sigma = std::max(sigma, sigma_[j]);
-          }
-        const std::size_t i = index(span.y, x);
-        const float n = float(history_counts_[i]);
-        const float noise = sigma + kNoiseFloor * std::abs(aux_[i].z / n) + kNoiseFloor;
-        // A sample of inf or NaN must not take every other pixel's rays.
-        noise_[i] = std::isfinite(noise) ? noise : kNoiseFloor;
-        noise_sum += noise_[i];
-        samples_sum += n;
-      }
-    // Each pixel's way to its share of the rays after this frame (noise_
-    // holds it from here on).
-    const double after = samples_sum + double(region_.pixels()) * rpp;
-    double lack_sum = 0.0;
-    for (const RowSpan &span : spans_)
-      for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
-        const double lack = std::max(0.0, after * noise_[i] / noise_sum - history_counts_[i]);
-        noise_[i] = float(lack);
-        lack_sum += lack;
-      }
-    const double scale = lack_sum > 0.0 ? double(region_.pixels()) * rpp / lack_sum : 0.0;
-    for (const RowSpan &span : spans_)
-      for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
-        // Rounded up or down at random (a hash of the pixel and the frame),
-        // so that the shares add up to the budget on average.
-        const double want = std::min(double(noise_[i]) * scale, double(kMostRaysAPixel * rpp));
-        const double whole = std::floor(want);
-        const double u =
-            double(kernel_.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ history_frames_)) *
-            (1.0 / 4294967296.0);
-        const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
-        shares_[i] = std::min({k, kMostRaysAPixel * rpp, most - history_counts_[i]});
-        rays += shares_[i];
-      }
-    return rays;
-  }
-
-  // The standard deviation of pixel i's samples' composite luminance (aux.z
-  // and aux.w hold its sum and sum of squares); 0 outside the history.
-  float luminance_sigma(std::size_t i) const {
-    const float n = float(history_counts_[i]);
-    if (n < 2.0f)
-      return 0.0f;
-    const float mean = aux_[i].z / n;
-    const float variance = (aux_[i].w / n - mean * mean) * n / (n - 1.0f);
-    return std::sqrt(std::max(variance, 0.0f));
+    return cpu::share_rays_by_noise(spans_, scene_.render.width, scene_.render.height, aux_,
+                                    history_counts_, rpp, most, history_frames_,
+                                    {sigma_, noise_, shares_}, pool_);
   }
 
   std::size_t index(std::uint32_t y, std::uint32_t x) const {
