@@ -270,17 +270,17 @@ private:
       render.adaptive = d.at("adaptive").boolean();
     // An adaptive frame shares its rays by what its own pilot saw: it keeps
     // no history, so adaptive turns accumulation off unless both are asked.
-    render.accumulate = d.has("accumulate") ? d.at("accumulate").boolean() : !render.adaptive;
-    if (render.accumulate && render.adaptive)
+    renderer::AccumulationSettings &accumulation = render.accumulation;
+    accumulation.enabled = d.has("accumulate") ? d.at("accumulate").boolean() : !render.adaptive;
+    if (accumulation.enabled && render.adaptive)
       d.fail_member("accumulate", "cannot be true with \"adaptive\": true (an adaptive frame "
                                   "shares its own rays and keeps no history); choose one");
     if (d.has("accumulate_tolerance_px"))
-      render.accumulate_tolerance_px =
-          d.at("accumulate_tolerance_px").number(Range::within(0.0, 100.0));
+      accumulation.tolerance_px = d.at("accumulate_tolerance_px").number(Range::within(0.0, 100.0));
     if (d.has("accumulate_max_samples"))
-      render.accumulate_max_samples = rpp("accumulate_max_samples");
+      accumulation.max_samples = rpp("accumulate_max_samples");
     if (d.has("reconstruct"))
-      render.reconstruct = d.at("reconstruct").boolean();
+      accumulation.reconstruct = d.at("reconstruct").boolean();
     return render;
   }
 

@@ -187,13 +187,9 @@ struct RenderConfig {
   std::uint32_t max_rays_per_pixel = 64;
   std::optional<std::uint32_t> rays_per_pixel;
   bool adaptive = false;
-  // While the lens and pose hold still, each frame's rays add to the last
-  // frames' (renderer/frame_history.h); off with `adaptive`.
-  bool accumulate = true;
-  double accumulate_tolerance_px = renderer::AccumulationSettings{}.tolerance_px;
-  std::uint32_t accumulate_max_samples = renderer::AccumulationSettings{}.max_samples;
-  // Accumulating frames borrow their neighbours' samples within their blur.
-  bool reconstruct = renderer::AccumulationSettings{}.reconstruct;
+  // How each frame adds to the frames before while the lens and pose hold
+  // still (renderer/accumulation.h): on unless `adaptive`.
+  renderer::AccumulationSettings accumulation{.enabled = true};
 };
 
 struct Board {

@@ -296,10 +296,7 @@ void Pipeline::render_loop() {
     request.adaptive = board_.render.adaptive;
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     request.influence_region = options_.influence_region;
-    request.accumulation.enabled = board_.render.accumulate;
-    request.accumulation.tolerance_px = board_.render.accumulate_tolerance_px;
-    request.accumulation.max_samples = board_.render.accumulate_max_samples;
-    request.accumulation.reconstruct = board_.render.reconstruct;
+    request.accumulation = board_.render.accumulation;
     r.rpp = request.rays_per_pixel;
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
@@ -325,14 +322,11 @@ void Pipeline::render_loop() {
     r.trace_s = report.trace_s;
     r.encode_s = report.encode_s;
     r.history_samples = report.history_samples;
-    // What the frame cost for the rays it traced (an accumulating frame's
-    // shares give some pixels more and some none; a full history traces
-    // none, and its cost says nothing of what the next new one's rays will).
-    const double traced_rpp = !request.accumulation.enabled ? double(request.rays_per_pixel)
-                              : report.traced_pixels > 0
-                                  ? double(report.camera_rays) / double(report.traced_pixels)
-                                  : 0.0;
-    budget.measured(traced_rpp, report.decode_s + report.trace_s + report.encode_s);
+    // What the frame cost for the rays it traced, a mean (adaptive and
+    // accumulating frames share them unevenly; a full history traces none).
+    budget.measured(report.traced_pixels > 0 ? double(report.camera_rays) / report.traced_pixels
+                                             : 0.0,
+                    report.decode_s + report.trace_s + report.encode_s);
     counters_.rpp = request.rays_per_pixel;
     (void)ready_slots_.push(*slot_index);
   }

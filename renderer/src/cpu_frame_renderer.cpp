@@ -21,6 +21,7 @@
 #include "cpu_kernel.h"
 #include "defocus_filter.h"
 #include "frame_checks.h"
+#include "pixel_span.h"
 #include "ray_shares.h"
 #include "video_codec.h"
 #include "worker_pool.h"

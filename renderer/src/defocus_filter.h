@@ -26,14 +26,10 @@
 #include <glm/vec4.hpp>
 
 #include "camhead/renderer/gpu_layout.h"
+#include "pixel_span.h"
 #include "worker_pool.h"
 
 namespace camhead::renderer::cpu {
-
-// A row's stretch of the pixels to filter.
-struct PixelSpan {
-  std::uint32_t y, x0, x1;
-};
 
 struct DefocusFilterSettings {
   double strength = 1.0;

@@ -15,7 +15,7 @@
 
 #include <glm/vec4.hpp>
 
-#include "defocus_filter.h" // PixelSpan
+#include "pixel_span.h"
 #include "worker_pool.h"
 
 namespace camhead::renderer::cpu {

@@ -138,15 +138,21 @@ TEST(EncoderFilter, RampLag) {
   }
 }
 
-TEST(EncoderFilter, StillLensJitter) {
-  // True position between two counts, so quantisation flips the reading;
-  // Gaussian noise of 1 count; and a further random +-1 count.
-  std::mt19937 rng(42);
+// 30 s of a still ring at 100 Hz: its true position between two counts, so
+// quantisation flips the reading; Gaussian noise of 1 count; and a further
+// random +-1 count.
+std::vector<double> still_ring(unsigned seed) {
+  std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_int_distribution<int> lsb(-1, 1);
   std::vector<double> raw;
   for (int i = 0; i < 3000; ++i)
     raw.push_back(std::round(2000.4 + gauss(rng)) + lsb(rng));
+  return raw;
+}
+
+TEST(EncoderFilter, StillLensJitter) {
+  const std::vector<double> raw = still_ring(42);
 
   const EncoderFilterParams params;
   EncoderFilter chain(params);
@@ -181,12 +187,7 @@ TEST(EncoderFilter, AStillRingGivesTheSameValueFrameAfterFrame) {
   // StillLensJitter's noise, 30 s of it: the One Euro output alone moves
   // every frame, and a renderer would start its history afresh every frame
   // (frame_history.h); with the still hold it changes on few frames.
-  std::mt19937 rng(7);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  std::uniform_int_distribution<int> lsb(-1, 1);
-  std::vector<double> raw;
-  for (int i = 0; i < 3000; ++i)
-    raw.push_back(std::round(2000.4 + gauss(rng)) + lsb(rng));
+  const std::vector<double> raw = still_ring(7);
   const auto changed = [](const std::vector<double> &frames) {
     int n = 0;
     for (std::size_t i = 26; i < frames.size(); ++i) // from the second second on

@@ -208,13 +208,13 @@ TEST(BoardLive, AccumulationIsOnUnlessAdaptive) {
     return parse_board(live(R"({"type": "sim"})", R"(, "render": )" + fields), "/rigs/test.json")
         .render;
   };
-  EXPECT_TRUE(render("{}").accumulate);
-  EXPECT_TRUE(render("{}").reconstruct);
-  EXPECT_FALSE(render(R"({"adaptive": true})").accumulate);
-  EXPECT_FALSE(render(R"({"accumulate": false})").accumulate);
-  EXPECT_FALSE(render(R"({"reconstruct": false})").reconstruct);
-  EXPECT_EQ(render(R"({"accumulate_max_samples": 64})").accumulate_max_samples, 64u);
-  EXPECT_EQ(render(R"({"accumulate_tolerance_px": 0.2})").accumulate_tolerance_px, 0.2);
+  EXPECT_TRUE(render("{}").accumulation.enabled);
+  EXPECT_TRUE(render("{}").accumulation.reconstruct);
+  EXPECT_FALSE(render(R"({"adaptive": true})").accumulation.enabled);
+  EXPECT_FALSE(render(R"({"accumulate": false})").accumulation.enabled);
+  EXPECT_FALSE(render(R"({"reconstruct": false})").accumulation.reconstruct);
+  EXPECT_EQ(render(R"({"accumulate_max_samples": 64})").accumulation.max_samples, 64u);
+  EXPECT_EQ(render(R"({"accumulate_tolerance_px": 0.2})").accumulation.tolerance_px, 0.2);
 }
 
 // A pose the tracer cannot build a view from would render no virtual object

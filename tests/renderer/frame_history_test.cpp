@@ -325,15 +325,21 @@ TEST(FrameHistory, PixelsOutsideTheRegionPassThrough) {
   }
 }
 
+// A converged render of `scene` (1024 samples), to measure against.
+Frames converged(const Scene &scene, std::uint32_t seed) {
+  Frames reference(scene);
+  FrameRequest request = still_uniform(scene, 1024, seed);
+  request.accumulation.max_samples = 1024;
+  (void)reference.render(request);
+  return reference;
+}
+
 TEST(FrameHistory, OneReconstructedRayPerPixelOfADefocusedShotIsNearlyNineFreshOnes) {
   // At this size the blur circles are 5-7 px; at 720x576, where the rig's
   // near focus blurs by tens of pixels, the reconstructed frame beats 9 rpp
   // (camhead bench live, bench/RESULTS.md).
   const Scene scene = defocused_ball_scene();
-  Frames reference(scene);
-  FrameRequest converged = still_uniform(scene, 1024, 78);
-  converged.accumulation.max_samples = 1024;
-  (void)reference.render(converged);
+  const Frames reference = converged(scene, 78);
   Frames nine(scene);
   FrameRequest fresh = still_uniform(scene, 9, 79);
   fresh.accumulation.enabled = false;
@@ -359,10 +365,7 @@ TEST(FrameHistory, SharingByNoiseConvergesFasterThanEveryPixelAlike) {
   // The same rays (2 a frame for 16 frames), given where the samples
   // disagree: the blurred rim of the ball and its shadow.
   const Scene scene = ball_scene();
-  Frames reference(scene);
-  FrameRequest converged = still_uniform(scene, 1024, 77);
-  converged.accumulation.max_samples = 1024;
-  (void)reference.render(converged);
+  const Frames reference = converged(scene, 77);
   Frames alike(scene);
   Frames by_noise(scene);
   std::uint64_t rays_alike = 0, rays_by_noise = 0;

@@ -20,7 +20,7 @@ struct AccumulationSettings {
   // whose samples disagree most (the blurred edges and shadows) rather than
   // to every pixel alike. Off, N still frames of k rays are exactly one
   // frame of N k rays (tests/renderer/frame_history_test.cpp); on, each
-  // pixel's picture is exactly one of its own count of samples.
+  // pixel holds its own count of samples of its own pattern.
   bool share_by_noise = true;
   // Let each pixel borrow its neighbours' samples within a Gaussian of
   // sigma = strength sqrt(blur radius / samples) pixels, among neighbours of
