@@ -1,5 +1,7 @@
 // The parts of a frame's set-up and the smallest units of tracing work:
-// compiling a scene, building the BVH of the bunny scene, and one small
+// compiling a scene, building the BVH of the bunny scene, a frame's
+// influence region (by a builder made for the frame, as every frame did
+// before issue 24, and by one kept from frame to frame), and one small
 // batch of camera rays on each executor (a 64 x 64 frame at 1 rpp, 4096
 // rays: on the GPU mostly the fixed cost of a frame, on one CPU thread the
 // kernel's own speed).
@@ -10,6 +12,7 @@
 #include "benchmarks.h"
 #include "camhead/renderer/bvh.h"
 #include "camhead/renderer/cpu_tracer.h"
+#include "camhead/renderer/influence_region.h"
 
 #include <benchmark/benchmark.h>
 
@@ -43,6 +46,24 @@ void build_bvh_bench(benchmark::State &state, const BenchScene &scene) {
       double(state.iterations()) * double(primitives.size()) * 1e-6, benchmark::Counter::kIsRate);
   state.counters["nodes"] = stats.node_count;
   state.counters["sah_cost"] = stats.sah_cost;
+}
+
+// A 720x576 frame's region with a plate, its focus stepping from frame to
+// frame as in a pull, so that nothing is the same twice.
+void influence_region_bench(benchmark::State &state, const BenchScene &scene, bool kept) {
+  const PreparedScene &prepared = BenchCache::get().scene(scene, 720, 576);
+  renderer::gpu::FrameParams frame = renderer::make_frame_params(prepared.scene, 1);
+  frame.image.z = 1; // a plate: the composite is the camera image outside the region
+  const float focus = frame.lens.y;
+  renderer::InfluenceRegionBuilder builder(prepared.compiled);
+  double fraction = 0.0;
+  int step = 0;
+  for (auto _ : state) {
+    frame.lens.y = focus * (0.5f + 0.05f * float(step++ % 20));
+    fraction += kept ? builder.build(frame).fraction()
+                     : renderer::influence_region(prepared.compiled, frame).fraction();
+  }
+  state.counters["traced"] = fraction / double(state.iterations());
 }
 
 constexpr int kBatchSide = 64;
@@ -90,6 +111,11 @@ void register_micro_benchmarks() {
     benchmark::RegisterBenchmark(("Micro/compile_scene/" + name).c_str(), compile_scene_bench,
                                  scene)
         ->Unit(benchmark::kMillisecond);
+    for (const bool kept : {false, true})
+      benchmark::RegisterBenchmark(
+          ("Micro/influence_region/" + name + "/720x576/" + (kept ? "kept" : "once")).c_str(),
+          influence_region_bench, scene, kept)
+          ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Micro/gpu_batch/" + name + "/" + batch + "/rpp:1").c_str(),
                                  gpu_batch_bench, scene)
         ->Unit(benchmark::kMillisecond)

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <optional>
 
+#include "camhead/base/thread_name.h"
+
 namespace camhead::pipeline {
 
 LensHub::LensHub(const Board &board)
@@ -11,7 +13,10 @@ LensHub::LensHub(const Board &board)
 
 void LensHub::start() {
   if (!thread_.joinable())
-    thread_ = std::thread([this] { poll_loop(); });
+    thread_ = std::thread([this] {
+      base::name_this_thread("camhead-lens");
+      poll_loop();
+    });
 }
 
 LensHub::~LensHub() {

@@ -18,6 +18,7 @@
 
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/base/thread_name.h"
 #include "camhead/hal/camera/camera_source.h"
 #include "camhead/hal/camera/frame_lease.h"
 #include "camhead/hal/output/frame_sink.h"
@@ -91,6 +92,8 @@ private:
   void print_status(std::int64_t now, double dt, std::uint64_t in, std::uint64_t out, bool tty);
   void report_sink_errors(bool tty);
   void report_camera(bool tty);
+  // A frame's request as the board and the options make it.
+  [[nodiscard]] renderer::FrameRequest board_request() const;
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
   // are on their way, and says how long in the record.
   LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
@@ -114,11 +117,14 @@ private:
 
   std::vector<Slot> slots_{kSlots};
   std::vector<std::vector<std::uint8_t>> last_frames_; // what each sink showed last
-  std::vector<std::uint64_t> sink_errors_seen_;        // status thread: reported so far
-  std::string camera_detail_seen_;                     // status thread: reported last
-  std::uint64_t camera_errors_seen_ = 0;               // status thread: reported so far
-  std::string camera_failure_;                         // capture thread; read after it is joined
-  std::string render_failure_;                         // render thread: the first; after the join
+  // Render thread: where a frame's composite goes, its slot's buffers
+  // (named anew each frame: the output thread swaps them).
+  std::vector<renderer::VideoBuffer> targets_;
+  std::vector<std::uint64_t> sink_errors_seen_; // status thread: reported so far
+  std::string camera_detail_seen_;              // status thread: reported last
+  std::uint64_t camera_errors_seen_ = 0;        // status thread: reported so far
+  std::string camera_failure_;                  // capture thread; read after it is joined
+  std::string render_failure_;                  // render thread: the first; after the join
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   Counters counters_;
@@ -178,12 +184,17 @@ Pipeline::Pipeline(const RunOptions &options)
       throw StatsFileError(options.stats_file->string() +
                            ": cannot be written: " + std::strerror(errno));
   }
-  // Every buffer the loop uses, made now.
+  // Every pipeline and buffer the loop uses, made now.
+  std::vector<base::VideoFormat> formats;
+  for (const auto &sink : sinks_)
+    formats.push_back(sink->format());
+  renderer_->prepare(board_request(), camera_->format(), formats);
   for (Slot &slot : slots_)
     for (const auto &sink : sinks_)
       slot.images.emplace_back(base::frame_bytes(sink->format()));
   for (const auto &sink : sinks_)
     last_frames_.emplace_back(base::frame_bytes(sink->format()));
+  targets_.resize(sinks_.size());
   sink_errors_seen_.assign(sinks_.size(), 0);
   sink_failed_.assign(sinks_.size(), 0);
   for (int i = 0; i < kSlots; ++i)
@@ -198,6 +209,15 @@ Pipeline::Pipeline(const RunOptions &options)
 Pipeline::~Pipeline() {
   if (stats_ != nullptr)
     std::fclose(stats_); // a run that failed: what was recorded stays
+}
+
+renderer::FrameRequest Pipeline::board_request() const {
+  renderer::FrameRequest request;
+  request.camera = pose_;
+  request.adaptive = board_.render.adaptive;
+  request.influence_region = options_.influence_region;
+  request.accumulation = board_.render.accumulation;
+  return request;
 }
 
 bool Pipeline::should_stop() const {
@@ -254,9 +274,6 @@ void Pipeline::render_loop() {
   budget_settings.max_rpp = board_.render.max_rays_per_pixel;
   renderer::FrameBudget budget(budget_settings);
   std::optional<std::uint64_t> last_sequence;
-  // Where a frame's composite goes: its slot's buffers (made once; the
-  // output thread swaps them, so they are named anew each frame).
-  std::vector<renderer::VideoBuffer> targets(sinks_.size());
   for (;;) {
     std::optional<Delivered> delivered = captured_.pop(100ms);
     if (!delivered) {
@@ -290,20 +307,17 @@ void Pipeline::render_loop() {
     r.f_number = lens.state.f_number.value;
     r.focal_length_mm = lens.state.focal_length_mm.value;
     r.lens_fresh = lens.fresh;
-    renderer::FrameRequest request;
+    renderer::FrameRequest request = board_request();
     request.camera = lens_camera(pose_, lens.state);
     request.rays_per_pixel = board_.render.rays_per_pixel.value_or(budget.rpp());
-    request.adaptive = board_.render.adaptive;
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
-    request.influence_region = options_.influence_region;
-    request.accumulation = board_.render.accumulation;
     r.rpp = request.rays_per_pixel;
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
-      targets[i] = {sinks_[i]->format(), slot.images[i]};
+      targets_[i] = {sinks_[i]->format(), slot.images[i]};
     r.render_start_ns = base::monotonic_ns();
     const renderer::FrameReport report =
-        renderer_->render(request, {frame.format, frame.bytes}, targets);
+        renderer_->render(request, {frame.format, frame.bytes}, targets_);
     r.render_end_ns = base::monotonic_ns();
     delivered->frame.reset(); // the camera may fill the buffer again
     if (report.status != renderer::FrameStatus::ok) {
@@ -527,9 +541,18 @@ RunSummary Pipeline::run() {
   start_ns_ = base::monotonic_ns();
   std::vector<std::thread> threads;
   try {
-    threads.emplace_back([this] { capture_loop(); });
-    threads.emplace_back([this] { render_loop(); });
-    threads.emplace_back([this] { output_loop(); });
+    threads.emplace_back([this] {
+      base::name_this_thread("camhead-capture");
+      capture_loop();
+    });
+    threads.emplace_back([this] {
+      base::name_this_thread("camhead-render");
+      render_loop();
+    });
+    threads.emplace_back([this] {
+      base::name_this_thread("camhead-output");
+      output_loop();
+    });
   } catch (...) {
     // A thread that cannot start: stop the ones that did (a capture thread
     // waiting for room, a render thread for a slot), then say so.

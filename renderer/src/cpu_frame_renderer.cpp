@@ -56,11 +56,24 @@ public:
                                   "x" + std::to_string(h) +
                                   " is not a video frame size (even width and height)");
     kernel_ = cpu::make_cpu_kernel(compiled_, make_frame_params(scene_), nodes_);
+    // A region's rows hold at most every other tile as a run of its own.
+    const std::size_t runs = (std::size_t(w) + 2 * CAMHEAD_TILE_X - 1) / (2 * CAMHEAD_TILE_X);
+    for (std::vector<RowSpan> *spans : {&spans_, &blocks_, &traced_spans_})
+      spans->reserve(runs * std::size_t(h));
   }
 
   std::string executor() const override {
     return "cpu reference, " + std::to_string(pool_.threads()) + " thread" +
            (pool_.threads() == 1 ? "" : "s");
+  }
+
+  void prepare(const FrameRequest &request, const std::optional<base::VideoFormat> &plate,
+               std::span<const base::VideoFormat>) override {
+    gpu::FrameParams frame = make_frame_params(scene_, request.camera, 1);
+    frame.image.z = plate ? 1u : 0u;
+    if (request.influence_region)
+      static_cast<void>(regions_.build(frame));
+    history_valid_ = false; // the region it traced is no longer in regions_
   }
 
   FrameReport render(const FrameRequest &request, const VideoFrame &plate,
@@ -108,19 +121,19 @@ public:
 
     Clock::time_point start = Clock::now();
     if (!continues) {
-      region_ = request.influence_region ? influence_region(compiled_, frame)
-                                         : whole_frame_region(frame.image.x, frame.image.y);
+      region_ = request.influence_region ? &regions_.build(frame)
+                                         : &regions_.whole_frame(frame.image.x, frame.image.y);
       region_kind_ = request.influence_region;
       spans_.clear();
       blocks_.clear();
-      for (const PixelRect &rect : region_.rects)
+      for (const PixelRect &rect : region_->rects)
         for (std::uint32_t y = rect.y0; y < rect.y1; ++y) {
           spans_.push_back({y, rect.x0, rect.x1});
           if ((y - rect.y0) % 2 == 0) // whole tiles: an even number of rows
             blocks_.push_back({y, rect.x0, rect.x1});
         }
     }
-    report.traced_pixels = region_.pixels();
+    report.traced_pixels = region_->pixels();
     report.frame_pixels = pixels_;
     // Outside the region the composite is the camera image, and in the
     // camera frame's own format the way through linear RGB and back gives
@@ -153,16 +166,16 @@ public:
       trace_shares(has_plate);
       history_rays_ += report.camera_rays;
       report.history_samples =
-          std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_.pixels(), 1));
+          std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_->pixels(), 1));
     } else if (!request.adaptive) {
       trace(0u, total, has_plate);
-      report.camera_rays = region_.pixels() * total;
+      report.camera_rays = region_->pixels() * total;
     } else {
       const std::uint32_t pilot = adaptive_pilot(request.adaptive_settings, total);
       kernel_.frame.sampling = gpu::uvec4(0u, pilot, pilot, frame.sampling.w);
       trace(0u, pilot, has_plate);
       // allocate_samples() returns a new vector (adaptive frames only).
-      counts_ = allocate_samples(aux_, frame, pilot, request.adaptive_settings, &region_);
+      counts_ = allocate_samples(aux_, frame, pilot, request.adaptive_settings, region_);
       const std::uint32_t most = *std::max_element(counts_.begin(), counts_.end());
       kernel_.sample_counts = counts_.data();
       kernel_.frame.tracing.y = pilot;
@@ -292,7 +305,7 @@ private:
         for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i)
           shares_[i] = k;
       history_uniform_ += k;
-      return region_.pixels() * k;
+      return region_->pixels() * k;
     }
     return cpu::share_rays_by_noise(spans_, scene_.render.width, scene_.render.height, aux_,
                                     history_counts_, rpp, most, history_frames_,
@@ -345,10 +358,11 @@ private:
   std::vector<glm::vec4> plate_, composite_;
   std::vector<glm::vec4> mixed_, real_, aux_; // the accumulators
   std::vector<std::uint32_t> counts_;         // adaptive shares
-  InfluenceRegion region_;                    // this frame's
-  std::vector<RowSpan> spans_;                // this frame's region, row by row
-  std::vector<RowSpan> blocks_;               // ... and by pairs of rows
-  std::vector<RowSpan> traced_spans_;         // what the accumulators hold
+  InfluenceRegionBuilder regions_{compiled_};
+  const InfluenceRegion *region_ = nullptr; // this frame's, in regions_
+  std::vector<RowSpan> spans_;              // this frame's region, row by row
+  std::vector<RowSpan> blocks_;             // ... and by pairs of rows
+  std::vector<RowSpan> traced_spans_;       // what the accumulators hold
   // The history: the accumulators' camera and pattern, and what they hold.
   gpu::FrameParams history_{};
   bool history_valid_ = false;

@@ -1,6 +1,9 @@
 // The GPU tracer as a live frame renderer (frame_renderer.h): the camera
 // frame's conversion, the trace and the outputs' conversion all on the
 // device, one submission for a steady frame (GpuTracer::render_video).
+#include <algorithm>
+#include <array>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -30,6 +33,23 @@ public:
 
   std::string executor() const override { return "gpu " + tracer_.device_name(); }
 
+  void prepare(const FrameRequest &request, const std::optional<base::VideoFormat> &plate,
+               std::span<const base::VideoFormat> outputs) override {
+    if (outputs.size() > VIDEO_MAX_OUTPUTS)
+      throw std::invalid_argument(std::to_string(outputs.size()) +
+                                  " outputs; the GPU executor takes " +
+                                  std::to_string(VIDEO_MAX_OUTPUTS));
+    const gpu::FrameParams frame = frame_params(request, plate.has_value());
+    if (request.influence_region)
+      static_cast<void>(regions_.build(frame));
+    std::array<base::PixelFormat, VIDEO_MAX_OUTPUTS> pixels{};
+    for (std::size_t k = 0; k < outputs.size(); ++k)
+      pixels[k] = outputs[k].pixel;
+    tracer_.prepare_video(frame,
+                          plate ? std::optional<base::PixelFormat>(plate->pixel) : std::nullopt,
+                          std::span(pixels.data(), outputs.size()), request.adaptive);
+  }
+
   FrameReport render(const FrameRequest &request, const VideoFrame &plate,
                      std::span<const VideoBuffer> outputs) override {
     if (lost_)
@@ -45,18 +65,16 @@ public:
       return bad_frame("0 rays per pixel");
     if (request.accumulation.enabled && request.adaptive)
       return bad_frame("adaptive frames do not accumulate");
-    gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
-    if (request.seed != 0)
-      frame.sampling.w = request.seed;
-    frame.image.z = plate.bytes.empty() ? 0u : 1u; // the camera frame is the plate
+    const gpu::FrameParams frame = frame_params(request, !plate.bytes.empty());
     FrameReport report;
     try {
-      region_ = request.influence_region ? influence_region(compiled_, frame)
-                                         : whole_frame_region(frame.image.x, frame.image.y);
-      report.traced_pixels = region_.pixels();
+      const InfluenceRegion &region = request.influence_region
+                                          ? regions_.build(frame)
+                                          : regions_.whole_frame(frame.image.x, frame.image.y);
+      report.traced_pixels = region.pixels();
       report.frame_pixels = std::uint64_t(frame.image.x) * frame.image.y;
       const RenderResult result = tracer_.render_video(
-          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, &region_);
+          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, &region);
       report.camera_rays = result.camera_rays;
       // No history on this executor yet: an accumulating frame starts one
       // and ends it, which is what the report says.
@@ -81,6 +99,15 @@ public:
   }
 
 private:
+  gpu::FrameParams frame_params(const FrameRequest &request, bool has_plate) const {
+    gpu::FrameParams frame =
+        make_frame_params(scene_, request.camera, int(std::max(request.rays_per_pixel, 1u)));
+    if (request.seed != 0)
+      frame.sampling.w = request.seed;
+    frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
+    return frame;
+  }
+
   static Scene without_plate(Scene scene) {
     scene.plate.reset();
     return scene;
@@ -96,7 +123,7 @@ private:
   Scene scene_;
   CompiledScene compiled_; // for each frame's influence region
   GpuTracer tracer_;
-  InfluenceRegion region_;
+  InfluenceRegionBuilder regions_{compiled_};
   bool lost_ = false;
 };
 

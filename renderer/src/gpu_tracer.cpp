@@ -24,6 +24,7 @@
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/bvh.h"
 #include "frame_checks.h"
+#include "function_ref.h"
 #include "resolve_spv.h"
 #include "trace_spv.h"
 #include "video_decode_spv.h"
@@ -305,16 +306,17 @@ struct GpuTracer::Impl {
                       LayerSelection layers, const AdaptiveSampling *adaptive,
                       const InfluenceRegion *region, const VideoJob *video = nullptr);
   // Records commands into a command buffer.
-  using Recorder = std::function<void(VkCommandBuffer)>;
+  using Recorder = FunctionRef<void(VkCommandBuffer)>;
   // Adds samples [0, end) of `frame` to the accumulators in batches sized by
   // `sizer`, one submission each, each batch recorded by `trace` once
   // frame.sampling holds its samples; `prologue` records commands into the
   // first submission, before its batch, and `epilogue` into the last, after
   // it (both submitted also when `end` is 0). `report` gets the samples done.
   // Returns the number of submissions.
-  int trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
-                    const Recorder &trace, const Recorder &prologue, const Recorder &epilogue,
-                    const std::function<void(std::uint32_t)> &report);
+  int trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer, Recorder trace,
+                    Recorder prologue, Recorder epilogue, FunctionRef<void(std::uint32_t)> report);
+  void prepare_video(const gpu::FrameParams &frame, std::optional<base::PixelFormat> plate,
+                     std::span<const base::PixelFormat> outputs, bool adaptive);
   // Records the accumulators' clear, ordered before the kernels.
   void record_clear(VkCommandBuffer command_buffer) const;
   // Records adaptive_weights, _solve and _shares (adaptive.glsl) and
@@ -345,7 +347,8 @@ struct GpuTracer::Impl {
                              base::PixelFormat format);
   // `kernel` over the frame's grid or, with `group_list`, over a group list
   // (buffers.glsl, GROUP_LIST), to be dispatched with a base; built on first
-  // use (a lookup allocates nothing).
+  // use, which for live frames is prepare_video() (a lookup allocates
+  // nothing).
   VkPipeline pipeline(const Kernel &kernel, bool group_list = false);
   // Binds `pipeline` and the descriptor set every kernel shares.
   void bind(VkCommandBuffer command_buffer, VkPipeline pipeline) const;
@@ -545,6 +548,10 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   // frame (CMJ samples, over an influence region: the default of stills and
   // live frames).
   static_cast<void>(pipeline(trace_kernel(gpu::FrameParams{}), true));
+  // Room for any frame's region and group lists: a frame allocates nothing.
+  frame_region.rects.reserve(tiles);
+  group_places.reserve(std::max(tiles, video_groups));
+  video_spans.reserve(tiles);
   uniform_sizer = {};
   second_pass_sizer = {};
   loaded = true;
@@ -674,7 +681,13 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
     throw GpuError("influence region is " + std::to_string(wanted_region->width) + "x" +
                    std::to_string(wanted_region->height) + " but the loaded scene is " +
                    std::to_string(width) + "x" + std::to_string(height));
-  frame_region = wanted_region != nullptr ? *wanted_region : whole_frame_region(width, height);
+  if (wanted_region != nullptr) {
+    frame_region = *wanted_region; // into the storage load() made
+  } else {
+    frame_region.width = width;
+    frame_region.height = height;
+    frame_region.rects.assign(1, PixelRect{0, 0, width, height});
+  }
 
   // A live frame: the camera frame into the plate on the device, and the
   // composite into each output's format (video_decode.comp, video_encode.comp).
@@ -943,9 +956,8 @@ void GpuTracer::Impl::record_queue_batch(VkCommandBuffer command_buffer,
 }
 
 int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
-                                   const Recorder &trace, const Recorder &prologue,
-                                   const Recorder &epilogue,
-                                   const std::function<void(std::uint32_t)> &report) {
+                                   Recorder trace, Recorder prologue, Recorder epilogue,
+                                   FunctionRef<void(std::uint32_t)> report) {
   // One uniform buffer suffices because each batch is waited for before the
   // next one rewrites it.
   int submissions = 0;
@@ -982,6 +994,30 @@ int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, B
   return submissions;
 }
 
+void GpuTracer::Impl::prepare_video(const gpu::FrameParams &frame,
+                                    std::optional<base::PixelFormat> plate,
+                                    std::span<const base::PixelFormat> outputs, bool adaptive) {
+  if (!loaded)
+    throw GpuError("GpuTracer::prepare_video() before a successful load()");
+  for (const bool group_list : {false, true}) {
+    static_cast<void>(pipeline(trace_kernel(frame), group_list));
+    static_cast<void>(pipeline(resolve_kernel(RESOLVE_COMPOSITE), group_list));
+    if (plate)
+      static_cast<void>(
+          pipeline(video_kernel(video_decode_spv, "video_decode.comp", *plate), group_list));
+    for (const base::PixelFormat out : outputs)
+      static_cast<void>(
+          pipeline(video_kernel(video_encode_spv, "video_encode.comp", out), group_list));
+    if (adaptive)
+      for (const Kernel &kernel : {Kernel{adaptive_weights_spv, "adaptive_weights.comp"},
+                                   Kernel{adaptive_shares_spv, "adaptive_shares.comp"},
+                                   Kernel{adaptive_queue_fill_spv, "adaptive_queue_fill.comp"}})
+        static_cast<void>(pipeline(kernel, group_list));
+  }
+  if (adaptive)
+    static_cast<void>(pipeline(trace_kernel(frame, true)));
+}
+
 GpuTracer::GpuTracer(const std::string &device) : impl_(std::make_unique<Impl>(device)) {}
 
 GpuTracer::~GpuTracer() = default;
@@ -992,6 +1028,11 @@ std::string GpuTracer::device_name() const {
 
 void GpuTracer::load(const CompiledScene &scene) {
   impl_->load(scene);
+}
+
+void GpuTracer::prepare_video(const gpu::FrameParams &frame, std::optional<base::PixelFormat> plate,
+                              std::span<const base::PixelFormat> outputs, bool adaptive) {
+  impl_->prepare_video(frame, plate, outputs, adaptive);
 }
 
 void GpuTracer::set_kernel_specialization(bool on) {

@@ -58,7 +58,9 @@ struct Halfspace {
 };
 
 // A closed convex polyhedron as its faces (convex polygons, vertices in
-// order), cut down one half-space at a time.
+// order), cut down one half-space at a time. Its faces lie end to end in
+// one array, so that a polyhedron cut into another's storage allocates
+// nothing once that storage has grown to fit.
 class ConvexPolyhedron {
 public:
   static ConvexPolyhedron box(const dvec3 &lo, const dvec3 &hi) {
@@ -68,52 +70,82 @@ public:
     constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
                                   {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
     ConvexPolyhedron p;
-    for (const auto &f : kFaces)
-      p.faces_.push_back({c[f[0]], c[f[1]], c[f[2]], c[f[3]]});
+    for (const auto &f : kFaces) {
+      for (const int corner : f)
+        p.vertices_.push_back(c[std::size_t(corner)]);
+      p.face_ends_.push_back(p.vertices_.size());
+    }
     return p;
   }
 
-  [[nodiscard]] bool empty() const { return faces_.empty(); }
+  [[nodiscard]] bool empty() const { return face_ends_.empty(); }
+  [[nodiscard]] std::size_t vertex_storage() const { return vertices_.size(); }
+  [[nodiscard]] std::size_t faces() const { return face_ends_.size(); }
 
-  // Keeps the part with n . x <= h, closed by a new face on the plane.
-  void clip(const Halfspace &plane) {
-    std::vector<std::vector<dvec3>> kept;
-    std::vector<dvec3> cap;
-    for (const std::vector<dvec3> &face : faces_) {
-      std::vector<dvec3> out;
-      for (std::size_t i = 0; i < face.size(); ++i) {
-        const dvec3 &a = face[i];
-        const dvec3 &b = face[(i + 1) % face.size()];
+  // Room for `vertices` and `faces` without growing.
+  void reserve(std::size_t vertices, std::size_t faces) {
+    vertices_.reserve(vertices);
+    face_ends_.reserve(faces);
+  }
+
+  // The part with n . x <= h, closed by a new face on the plane, into `out`
+  // (its storage reused); `cap` is scratch. A face loses its outside
+  // vertices and gains at most two, and the new face takes two points of
+  // each face cut (an edge's point twice), so `out` needs at most
+  // vertex_storage() + 4 faces() vertices and faces() + 1 faces.
+  void clip_into(const Halfspace &plane, ConvexPolyhedron &out, std::vector<dvec3> &cap) const {
+    out.vertices_.clear();
+    out.face_ends_.clear();
+    cap.clear();
+    std::size_t begin = 0;
+    for (const std::size_t end : face_ends_) {
+      const std::size_t kept_from = out.vertices_.size();
+      for (std::size_t i = begin; i < end; ++i) {
+        const dvec3 &a = vertices_[i];
+        const dvec3 &b = vertices_[i + 1 < end ? i + 1 : begin];
         const double da = glm::dot(plane.n, a) - plane.h;
         const double db = glm::dot(plane.n, b) - plane.h;
         if (da <= 0.0) {
-          out.push_back(a);
+          out.vertices_.push_back(a);
           if (da == 0.0)
             cap.push_back(a);
         }
         if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
           const dvec3 p = a + (b - a) * (da / (da - db));
-          out.push_back(p);
+          out.vertices_.push_back(p);
           cap.push_back(p);
         }
       }
-      if (out.size() >= 3)
-        kept.push_back(std::move(out));
+      if (out.vertices_.size() - kept_from >= 3)
+        out.face_ends_.push_back(out.vertices_.size());
+      else
+        out.vertices_.resize(kept_from);
+      begin = end;
     }
-    if (cap.size() >= 3)
-      kept.push_back(order_around(std::move(cap), plane.n));
-    faces_ = std::move(kept);
+    if (cap.size() >= 3) {
+      order_around(cap, plane.n);
+      out.vertices_.insert(out.vertices_.end(), cap.begin(), cap.end());
+      out.face_ends_.push_back(out.vertices_.size());
+    }
+  }
+
+  // Keeps the part with n . x <= h: the world-space step, where allocating
+  // is fine.
+  void clip(const Halfspace &plane) {
+    ConvexPolyhedron out;
+    std::vector<dvec3> cap;
+    clip_into(plane, out, cap);
+    *this = std::move(out);
   }
 
   template <typename Visit> void for_each_vertex(Visit visit) const {
-    for (const std::vector<dvec3> &face : faces_)
-      for (const dvec3 &v : face)
-        visit(v);
+    for (const dvec3 &v : vertices_)
+      visit(v);
   }
 
 private:
-  // The points of a convex polygon on a plane of normal n, in order.
-  static std::vector<dvec3> order_around(std::vector<dvec3> points, const dvec3 &n) {
+  // Puts the points of a convex polygon on a plane of normal n in order.
+  static void order_around(std::span<dvec3> points, const dvec3 &n) {
     dvec3 centre(0.0);
     for (const dvec3 &p : points)
       centre += p;
@@ -126,10 +158,10 @@ private:
     };
     std::sort(points.begin(), points.end(),
               [&](const dvec3 &a, const dvec3 &b) { return angle(a) < angle(b); });
-    return points;
   }
 
-  std::vector<std::vector<dvec3>> faces_;
+  std::vector<dvec3> vertices_;
+  std::vector<std::size_t> face_ends_; // one past each face's last vertex
 };
 
 // A box along three orthonormal axes: the points x with lo_i <= axes_i . x
@@ -204,17 +236,21 @@ struct Point {
   double u, v;
 };
 
-// Andrew's monotone chain: the hull's corners in order (collinear points
-// dropped); fewer than three points come back as they are.
-std::vector<Point> convex_hull(std::vector<Point> points) {
+// Andrew's monotone chain: the corners of the hull of `points` (sorted in
+// place) in order, into `hull` (collinear points dropped); fewer than three
+// points come back as they are. `hull` needs room for 2 points.size().
+void convex_hull(std::span<Point> points, std::vector<Point> &hull) {
   std::sort(points.begin(), points.end(),
             [](const Point &a, const Point &b) { return a.u != b.u ? a.u < b.u : a.v < b.v; });
-  if (points.size() < 3)
-    return points;
+  hull.clear();
+  if (points.size() < 3) {
+    hull.insert(hull.end(), points.begin(), points.end());
+    return;
+  }
   const auto turn = [](const Point &o, const Point &a, const Point &b) {
     return (a.u - o.u) * (b.v - o.v) - (a.v - o.v) * (b.u - o.u);
   };
-  std::vector<Point> hull(2 * points.size());
+  hull.resize(2 * points.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < points.size(); ++i) { // lower chain
     while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0)
@@ -227,41 +263,75 @@ std::vector<Point> convex_hull(std::vector<Point> points) {
     hull[k++] = points[i];
   }
   hull.resize(k - 1); // the last point is the first
-  return hull;
 }
 
-// The frame's thin lens in the compiled scene's frame, and the tiles marked
-// so far.
-class RegionBuilder {
+// Steps 2 and 3 for one frame after another: each frame's thin lens, the
+// tiles marked so far, and the scratch space of the cuts and hulls, kept
+// from frame to frame.
+class FrameProjector {
 public:
-  RegionBuilder(const gpu::FrameParams &frame, const dvec3 &origin)
-      : centre_(dvec3(frame.cam_position) - origin), right_(dvec3(frame.cam_right)),
-        up_(dvec3(frame.cam_up)), forward_(dvec3(frame.cam_forward)), aperture_(frame.lens.x),
-        focus_(frame.lens.y), focal_px_(frame.lens.z), filter_px_(frame.lens.w),
-        width_(frame.image.x), height_(frame.image.y),
-        tiles_x_((width_ + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X),
-        tiles_y_((height_ + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y),
-        marked_(std::size_t(tiles_x_) * tiles_y_, 0) {}
+  // Room for pieces of up to `vertices` vertices in `faces` faces, and for
+  // frames of width x height: after this, start(), add() and finish()
+  // allocate nothing.
+  void reserve(std::size_t vertices, std::size_t faces, std::uint32_t width, std::uint32_t height) {
+    // Three cuts deep at most (behind the lens, then near or far), each
+    // growing a piece as clip_into() says.
+    std::size_t v = vertices, f = faces;
+    for (int cut = 0; cut < 2; ++cut) {
+      v += 4 * f;
+      f += 1;
+    }
+    for (ConvexPolyhedron *p : {&front_, &near_, &far_})
+      p->reserve(v, f);
+    cap_.reserve(2 * f);
+    points_.reserve(8 * v); // an octagon per vertex
+    hull_.reserve(16 * v);
+    const std::size_t tiles_x = (width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X;
+    const std::size_t tiles_y = (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y;
+    marked_.reserve(tiles_x * tiles_y);
+    // Runs of marked tiles alternate with gaps: at most half a row's tiles,
+    // and a rectangle ends at most once per run.
+    const std::size_t runs = (tiles_x + 1) / 2;
+    open_.reserve(runs);
+    next_.reserve(runs);
+    rects_capacity_ = runs * tiles_y;
+  }
 
-  // Marks the pixels that may see a point of `poly` (consumed).
-  void add(ConvexPolyhedron poly) {
-    poly.clip({-forward_, -glm::dot(forward_, centre_)}); // behind the lens: no camera ray
-    if (poly.empty())
+  // Forgets the last frame's tiles and takes this one's lens.
+  void start(const gpu::FrameParams &frame, const dvec3 &origin) {
+    centre_ = dvec3(frame.cam_position) - origin;
+    right_ = dvec3(frame.cam_right);
+    up_ = dvec3(frame.cam_up);
+    forward_ = dvec3(frame.cam_forward);
+    aperture_ = frame.lens.x;
+    focus_ = frame.lens.y;
+    focal_px_ = frame.lens.z;
+    filter_px_ = frame.lens.w;
+    width_ = frame.image.x;
+    height_ = frame.image.y;
+    tiles_x_ = (width_ + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X;
+    tiles_y_ = (height_ + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y;
+    marked_.assign(std::size_t(tiles_x_) * tiles_y_, 0);
+  }
+
+  // Marks the pixels that may see a point of `poly`.
+  void add(const ConvexPolyhedron &poly) {
+    poly.clip_into({-forward_, -glm::dot(forward_, centre_)}, front_, cap_); // behind: no ray
+    if (front_.empty())
       return;
     // Within kNearM of the lens a ray is still within the aperture plus a
     // sliver of the field of view; a piece there that a ray may reach is
     // seen across the whole frame.
     constexpr double kNearM = 1e-3;
-    ConvexPolyhedron near = poly;
-    near.clip({forward_, glm::dot(forward_, centre_) + kNearM});
-    if (!near.empty()) {
+    front_.clip_into({forward_, glm::dot(forward_, centre_) + kNearM}, near_, cap_);
+    if (!near_.empty()) {
       const double reach_aperture = aperture_ * std::max(1.0, std::abs(1.0 - kNearM / focus_));
       const double reach_x =
           reach_aperture + (0.5 * width_ + filter_px_ + 2.0) * kNearM / focal_px_;
       const double reach_y =
           reach_aperture + (0.5 * height_ + filter_px_ + 2.0) * kNearM / focal_px_;
       double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
-      near.for_each_vertex([&](const dvec3 &v) {
+      near_.for_each_vertex([&](const dvec3 &v) {
         x_lo = std::min(x_lo, glm::dot(right_, v - centre_));
         x_hi = std::max(x_hi, glm::dot(right_, v - centre_));
         y_lo = std::min(y_lo, glm::dot(up_, v - centre_));
@@ -274,44 +344,46 @@ public:
         return;
       }
     }
-    poly.clip({-forward_, -glm::dot(forward_, centre_) - kNearM});
-    if (poly.empty())
+    front_.clip_into({-forward_, -glm::dot(forward_, centre_) - kNearM}, far_, cap_);
+    if (far_.empty())
       return;
     // Each vertex's blur circle by the octagon around it; the image lies in
     // the convex hull of the octagons.
     constexpr double kOctagon = 1.0823922002923940; // 1 / cos(pi / 8)
-    std::vector<Point> points;
+    points_.clear();
     bool finite = true;
-    poly.for_each_vertex([&](const dvec3 &p) {
+    far_.for_each_vertex([&](const dvec3 &p) {
       const dvec3 d = p - centre_;
       const double z = glm::dot(forward_, d);
       const double u = 0.5 * width_ + focal_px_ * glm::dot(right_, d) / z;
       const double v = 0.5 * height_ - focal_px_ * glm::dot(up_, d) / z;
       const double blur = focal_px_ * aperture_ * std::abs(1.0 / focus_ - 1.0 / z) * kOctagon;
       finite = finite && std::isfinite(u) && std::isfinite(v) && std::isfinite(blur);
-      for (int k = 0; k < 8; ++k) {
-        const double phi = 0.7853981633974483 * k;
-        points.push_back({u + blur * std::cos(phi), v + blur * std::sin(phi)});
-      }
+      for (const Point &corner : kOctagonCorners)
+        points_.push_back({u + blur * corner.u, v + blur * corner.v});
     });
     if (!finite) {
       mark_everywhere(); // unknown
       return;
     }
-    mark_polygon(convex_hull(std::move(points)));
+    convex_hull(points_, hull_);
+    mark_polygon(hull_);
   }
 
-  [[nodiscard]] InfluenceRegion region() const;
+  // The marked tiles as rectangles, into `region` (its storage reused).
+  void finish(InfluenceRegion &region);
 
-private:
   // Marks every tile: where a piece's image is not known.
   void mark_everywhere() { std::fill(marked_.begin(), marked_.end(), std::uint8_t(1)); }
 
+  [[nodiscard]] std::size_t rects_capacity() const { return rects_capacity_; }
+
+private:
   // Marks the tiles of the pixels whose samples (the pixel's centre within
   // half the filter width, and one pixel more for the rays' rounding) can
   // fall in a convex polygon (image coordinates, in order), a row of
   // tiles at a time: its x-range within the row's band of sample positions.
-  void mark_polygon(const std::vector<Point> &hull) {
+  void mark_polygon(std::span<const Point> hull) {
     if (hull.empty())
       return;
     double v_lo = INFINITY, v_hi = -INFINITY;
@@ -355,16 +427,32 @@ private:
   // A pixel of margin for the rays' rounding, beyond the pixel filter.
   static constexpr double kReachPx = 1.0;
 
-  dvec3 centre_, right_, up_, forward_;
-  double aperture_, focus_, focal_px_, filter_px_;
-  std::uint32_t width_, height_, tiles_x_, tiles_y_;
+  // The unit octagon's corners, at multiples of 45 degrees.
+  static constexpr double kHalfRoot2 = 0.70710678118654752;
+  static constexpr Point kOctagonCorners[8] = {
+      {1, 0},  {kHalfRoot2, kHalfRoot2},   {0, 1},  {-kHalfRoot2, kHalfRoot2},
+      {-1, 0}, {-kHalfRoot2, -kHalfRoot2}, {0, -1}, {kHalfRoot2, -kHalfRoot2}};
+
+  // A run of marked tiles [tx0, tx1), open since row ty0.
+  struct Open {
+    std::uint32_t tx0, tx1, ty0;
+  };
+
+  dvec3 centre_{}, right_{}, up_{}, forward_{};
+  double aperture_ = 0.0, focus_ = 0.0, focal_px_ = 0.0, filter_px_ = 0.0;
+  std::uint32_t width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
   std::vector<std::uint8_t> marked_;
+  ConvexPolyhedron front_, near_, far_;
+  std::vector<dvec3> cap_;
+  std::vector<Point> points_, hull_;
+  std::vector<Open> open_, next_;
+  std::size_t rects_capacity_ = 0;
 };
 
-InfluenceRegion RegionBuilder::region() const {
-  InfluenceRegion region;
+void FrameProjector::finish(InfluenceRegion &region) {
   region.width = width_;
   region.height = height_;
+  region.rects.clear();
   const auto pixel_rect = [&](std::uint32_t tx0, std::uint32_t tx1, std::uint32_t ty0,
                               std::uint32_t ty1) {
     return PixelRect{tx0 * CAMHEAD_TILE_X, ty0 * CAMHEAD_TILE_Y,
@@ -373,12 +461,9 @@ InfluenceRegion RegionBuilder::region() const {
   };
   // Runs of tiles, a row at a time; a run that repeats the one above
   // extends its rectangle.
-  struct Open {
-    std::uint32_t tx0, tx1, ty0;
-  };
-  std::vector<Open> open, next;
+  open_.clear();
   for (std::uint32_t ty = 0; ty <= tiles_y_; ++ty) {
-    next.clear();
+    next_.clear();
     std::uint32_t tx = 0;
     while (ty < tiles_y_ && tx < tiles_x_) {
       if (!marked_[std::size_t(ty) * tiles_x_ + tx]) {
@@ -388,20 +473,19 @@ InfluenceRegion RegionBuilder::region() const {
       const std::uint32_t start = tx;
       while (tx < tiles_x_ && marked_[std::size_t(ty) * tiles_x_ + tx])
         ++tx;
-      const auto above = std::find_if(open.begin(), open.end(),
+      const auto above = std::find_if(open_.begin(), open_.end(),
                                       [&](const Open &o) { return o.tx0 == start && o.tx1 == tx; });
-      next.push_back({start, tx, above != open.end() ? above->ty0 : ty});
-      if (above != open.end())
-        open.erase(above);
+      next_.push_back({start, tx, above != open_.end() ? above->ty0 : ty});
+      if (above != open_.end())
+        open_.erase(above);
     }
-    for (const Open &o : open) // not continued in this row
+    for (const Open &o : open_) // not continued in this row
       region.rects.push_back(pixel_rect(o.tx0, o.tx1, o.ty0, ty));
-    std::swap(open, next);
+    std::swap(open_, next_);
   }
   std::sort(region.rects.begin(), region.rects.end(), [](const PixelRect &a, const PixelRect &b) {
     return a.y0 != b.y0 ? a.y0 < b.y0 : a.x0 < b.x0;
   });
-  return region;
 }
 
 // Tangent planes around a sphere of `radius` (margin included) at `centre`,
@@ -541,44 +625,25 @@ std::optional<LightShape> light_shape(const gpu::Light &light, double margin) {
   return shape;
 }
 
-} // namespace
+// A world-space piece of the region (step 1): where a virtual object can
+// change what a camera ray brings back, in every frame or, for a shadow,
+// while its light is one of the frame's.
+struct WorldPiece {
+  ConvexPolyhedron where;
+  std::size_t light = 0; // lights a frame must have for it; 0 for none
+};
 
-std::uint64_t InfluenceRegion::pixels() const {
-  std::uint64_t sum = 0;
-  for (const PixelRect &r : rects)
-    sum += r.pixels();
-  return sum;
-}
-
-InfluenceRegion whole_frame_region(std::uint32_t width, std::uint32_t height) {
-  InfluenceRegion region;
-  region.width = width;
-  region.height = height;
-  if (width > 0 && height > 0)
-    region.rects.push_back({0, 0, width, height});
-  return region;
-}
-
-InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FrameParams &frame) {
-  if (frame.image.z == 0)
-    return whole_frame_region(frame.image.x, frame.image.y);
-  // Above the kernel's ray offsets (CAMHEAD_RAY_EPSILON x (1 + |p|)) and the
-  // float rounding of hits, at the scale of the scene.
-  double scale = glm::length(dvec3(frame.cam_position) - dvec3(scene.origin));
-  for (const ObjectBounds &o : scene.objects)
-    scale = std::max({scale, glm::length(dvec3(o.lo)), glm::length(dvec3(o.hi))});
-  const double margin = 1e-3 * (1.0 + scale);
-
-  RegionBuilder builder(frame, dvec3(scene.origin));
+// Step 1 for `scene` with everything grown by `margin`.
+std::vector<WorldPiece> world_pieces(const CompiledScene &scene, double margin) {
+  std::vector<WorldPiece> pieces;
   if (std::none_of(scene.objects.begin(), scene.objects.end(),
                    [](const ObjectBounds &o) { return !o.real; }))
-    return builder.region();
+    return pieces; // nothing virtual: the camera image everywhere
   for (const ObjectBounds &o : scene.objects)
     if (!o.real || o.specular)
-      builder.add(object_polyhedron(o, margin));
+      pieces.push_back({object_polyhedron(o, margin), 0});
 
-  const std::size_t lights = std::min<std::size_t>(frame.image.w, scene.lights.size());
-  for (std::size_t li = 0; li < lights; ++li) {
+  for (std::size_t li = 0; li < scene.lights.size(); ++li) {
     const std::optional<LightShape> shape = light_shape(scene.lights[li], margin);
     if (!shape)
       continue;
@@ -620,11 +685,108 @@ InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FramePar
             break;
         }
         if (!poly.empty())
-          builder.add(std::move(poly));
+          pieces.push_back({std::move(poly), li + 1});
       }
     }
   }
-  return builder.region();
+  return pieces;
+}
+
+} // namespace
+
+struct InfluenceRegionBuilder::State {
+  explicit State(const CompiledScene &s) : scene(s) {
+    for (const ObjectBounds &o : scene.objects)
+      object_scale = std::max({object_scale, glm::length(dvec3(o.lo)), glm::length(dvec3(o.hi))});
+  }
+
+  // Step 1 for a scene seen from up to `scale` metres from its origin, and
+  // room for steps 2 and 3 to project it into width x height frames.
+  void build_pieces(double scale) {
+    // Above the kernel's ray offsets (CAMHEAD_RAY_EPSILON x (1 + |p|)) and
+    // the float rounding of hits, at the scale of the scene.
+    pieces = world_pieces(scene, 1e-3 * (1.0 + scale));
+    pieces_scale = scale;
+    reserved_width = 0; // the pieces' sizes changed
+  }
+
+  void reserve(std::uint32_t width, std::uint32_t height) {
+    std::size_t vertices = 0, faces = 0;
+    for (const WorldPiece &p : pieces) {
+      vertices = std::max(vertices, p.where.vertex_storage());
+      faces = std::max(faces, p.where.faces());
+    }
+    projector.reserve(vertices, faces, width, height);
+    region.rects.reserve(std::max<std::size_t>(projector.rects_capacity(), 1));
+    reserved_width = width;
+    reserved_height = height;
+  }
+
+  const CompiledScene &scene;
+  double object_scale = 0.0;
+  double pieces_scale = -1.0; // none built
+  std::vector<WorldPiece> pieces;
+  FrameProjector projector;
+  std::uint32_t reserved_width = 0, reserved_height = 0;
+  InfluenceRegion region;
+};
+
+InfluenceRegionBuilder::InfluenceRegionBuilder(const CompiledScene &scene)
+    : state_(std::make_unique<State>(scene)) {}
+
+InfluenceRegionBuilder::~InfluenceRegionBuilder() = default;
+
+const InfluenceRegion &InfluenceRegionBuilder::build(const gpu::FrameParams &frame) {
+  State &s = *state_;
+  if (frame.image.z == 0)
+    return whole_frame(frame.image.x, frame.image.y);
+  const double scale =
+      std::max(s.object_scale, glm::length(dvec3(frame.cam_position) - dvec3(s.scene.origin)));
+  if (!std::isfinite(scale))
+    return whole_frame(frame.image.x, frame.image.y); // a camera nowhere: unknown
+  if (scale > s.pieces_scale) // rounded up, so that a camera moving about rarely rebuilds
+    s.build_pieces(scale > 0.0 ? std::exp2(std::ceil(std::log2(scale))) : 0.0);
+  if (s.reserved_width != frame.image.x || s.reserved_height != frame.image.y)
+    s.reserve(frame.image.x, frame.image.y);
+  s.projector.start(frame, dvec3(s.scene.origin));
+  const std::size_t lights = std::min<std::size_t>(frame.image.w, s.scene.lights.size());
+  for (const WorldPiece &piece : s.pieces)
+    if (piece.light <= lights)
+      s.projector.add(piece.where);
+  s.projector.finish(s.region);
+  return s.region;
+}
+
+const InfluenceRegion &InfluenceRegionBuilder::whole_frame(std::uint32_t width,
+                                                           std::uint32_t height) {
+  InfluenceRegion &region = state_->region;
+  region.width = width;
+  region.height = height;
+  region.rects.clear();
+  if (width > 0 && height > 0)
+    region.rects.push_back({0, 0, width, height});
+  return region;
+}
+
+std::uint64_t InfluenceRegion::pixels() const {
+  std::uint64_t sum = 0;
+  for (const PixelRect &r : rects)
+    sum += r.pixels();
+  return sum;
+}
+
+InfluenceRegion whole_frame_region(std::uint32_t width, std::uint32_t height) {
+  InfluenceRegion region;
+  region.width = width;
+  region.height = height;
+  if (width > 0 && height > 0)
+    region.rects.push_back({0, 0, width, height});
+  return region;
+}
+
+InfluenceRegion influence_region(const CompiledScene &scene, const gpu::FrameParams &frame) {
+  InfluenceRegionBuilder builder(scene);
+  return builder.build(frame);
 }
 
 } // namespace camhead::renderer

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "camhead/base/thread_name.h"
+
 namespace camhead::renderer {
 
 WorkerPool::WorkerPool(int threads) {
@@ -10,7 +12,10 @@ WorkerPool::WorkerPool(int threads) {
   workers_.reserve(std::size_t(threads - 1));
   try {
     for (int t = 1; t < threads; ++t)
-      workers_.emplace_back([this] { worker_loop(); });
+      workers_.emplace_back([this] {
+        base::name_this_thread("camhead-worker");
+        worker_loop();
+      });
   } catch (...) {
     // A vector of joinable threads must not be destroyed: stop the ones
     // that started before giving the error on.

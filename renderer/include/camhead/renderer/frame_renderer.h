@@ -3,17 +3,18 @@
 // and its own plate (the camera frame in the camera's own pixel format), and
 // the composite written straight into each output's buffer in that output's
 // format. The scene, the kernels and the per-pixel buffers are made when the
-// renderer is created, and nothing is thrown per frame: what goes wrong is
-// the returned status. Allocation, as far as it is held: a frame of a held
-// shot on the CPU reference allocates nothing (tests/renderer/
-// frame_allocations_test.cpp); a frame that starts a new history builds its
-// influence region, which does, and so does every GPU frame (issue 24).
+// renderer is created, the GPU's pipelines by prepare(), and nothing is
+// thrown per frame: what goes wrong is the returned status. Nor is anything
+// allocated per frame once prepared, on either executor, held shot or focus
+// pull (tests/renderer/frame_allocations_test.cpp, which says what it
+// counts), except an adaptive frame's shares on the CPU reference.
 //
 // Thread safety: one thread renders at a time.
 #pragma once
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -100,6 +101,16 @@ public:
   // without bytes is none, and the outputs get I_m (the scene as rendered).
   [[nodiscard]] virtual FrameReport render(const FrameRequest &request, const VideoFrame &plate,
                                            std::span<const VideoBuffer> outputs) = 0;
+
+  // Builds, before the first frame, what frames like `request` with a
+  // camera frame of `plate` (none: frames without) and outputs of `outputs`
+  // need: the GPU's pipelines, the influence region's world-space part. So
+  // no frame compiles, and none allocates from the first
+  // (tests/renderer/frame_allocations_test.cpp). Without it the first frames
+  // do this work. Throws what the constructor throws, and
+  // std::invalid_argument for more outputs than render() takes.
+  virtual void prepare(const FrameRequest &request, const std::optional<base::VideoFormat> &plate,
+                       std::span<const base::VideoFormat> outputs) = 0;
 
   // The last frame's composite in linear RGB (alpha unused), row by row, for
   // measurement before the outputs' 8-bit rounding: set over the frame's

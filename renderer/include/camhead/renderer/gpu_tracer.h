@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -82,6 +83,13 @@ public:
                                           std::span<const VideoBuffer> outputs,
                                           const AdaptiveSampling *adaptive = nullptr,
                                           const InfluenceRegion *region = nullptr);
+
+  // Builds every pipeline render_video() takes for frames like `frame`
+  // with a camera frame in `plate` (none: no decode) and outputs in
+  // `outputs`, over a region or the whole frame, adaptive or not: so that
+  // no live frame compiles one.
+  void prepare_video(const gpu::FrameParams &frame, std::optional<base::PixelFormat> plate,
+                     std::span<const base::PixelFormat> outputs, bool adaptive);
 
 private:
   struct VideoJob {

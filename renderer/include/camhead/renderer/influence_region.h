@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "camhead/renderer/compiled_scene.h"
@@ -48,9 +49,34 @@ struct InfluenceRegion {
 // Every pixel of a width x height frame: what tracing without a region does.
 [[nodiscard]] InfluenceRegion whole_frame_region(std::uint32_t width, std::uint32_t height);
 
-// The region of `frame` (world coordinates, as make_frame_params() gives
-// them) in `scene`. Without a plate (frame.image.z == 0) the composite is
-// I_m, which needs every pixel: the whole frame.
+// The regions of one scene's frames, as the live path builds them: the
+// world-space part (influence_region.cpp, step 1) depends on the scene
+// alone and is built once; build() projects it through each frame's lens
+// into storage the builder keeps. After the first frame of a size, a frame
+// allocates nothing (tests/renderer/frame_allocations_test.cpp), until the
+// camera goes more than twice as far from the scene's origin as it has
+// been (the margin grows with that distance, and step 1 is built again).
+// `scene` must outlive the builder.
+class InfluenceRegionBuilder {
+public:
+  explicit InfluenceRegionBuilder(const CompiledScene &scene);
+  ~InfluenceRegionBuilder();
+  InfluenceRegionBuilder(const InfluenceRegionBuilder &) = delete;
+  InfluenceRegionBuilder &operator=(const InfluenceRegionBuilder &) = delete;
+
+  // The region of `frame` (world coordinates, as make_frame_params() gives
+  // them). Without a plate (frame.image.z == 0) the composite is I_m, which
+  // needs every pixel: the whole frame. Valid until the next call.
+  [[nodiscard]] const InfluenceRegion &build(const gpu::FrameParams &frame);
+  // Every pixel, in the same storage.
+  [[nodiscard]] const InfluenceRegion &whole_frame(std::uint32_t width, std::uint32_t height);
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// The region of one frame, by a builder of its own.
 [[nodiscard]] InfluenceRegion influence_region(const CompiledScene &scene,
                                                const gpu::FrameParams &frame);
 

@@ -1,0 +1,171 @@
+// The live pipeline's render and output threads allocate nothing per frame
+// (architecture.md: nothing in the frame loop allocates): a counting
+// operator new for this test binary counts the allocations of the threads
+// run_loop.cpp names camhead-render (with the CPU reference's workers,
+// camhead-worker) and camhead-output, over a whole run of a camera take
+// through a scene with a virtual ball, its lens pulling focus, into a Y4M
+// file and the per-frame record. The renderer is prepared before the first
+// frame (FrameRenderer::prepare), so there is no warm-up to leave out.
+//
+// Counted: C++ allocations (operator new), not the C library's malloc (stdio
+// buffers its streams with it, once).
+#include <atomic>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <pthread.h>
+
+#include "run/run_loop.h"
+#include "run_test_support.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+// GCC takes the replaced delete's free() for a mismatch with the new that it
+// cannot see is replaced too.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+
+namespace {
+
+std::atomic<bool> counting{false};
+std::atomic<std::uint64_t> render_allocations{0}, output_allocations{0};
+
+// Counts an allocation by the name of the thread that makes it.
+void count() {
+  if (!counting.load(std::memory_order_relaxed))
+    return;
+  char name[16] = {};
+  if (pthread_getname_np(pthread_self(), name, sizeof name) != 0)
+    return;
+  if (std::strcmp(name, "camhead-render") == 0 || std::strcmp(name, "camhead-worker") == 0)
+    render_allocations.fetch_add(1, std::memory_order_relaxed);
+  else if (std::strcmp(name, "camhead-output") == 0)
+    output_allocations.fetch_add(1, std::memory_order_relaxed);
+}
+
+// Every unaligned form is replaced, so that whatever the process allocates
+// with one it frees with its own kind; the aligned forms stay the library's.
+void *counted(std::size_t bytes) noexcept {
+  count();
+  return std::malloc(bytes == 0 ? 1 : bytes);
+}
+
+void *counted_or_throw(std::size_t bytes) {
+  if (void *p = counted(bytes))
+    return p;
+  throw std::bad_alloc();
+}
+
+} // namespace
+
+void *operator new(std::size_t bytes) {
+  return counted_or_throw(bytes);
+}
+void *operator new[](std::size_t bytes) {
+  return counted_or_throw(bytes);
+}
+void *operator new(std::size_t bytes, const std::nothrow_t &) noexcept {
+  return counted(bytes);
+}
+void *operator new[](std::size_t bytes, const std::nothrow_t &) noexcept {
+  return counted(bytes);
+}
+void operator delete(void *p) noexcept {
+  std::free(p);
+}
+void operator delete[](void *p) noexcept {
+  std::free(p);
+}
+void operator delete(void *p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void *p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete(void *p, const std::nothrow_t &) noexcept {
+  std::free(p);
+}
+void operator delete[](void *p, const std::nothrow_t &) noexcept {
+  std::free(p);
+}
+
+namespace camhead::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+
+class RunAllocations : public RunLoop {
+protected:
+  struct Counts {
+    std::uint64_t render = 0, output = 0, frames_out = 0;
+  };
+
+  // A run of a take played in real time, looped, through a floor with a
+  // virtual ball, with `render` as the board's render settings.
+  Counts run(const std::string &render) {
+    const int w = 96, h = 64, n = 8;
+    std::vector<std::vector<std::uint8_t>> frames;
+    for (int k = 0; k < n; ++k)
+      frames.emplace_back(std::size_t(w) * h * 2, std::uint8_t(60 + 20 * k));
+    const fs::path input = write("in.y4m", y4m_422(w, h, frames));
+    const fs::path scene =
+        write("ball.json", R"({"render": {"width": 96, "height": 64, "samples": 1},
+      "camera": {"position": [0, 0.7, 0], "look_at": [0, 0.3, -2], "up": [0, 1, 0],
+                 "focal_length_mm": 35, "sensor_width_mm": 36, "f_number": 2, "focus_distance_m": 2},
+      "materials": {"grey": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+      "objects": [
+        {"name": "floor", "type": "plane", "center": [0, 0, -3], "size": [10, 10], "material": "grey", "real": true},
+        {"name": "ball", "type": "sphere", "center": [0.2, 0.25, -1.8], "radius": 0.25, "material": "grey", "real": false}],
+      "lights": [{"name": "key", "type": "point", "position": [-1, 2, -1], "power_W": 200}]})");
+    RunOptions options;
+    options.board = board(R"({"type": "file", "path": ")" + input.string() +
+                              R"(", "loop": true, "realtime": true, "width": 96, "height": 64})",
+                          scene, R"(, "speed": 4)", R"(, "render": )" + render);
+    options.outputs = {"file:" + (dir_ / "out.y4m").string()};
+    options.stats_file = dir_ / "stats.jsonl";
+    options.frames = 40;
+    options.threads = 2;
+    options.status = nullptr;
+    render_allocations = 0;
+    output_allocations = 0;
+    counting = true;
+    const RunSummary summary = run_pipeline(options);
+    counting = false;
+    return {render_allocations.load(), output_allocations.load(), summary.frames_out};
+  }
+};
+
+TEST_F(RunAllocations, TheRenderAndOutputThreadsAllocateNothingOnTheCpuReference) {
+  const Counts counts = run(R"({"executor": "cpu"})");
+  EXPECT_EQ(counts.frames_out, 40u);
+  EXPECT_EQ(counts.render, 0u);
+  EXPECT_EQ(counts.output, 0u);
+}
+
+// The driver's own threads are not camhead's, and not counted (lavapipe's
+// allocate: tests/renderer/frame_allocations_test.cpp).
+TEST_F(RunAllocations, TheRenderAndOutputThreadsAllocateNothingOnTheGpu) {
+  if (!test::have_vulkan())
+    GTEST_SKIP() << "no Vulkan device";
+  const Counts counts = run(R"({"executor": "gpu"})");
+  EXPECT_EQ(counts.frames_out, 40u);
+  EXPECT_EQ(counts.render, 0u);
+  EXPECT_EQ(counts.output, 0u);
+}
+
+// The count works: the CPU reference's adaptive frames allocate their
+// shares (frame_renderer.h says so), on the render thread.
+TEST_F(RunAllocations, AdaptiveFramesOnTheCpuAreCounted) {
+  const Counts counts = run(R"({"executor": "cpu", "adaptive": true})");
+  EXPECT_EQ(counts.frames_out, 40u);
+  EXPECT_GE(counts.render, counts.frames_out);
+}
+
+} // namespace
+} // namespace camhead::pipeline
