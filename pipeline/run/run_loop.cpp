@@ -98,8 +98,9 @@ private:
   // are on their way, and says how long in the record.
   LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
   RunSummary finish();
-  // Sends one frame to every sink; `fill` writes sink i's buffer.
-  template <typename Fill> void send(Fill fill, std::int64_t capture_ns);
+  // Sends one frame to every sink: `frame(i)` is sink i's, sent from where
+  // it is (frame_sink.h).
+  template <typename Frame> void send(Frame frame, std::int64_t capture_ns);
 
   const RunOptions &options_;
   const Board &board_;
@@ -117,6 +118,7 @@ private:
 
   std::vector<Slot> slots_{kSlots};
   std::vector<std::vector<std::uint8_t>> last_frames_; // what each sink showed last
+  std::vector<std::vector<std::uint8_t>> placeholders_; // each sink's, made once
   // Render thread: where a frame's composite goes, its slot's buffers
   // (named anew each frame: the output thread swaps them).
   std::vector<renderer::VideoBuffer> targets_;
@@ -192,8 +194,10 @@ Pipeline::Pipeline(const RunOptions &options)
   for (Slot &slot : slots_)
     for (const auto &sink : sinks_)
       slot.images.emplace_back(base::frame_bytes(sink->format()));
-  for (const auto &sink : sinks_)
+  for (const auto &sink : sinks_) {
     last_frames_.emplace_back(base::frame_bytes(sink->format()));
+    fill_placeholder(sink->format(), placeholders_.emplace_back(last_frames_.back().size()));
+  }
   targets_.resize(sinks_.size());
   sink_errors_seen_.assign(sinks_.size(), 0);
   sink_failed_.assign(sinks_.size(), 0);
@@ -372,20 +376,12 @@ LensSnapshot Pipeline::lens_at(std::int64_t mid_exposure_ns, FrameRecord &record
   return lens;
 }
 
-template <typename Fill> void Pipeline::send(Fill fill, std::int64_t capture_ns) {
-  for (std::size_t i = 0; i < sinks_.size(); ++i) {
-    const std::span<std::uint8_t> buffer = sinks_[i]->acquire();
-    if (buffer.size() < base::frame_bytes(sinks_[i]->format())) {
-      ++counters_.sink_errors;
-      ++sink_failed_[i];
-      continue;
-    }
-    fill(i, buffer);
-    if (!sinks_[i]->submit(capture_ns)) {
+template <typename Frame> void Pipeline::send(Frame frame, std::int64_t capture_ns) {
+  for (std::size_t i = 0; i < sinks_.size(); ++i)
+    if (!sinks_[i]->submit(frame(i), capture_ns)) {
       ++counters_.sink_errors;
       ++sink_failed_[i];
     }
-  }
   last_output_ns_ = base::monotonic_ns();
 }
 
@@ -408,16 +404,10 @@ void Pipeline::output_loop() {
         continue;
       const bool repeat = shown_any && !counters_.camera_lost && !counters_.renderer_lost;
       if (repeat) {
-        send(
-            [&](std::size_t i, std::span<std::uint8_t> out) {
-              std::copy(last_frames_[i].begin(), last_frames_[i].end(), out.begin());
-            },
-            base::monotonic_ns());
+        send([&](std::size_t i) { return std::span(last_frames_[i]); }, base::monotonic_ns());
         ++counters_.repeats;
       } else {
-        send([&](std::size_t i,
-                 std::span<std::uint8_t> out) { fill_placeholder(sinks_[i]->format(), out); },
-             base::monotonic_ns());
+        send([&](std::size_t i) { return std::span(placeholders_[i]); }, base::monotonic_ns());
         ++counters_.placeholders;
       }
       if (stats_ != nullptr)
@@ -431,11 +421,7 @@ void Pipeline::output_loop() {
       (void)free_slots_.push(*slot_index); // rendered after the last one asked for
       continue;
     }
-    send(
-        [&](std::size_t i, std::span<std::uint8_t> out) {
-          std::copy(slot.images[i].begin(), slot.images[i].end(), out.begin());
-        },
-        slot.record.capture_ns);
+    send([&](std::size_t i) { return std::span(slot.images[i]); }, slot.record.capture_ns);
     counters_.latency_ns = last_output_ns_ - slot.record.capture_ns;
     if (stats_ != nullptr)
       write_composite_record(stats_, output_frame, slot.record, last_output_ns_, executor_name_);

@@ -6,7 +6,7 @@
 //                    while its readings are still coming), FrameBudget's
 //                    rays per pixel, FrameRenderer into a free output slot ->
 //                    [queue of slots] ->
-//   output thread    each sink: acquire, copy, submit; the per-frame record;
+//   output thread    each sink: submit from the slot; the per-frame record;
 //                    after half a second without a composite, the last one
 //                    again, or a placeholder while there is no camera
 //   lens thread      (LensHub) every lens source into its tracker

@@ -1,5 +1,7 @@
-// The null sink counts what it is given and never fails.
+// The null sink counts what it is given; it fails only a frame of the wrong
+// size.
 #include <stdexcept>
+#include <vector>
 
 #include "camhead/hal/output/null/null_sink.h"
 #include "video_test_files.h"
@@ -14,11 +16,11 @@ TEST(NullSink, CountsFramesAndNeverFails) {
   auto sink = hal::output::open_null_sink(format);
   EXPECT_EQ(sink->name(), "null");
   EXPECT_EQ(sink->format(), format);
-  for (int i = 0; i < 5; ++i) {
-    EXPECT_EQ(sink->acquire().size(), base::frame_bytes(format));
-    EXPECT_TRUE(sink->submit(i));
-  }
-  EXPECT_TRUE(sink->submit(5)); // even without acquire
+  const std::vector<std::uint8_t> frame(base::frame_bytes(format));
+  for (int i = 0; i < 6; ++i)
+    EXPECT_TRUE(sink->submit(frame, i));
+  // A frame of another size is not one of this sink's.
+  EXPECT_FALSE(sink->submit(std::span(frame).first(frame.size() - 1), 6));
   EXPECT_EQ(sink->status().frames, 6u);
   EXPECT_EQ(sink->status().errors, 0u);
   EXPECT_TRUE(sink->status().connected);

@@ -21,8 +21,8 @@
 //                            mode and position it had before
 //   drm_console_back         ... and the screen is the text console again,
 //                            pixel for pixel as before open (screendump)
-//   drm_zero_copy            a 1280x800 frame in the 1280x800 mode is written
-//                            straight into the dumb buffer at its pitch
+//   drm_full_frame           a 1280x800 frame in the 1280x800 mode, at the
+//                            dumb buffer's pitch, is copied into it whole
 //                            (screendump)
 //   drm_destructor_restores  a sink destroyed without close() also puts the
 //                            console back
@@ -257,17 +257,12 @@ std::string rect(int width, int height, int x, int y) {
          std::to_string(y);
 }
 
-// Writes frame `seed` into the sink; empty when it went out.
+// Sends frame `seed` to the sink; empty when it went out.
 std::string send_frame(FrameSink &sink, int seed) {
-  const std::span<std::uint8_t> buffer = sink.acquire();
-  if (buffer.empty())
-    return "acquire lent no buffer: " + sink.status().detail;
   const auto format = sink.format();
-  if (buffer.size() != camhead::base::frame_bytes(format))
-    return "acquire lent " + std::to_string(buffer.size()) + " bytes for " +
-           camhead::base::describe(format);
-  fill(buffer, format.width, format.height, camhead::base::row_bytes(format), seed);
-  if (!sink.submit(camhead::base::monotonic_ns()))
+  std::vector<std::uint8_t> frame(camhead::base::frame_bytes(format));
+  fill(frame, format.width, format.height, camhead::base::row_bytes(format), seed);
+  if (!sink.submit(frame, camhead::base::monotonic_ns()))
     return "submit failed: " + sink.status().detail;
   return {};
 }
@@ -359,7 +354,7 @@ int main(int argc, char **argv) {
   else
     report("drm_frame", control.dump("frame", kModeWidth, kModeHeight, "pattern " + area + " 1"));
 
-  // Frames 10..20, then 2: each waits in acquire() for the last one's flip.
+  // Frames 10..20, then 2: each waits in submit() for the last one's flip.
   std::string problem;
   const std::int64_t start = camhead::base::monotonic_ns();
   for (int seed = 10; seed <= 21 && problem.empty(); ++seed)
@@ -388,19 +383,20 @@ int main(int argc, char **argv) {
   else
     report("drm_console_back", console_after);
 
-  // Frame and mode the same size: zero copy, by path and connector name.
+  // Frame and mode the same size: the frame at the buffer's pitch, by path and
+  // connector name.
   try {
     auto full = open_drm_sink(
         DrmSinkOptions{"/dev/dri/card0", "Virtual-1", kModeWidth, kModeHeight, "1280x800@75"});
     const auto f = full->format();
     const std::string stride = "stride " + std::to_string(f.stride);
     if (f.stride < kModeWidth * 4)
-      print_result("drm_zero_copy", false, stride + " is not the dumb buffer's pitch");
+      print_result("drm_full_frame", false, stride + " is not the dumb buffer's pitch");
     else if (const std::string trouble = send_frame(*full, 3); !trouble.empty())
-      print_result("drm_zero_copy", false, trouble);
+      print_result("drm_full_frame", false, trouble);
     else
-      report("drm_zero_copy",
-             control.dump("zero_copy", kModeWidth, kModeHeight,
+      report("drm_full_frame",
+             control.dump("full_frame", kModeWidth, kModeHeight,
                           "pattern " + rect(kModeWidth, kModeHeight, 0, 0) + " 3"),
              "; " + stride + "; " + full->status().detail);
     full.reset(); // no close(): the destructor restores
@@ -409,7 +405,7 @@ int main(int argc, char **argv) {
                  "CRTC before: " + describe(*before) +
                      ", after the destructor: " + (left ? describe(*left) : "unreadable"));
   } catch (const std::exception &e) {
-    print_result("drm_zero_copy", false, e.what());
+    print_result("drm_full_frame", false, e.what());
     print_result("drm_destructor_restores", false, "not run: the sink did not open");
   }
   return 0;

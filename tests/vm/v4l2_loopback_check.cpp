@@ -84,11 +84,9 @@ std::string first_difference(std::span<const std::uint8_t> frame, std::uint32_t 
 }
 
 bool write_frame(output::FrameSink &sink, std::uint32_t k) {
-  const std::span<std::uint8_t> buffer = sink.acquire();
-  if (buffer.empty())
-    return false;
-  fill(buffer, k);
-  return sink.submit(camhead::base::monotonic_ns());
+  std::vector<std::uint8_t> frame(camhead::base::frame_bytes(sink.format()));
+  fill(frame, k);
+  return sink.submit(frame, camhead::base::monotonic_ns());
 }
 
 struct Pair {

@@ -299,10 +299,9 @@ void paint_placeholder(const DumbBuffer &buffer, int mode_height, Placement at, 
 
 class DrmSink final : public FrameSink {
 public:
-  DrmSink(std::unique_ptr<Display> display, base::VideoFormat format, bool zero_copy,
+  DrmSink(std::unique_ptr<Display> display, base::VideoFormat format, bool full_frame,
           const std::string &summary)
-      : display_(std::move(display)), format_(format), zero_copy_(zero_copy),
-        staging_(zero_copy ? 0 : base::frame_bytes(format)),
+      : display_(std::move(display)), format_(format), full_frame_(full_frame),
         next_check_ns_(base::monotonic_ns() + kConnectorCheckNs) {
     status_.connected = true;
     status_.detail = name() + ": ready, " + summary;
@@ -313,33 +312,22 @@ public:
   }
   base::VideoFormat format() const override { return format_; }
 
-  std::span<std::uint8_t> acquire() override {
+  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
     if (closed_)
-      return {};
+      return fail("submit after close");
+    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
+      return fail(wrong);
     const std::int64_t now = base::monotonic_ns();
     if (live_ && now >= next_check_ns_)
       check_connector(now);
     if (!live_ && !resume(now))
-      return {};
+      return false; // skipped while it is away; status() says so
     if (display_->flip_pending) {
       std::string error;
       if (!display_->wait_for_flip(error))
         stop_flipping(error);
     }
-    acquired_ = true;
-    if (!zero_copy_)
-      return staging_;
-    return back().bytes().first(base::frame_bytes(format_));
-  }
-
-  bool submit(std::int64_t) override {
-    if (closed_)
-      return fail("submit after close");
-    if (!acquired_)
-      return fail("submit without acquire");
-    acquired_ = false;
-    if (!zero_copy_)
-      copy_into(back());
+    copy_into(back(), frame);
     if (!present())
       return false;
     const std::lock_guard lock(mutex_);
@@ -373,13 +361,19 @@ public:
 private:
   DumbBuffer &back() { return display_->buffers[static_cast<std::size_t>(1 - display_->front)]; }
 
-  void copy_into(DumbBuffer &buffer) {
+  // The frame into the buffer's frame area: one copy where the frame is the
+  // mode's size and its rows the buffer's pitch, else row by row.
+  void copy_into(DumbBuffer &buffer, std::span<const std::uint8_t> frame) {
+    if (full_frame_) {
+      std::memcpy(buffer.bytes().data(), frame.data(), frame.size());
+      return;
+    }
     const std::size_t row = base::row_bytes(format_);
     const Placement at = display_->placement;
     for (int y = 0; y < format_.height; ++y)
       std::memcpy(buffer.bytes().data() + static_cast<std::size_t>(y + at.y) * buffer.pitch() +
                       static_cast<std::size_t>(at.x) * 4,
-                  staging_.data() + static_cast<std::size_t>(y) * row, row);
+                  frame.data() + static_cast<std::size_t>(y) * row, row);
   }
 
   bool present() {
@@ -500,11 +494,9 @@ private:
 
   const std::unique_ptr<Display> display_;
   const base::VideoFormat format_;
-  const bool zero_copy_;
-  std::vector<std::uint8_t> staging_;
+  const bool full_frame_;
   std::int64_t next_check_ns_;
   bool live_ = true;
-  bool acquired_ = false;
   bool closed_ = false;
   std::string note_; // what changed since open, for later status lines
 
@@ -573,20 +565,21 @@ std::unique_ptr<FrameSink> open_drm_sink(const DrmSinkOptions &options) {
   if (!d.show(0, error))
     fail_open(d.label, where + ", mode " + describe_mode(d.mode_summary) + ": " + error);
 
-  const bool zero_copy = options.width == d.mode.hdisplay && options.height == d.mode.vdisplay;
-  if (zero_copy)
+  // A frame the mode's size comes at the buffers' pitch: one copy, whole.
+  const bool full_frame = options.width == d.mode.hdisplay && options.height == d.mode.vdisplay;
+  if (full_frame)
     format.stride = static_cast<int>(d.buffers[0].pitch());
   std::string summary = base::describe(format) + " in " + describe_mode(d.mode_summary) +
                         " on CRTC " + std::to_string(d.crtc);
-  if (zero_copy)
-    summary += ", zero copy (frames are written into the dumb buffers, stride " +
+  if (full_frame)
+    summary += ", full screen (each frame copied whole into the back buffer, stride " +
                std::to_string(format.stride) + ")";
   else
     summary += ", centred at (" + std::to_string(d.placement.x) + ", " +
                std::to_string(d.placement.y) +
                ") with black borders, copied into the back buffer each frame";
   summary += ", page flips; mid-grey until the first frame";
-  return std::make_unique<DrmSink>(std::move(display), format, zero_copy, summary);
+  return std::make_unique<DrmSink>(std::move(display), format, full_frame, summary);
 }
 
 } // namespace camhead::hal::output

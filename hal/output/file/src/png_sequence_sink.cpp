@@ -17,7 +17,7 @@ using video_file::FramePattern;
 class PngSequenceSink final : public FrameSink {
 public:
   PngSequenceSink(FramePattern pattern, base::VideoFormat format)
-      : pattern_(std::move(pattern)), format_(format), frame_(base::frame_bytes(format)) {
+      : pattern_(std::move(pattern)), format_(format) {
     status_.connected = true;
     status_.detail = name() + ": ready";
   }
@@ -25,20 +25,12 @@ public:
   std::string name() const override { return "png " + pattern_.text(); }
   base::VideoFormat format() const override { return format_; }
 
-  std::span<std::uint8_t> acquire() override {
-    if (closed_)
-      return {};
-    acquired_ = true;
-    return frame_;
-  }
-
-  bool submit(std::int64_t) override {
+  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
     if (closed_)
       return fail("submit after close");
-    if (!acquired_)
-      return fail("submit without acquire");
-    acquired_ = false;
-    if (!video_file::encode_png_rgb(frame_, format_.width, format_.height, base::row_bytes(format_),
+    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
+      return fail(wrong);
+    if (!video_file::encode_png_rgb(frame, format_.width, format_.height, base::row_bytes(format_),
                                     png_))
       return fail("cannot encode PNG (out of memory)");
     const std::filesystem::path target = pattern_.path(next_);
@@ -77,10 +69,8 @@ private:
 
   const FramePattern pattern_;
   const base::VideoFormat format_;
-  std::vector<std::uint8_t> frame_;
   std::vector<std::uint8_t> png_;
   std::uint64_t next_ = 0; // frames written, and the next file's number
-  bool acquired_ = false;
   bool closed_ = false;
 
   mutable std::mutex mutex_;

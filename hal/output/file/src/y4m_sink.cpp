@@ -19,7 +19,6 @@ class Y4mSink final : public FrameSink {
 public:
   Y4mSink(std::string name, base::VideoFormat format, base::PartialFile file)
       : name_(std::move(name)), format_(format), file_(std::move(file)),
-        frame_(base::frame_bytes(format)),
         record_(kFrameLine.size() + video_file::y4m_plane_bytes(format)) {
     // Every frame record is "FRAME\n" and the planes: one write each.
     std::copy(kFrameLine.begin(), kFrameLine.end(), record_.begin());
@@ -30,20 +29,12 @@ public:
   std::string name() const override { return "file " + name_; }
   base::VideoFormat format() const override { return format_; }
 
-  std::span<std::uint8_t> acquire() override {
-    if (closed_ || broken_)
-      return {};
-    acquired_ = true;
-    return frame_;
-  }
-
-  bool submit(std::int64_t) override {
+  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
     if (closed_ || broken_)
       return fail(closed_ ? "submit after close" : "the file is broken, no more frames");
-    if (!acquired_)
-      return fail("submit without acquire");
-    acquired_ = false;
-    video_file::frame_to_y4m_planes(frame_, format_, std::span(record_).subspan(kFrameLine.size()));
+    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
+      return fail(wrong);
+    video_file::frame_to_y4m_planes(frame, format_, std::span(record_).subspan(kFrameLine.size()));
     const off_t good = file_.size();
     std::string error;
     if (!file_.write(record_, error)) {
@@ -100,9 +91,7 @@ private:
   const std::string name_;
   const base::VideoFormat format_;
   base::PartialFile file_;
-  std::vector<std::uint8_t> frame_;
   std::vector<std::uint8_t> record_;
-  bool acquired_ = false;
   bool closed_ = false;
   bool broken_ = false;
 

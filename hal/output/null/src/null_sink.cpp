@@ -3,21 +3,19 @@
 
 #include <atomic>
 #include <stdexcept>
-#include <vector>
 
 namespace camhead::hal::output {
 namespace {
 
 class NullSink final : public FrameSink {
 public:
-  explicit NullSink(base::VideoFormat format)
-      : format_(format), frame_(base::frame_bytes(format)) {}
+  explicit NullSink(base::VideoFormat format) : format_(format) {}
 
   std::string name() const override { return "null"; }
   base::VideoFormat format() const override { return format_; }
-  std::span<std::uint8_t> acquire() override { return frame_; }
-
-  bool submit(std::int64_t) override {
+  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
+    if (!wrong_frame_size(frame, format_).empty())
+      return false;
     frames_.fetch_add(1, std::memory_order_relaxed);
     return true;
   }
@@ -37,7 +35,6 @@ public:
 
 private:
   const base::VideoFormat format_;
-  std::vector<std::uint8_t> frame_;
   // Atomics: status() may come from another thread than submit().
   std::atomic<std::uint64_t> frames_{0};
   std::atomic<bool> closed_{false};

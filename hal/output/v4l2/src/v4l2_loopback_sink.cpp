@@ -123,7 +123,7 @@ class V4l2LoopbackSink final : public FrameSink {
 public:
   V4l2LoopbackSink(std::string device, base::VideoFormat asked, double fps, OpenedDevice opened)
       : device_(std::move(device)), asked_(asked), fps_(fps), format_(opened.format),
-        file_(std::move(opened.file)), frame_(base::frame_bytes(format_)) {
+        file_(std::move(opened.file)) {
     status_.connected = true;
     status_.detail = name() + ": ready, " + opened.summary;
   }
@@ -131,20 +131,14 @@ public:
   std::string name() const override { return "v4l2 " + device_; }
   base::VideoFormat format() const override { return format_; }
 
-  std::span<std::uint8_t> acquire() override {
-    if (closed_ || (!file_.is_open() && !reopen()))
-      return {};
-    acquired_ = true;
-    return frame_;
-  }
-
-  bool submit(std::int64_t) override {
+  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
     if (closed_)
       return fail("submit after close");
-    if (!acquired_)
-      return fail("submit without acquire");
-    acquired_ = false;
-    if (!write_frame())
+    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
+      return fail(wrong);
+    if (!file_.is_open() && !reopen())
+      return false; // skipped while it is away; status() says so
+    if (!write_frame(frame))
       return false;
     const std::lock_guard lock(mutex_);
     ++status_.frames;
@@ -157,8 +151,9 @@ public:
     closed_ = true;
     if (!file_.is_open())
       return fail("closed while disconnected: nothing left on the device");
-    fill_black(frame_, format_);
-    const bool written = write_frame();
+    std::vector<std::uint8_t> black(base::frame_bytes(format_));
+    fill_black(black, format_);
+    const bool written = write_frame(black);
     file_.close();
     const std::lock_guard lock(mutex_);
     status_.connected = false;
@@ -175,15 +170,15 @@ public:
 
 private:
   // One write() is one frame to v4l2loopback: never split, never resumed.
-  bool write_frame() {
+  bool write_frame(std::span<const std::uint8_t> frame) {
     ssize_t n = 0;
     do {
-      n = ::write(file_.fd(), frame_.data(), frame_.size());
+      n = ::write(file_.fd(), frame.data(), frame.size());
     } while (n < 0 && errno == EINTR);
-    if (n == static_cast<ssize_t>(frame_.size()))
+    if (n == static_cast<ssize_t>(frame.size()))
       return true;
     if (n >= 0)
-      return fail("short write: " + std::to_string(n) + " of " + std::to_string(frame_.size()) +
+      return fail("short write: " + std::to_string(n) + " of " + std::to_string(frame.size()) +
                   " bytes taken");
     const int err = errno;
     if (err == EAGAIN)
@@ -233,9 +228,7 @@ private:
   const double fps_;
   const base::VideoFormat format_;
   v4l2::DeviceFile file_;
-  std::vector<std::uint8_t> frame_;
   v4l2::ReconnectSchedule schedule_;
-  bool acquired_ = false;
   bool closed_ = false;
 
   mutable std::mutex mutex_; // guards status_

@@ -21,14 +21,14 @@
 // first composite arrives. Anything that fails throws DrmSinkError
 // "CARD (DRIVER): [connector NAME: ]REASON".
 //
-// Frames: format() is xrgb8888 at the frame size. When the frame is exactly
-// the mode's size, acquire() lends the back dumb buffer itself (zero copy;
-// format().stride is then the buffer's pitch, which may exceed width * 4).
-// Otherwise it lends a packed staging buffer and submit() copies it into the
-// back buffer's frame area (one copy per frame; the borders are never
-// written again). submit() presents the back buffer with a page flip that
-// asks for an event (DRM_MODE_PAGE_FLIP_EVENT); the next acquire() waits for
-// that event, so a buffer is never written while it is being scanned out (on
+// Frames: format() is xrgb8888 at the frame size. submit() copies the frame
+// into the back dumb buffer, the one copy a display needs: whole when the
+// frame is exactly the mode's size (format().stride is then the buffer's
+// pitch, which may exceed width * 4), else row by row into the back
+// buffer's frame area (the borders are never written again). It then
+// presents the back buffer with a page flip that asks for an event
+// (DRM_MODE_PAGE_FLIP_EVENT); the next submit() waits for that event before
+// it copies, so a buffer is never written while it is being scanned out (on
 // a real display that paces the frame loop to the refresh rate). A driver
 // that refuses page flips, or whose flip event does not come within 1 s, is
 // driven with SETCRTC per frame instead (blocking, may tear); status().detail
@@ -39,7 +39,7 @@
 // Loss: the connector's state is read every 0.5 s (the kernel's cached
 // state: no probing, which can take tens of milliseconds on HDMI). While it
 // is disconnected, or after a presentation failed because the device went
-// away, acquire() lends nothing (the frame is skipped) and status() says
+// away, submit() sends nothing (the frame is skipped) and status() says
 // why; when it is connected again the mode is set again and frames resume.
 //
 // close(), and the destructor of a sink never closed: the saved CRTC state is
@@ -47,8 +47,8 @@
 // splash comes back; a CRTC that was off is switched off), the buffers are
 // removed and unmapped, DRM master is dropped and the card closed.
 //
-// Thread safety: as FrameSink (acquire, submit and close from one thread;
-// status from any).
+// Thread safety: as FrameSink (submit and close from one thread; status
+// from any).
 #pragma once
 
 #include <memory>

@@ -22,8 +22,8 @@
 // capture_ns is therefore not passed on.
 //
 // Loss: a write failing with ENODEV (the module unloaded) marks the sink
-// disconnected; acquire() then tries to reopen the device every 0.5 s, and
-// lends no buffer until it is back, so those frames are skipped.
+// disconnected; submit() then tries to reopen the device every 0.5 s, and
+// skips the frames until it is back.
 //
 // close(): writes one black frame, so that readers are left with a neutral
 // picture rather than the last composite frozen (or the green of a
@@ -31,8 +31,8 @@
 // back to the next writer (with exclusive_caps=1 only a writer that called
 // STREAMON does that in 0.12.7).
 //
-// Thread safety: as FrameSink (acquire, submit and close from one thread;
-// status from any).
+// Thread safety: as FrameSink (submit and close from one thread; status
+// from any).
 #pragma once
 
 #include <memory>
