@@ -12,6 +12,7 @@
 #include "benchmarks.h"
 #include "camhead/renderer/bvh.h"
 #include "camhead/renderer/cpu_tracer.h"
+#include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/influence_region.h"
 
 #include <benchmark/benchmark.h>
@@ -52,14 +53,20 @@ void build_bvh_bench(benchmark::State &state, const BenchScene &scene) {
 // frame as in a pull, so that nothing is the same twice.
 void influence_region_bench(benchmark::State &state, const BenchScene &scene, bool kept) {
   const PreparedScene &prepared = BenchCache::get().scene(scene, 720, 576);
-  renderer::gpu::FrameParams frame = renderer::make_frame_params(prepared.scene, 1);
-  frame.image.z = 1; // a plate: the composite is the camera image outside the region
-  const float focus = frame.lens.y;
+  std::vector<renderer::gpu::FrameParams> pull;
+  renderer::FrameCamera camera = renderer::scene_camera(prepared.scene);
+  const float focus = camera.focus_distance_m;
+  for (int step = 0; step < 20; ++step) {
+    camera.focus_distance_m = focus * (0.5f + 0.05f * float(step));
+    pull.push_back(renderer::make_frame_params(prepared.scene, camera, 1));
+    // A plate: the composite is the camera image outside the region.
+    renderer::set_has_plate(pull.back(), true);
+  }
   renderer::InfluenceRegionBuilder builder(prepared.compiled);
   double fraction = 0.0;
-  int step = 0;
+  std::size_t step = 0;
   for (auto _ : state) {
-    frame.lens.y = focus * (0.5f + 0.05f * float(step++ % 20));
+    const renderer::gpu::FrameParams &frame = pull[step++ % pull.size()];
     fraction += kept ? builder.build(frame).fraction()
                      : renderer::influence_region(prepared.compiled, frame).fraction();
   }

@@ -17,6 +17,7 @@
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/frame_budget.h"
+#include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/scene_loader.h"
@@ -109,8 +110,7 @@ int run_frame_target(const BenchArgs &args, renderer::GpuTracer &tracer,
   for (int i = 0; i < args.warmup + args.frames; ++i) {
     const std::uint32_t rpp = budget.rpp();
     gpu::FrameParams frame = make_frame_params(scene, int(rpp));
-    if (args.skip_empty)
-      frame.tracing.w |= TRACING_SKIP_EMPTY_PIXELS;
+    set_skip_empty_pixels(frame, args.skip_empty);
     const RenderResult r =
         args.adaptive ? tracer.render_adaptive(frame, {}, {}, LayerSelection::display_only())
                       : tracer.render(frame, {}, LayerSelection::display_only());
@@ -219,8 +219,7 @@ int run_bench(const BenchArgs &args) {
     std::vector<FrameTimings> breakdown;
     for (int rpp : args.rpp) {
       gpu::FrameParams frame = make_frame_params(scene, rpp);
-      if (args.skip_empty)
-        frame.tracing.w |= TRACING_SKIP_EMPTY_PIXELS;
+      set_skip_empty_pixels(frame, args.skip_empty);
       const FrameMedians gpu = median_frame(args, [&] {
         return args.adaptive ? tracer.render_adaptive(frame, {}, {}, layers)
                              : tracer.render(frame, {}, layers);

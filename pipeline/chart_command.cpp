@@ -30,6 +30,7 @@
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/dof_gather.h"
+#include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/scene_loader.h"
@@ -108,10 +109,10 @@ struct Method {
   Measurement (*run)(ChartContext &, int rpp);
 };
 
-// The tracer's frame at `rpp` with camera sampler `sampler` (layout.h).
-Measurement run_traced(ChartContext &c, int rpp, std::uint32_t sampler) {
+// The tracer's frame at `rpp` with camera sampler `sampler`.
+Measurement run_traced(ChartContext &c, int rpp, CameraSampler sampler) {
   gpu::FrameParams frame = make_frame_params(c.scene, rpp);
-  frame.tracing.z = sampler;
+  set_camera_sampler(frame, sampler);
   Measurement m;
   m.frame_s = median_seconds(c.args, [&] {
     return frame_seconds(c.tracer.render(frame, {}, LayerSelection::display_only()));
@@ -123,13 +124,13 @@ Measurement run_traced(ChartContext &c, int rpp, std::uint32_t sampler) {
 // 1. The tracer as it is: stratified jittered pixel and lens samples
 //    (method.md section 2).
 Measurement run_uniform(ChartContext &c, int rpp) {
-  return run_traced(c, rpp, SAMPLER_CMJ);
+  return run_traced(c, rpp, CameraSampler::cmj);
 }
 
 // 1b. The same budgets with the low-discrepancy sampler: pixel and aperture
 //     jointly from Owen-scrambled Sobol' (sampling.glsl).
 Measurement run_sobol(ChartContext &c, int rpp) {
-  return run_traced(c, rpp, SAMPLER_SOBOL);
+  return run_traced(c, rpp, CameraSampler::sobol);
 }
 
 // 2. Image-space depth of field: a pinhole render (aperture radius 0) at
@@ -140,7 +141,7 @@ Measurement run_sobol(ChartContext &c, int rpp) {
 //    input through here is not counted.
 Measurement run_pinhole_gather(ChartContext &c, int rpp) {
   gpu::FrameParams pinhole = make_frame_params(c.scene, rpp);
-  pinhole.lens.x = 0.0f;
+  set_pinhole(pinhole);
   const gpu::FrameParams lens = make_frame_params(c.scene, rpp);
   const double trace_s = median_seconds(c.args, [&] {
     return frame_seconds(c.tracer.render(pinhole, {}, LayerSelection::display_only()));
@@ -400,12 +401,12 @@ Reference make_reference(const std::string &file, const Scene &scene, const Comp
   // The convergence check: half the samples with another seed. Independent
   // noise, so the reference's own error is about this / sqrt(3).
   gpu::FrameParams half = make_frame_params(scene, std::max(1, args.ref_rpp / 2));
-  half.sampling.w += 1;
+  set_seed(half, seed(half) + 1);
   ref.check = cached_render(
       cache_dir / (key + "_check" + std::to_string(args.ref_rpp / 2) + ".exr"), compiled, half,
       args, "check " + stem + " " + std::to_string(args.ref_rpp / 2) + " rpp (CPU)", false);
   gpu::FrameParams pinhole = make_frame_params(scene, 16);
-  pinhole.lens.x = 0.0f;
+  set_pinhole(pinhole);
   ref.pinhole_depth = cached_render(cache_dir / (key + "_pinhole_depth.exr"), compiled, pinhole,
                                     args, "edge mask " + stem + " (CPU)", true);
   // Cycles, where the shared reference folder has the matching layer.

@@ -27,6 +27,7 @@
 #include "camhead/base/video_format.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/image.h"
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/influence_region.h"
@@ -98,7 +99,7 @@ public:
     check(real_renderer->render(plate_request, {}, std::span(&plate_target, 1)), "the plate");
 
     gpu::FrameParams frame = make_frame_params(scene, camera_);
-    frame.image.z = 1u;
+    set_has_plate(frame, true);
     const InfluenceRegion region = influence_region(compiled, frame);
     for (const PixelRect &r : region.rects)
       for (std::uint32_t y = r.y0; y < r.y1; ++y)
@@ -272,12 +273,12 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
     return;
   // Where the object's centre lands: the pinhole projection.
   const gpu::FrameParams frame = make_frame_params(scene, scene_camera(scene));
-  const glm::vec3 d = first_virtual->center - glm::vec3(frame.cam_position);
-  const float z = glm::dot(d, glm::vec3(frame.cam_forward));
+  const glm::vec2 centre =
+      project_to_pixel(frame, first_virtual->center).value_or(0.5f * glm::vec2(image_size(frame)));
   const int w = scene.render.width, h = scene.render.height;
   const int crop_w = std::min(w, 200), crop_h = std::min(h, 150);
-  const int cx = int(0.5f * float(w) + frame.lens.z * glm::dot(d, glm::vec3(frame.cam_right)) / z);
-  const int cy = int(0.5f * float(h) - frame.lens.z * glm::dot(d, glm::vec3(frame.cam_up)) / z);
+  const int cx = int(centre.x);
+  const int cy = int(centre.y);
   const int x0 = std::clamp(cx - crop_w / 2, 0, w - crop_w);
   const int y0 = std::clamp(cy - crop_h / 2, 0, h - crop_h);
 

@@ -12,6 +12,7 @@
 #include "camhead/base/partial_file.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
+#include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/influence_region.h"
@@ -108,12 +109,13 @@ int run_render(const RenderArgs &args) {
     }
     const CompiledScene compiled = compile_scene(scene);
     const gpu::FrameParams frame = make_frame_params(scene, args.rpp);
-    const int rpp = int(frame.sampling.z);
+    const int rpp = int(rays_per_pixel(frame));
     // The region leaves the layers other than the composite unmade outside it.
     const bool use_region =
         !args.no_influence_region && (args.layer == "composite" || args.layer == "region");
-    const InfluenceRegion region = use_region ? influence_region(compiled, frame)
-                                              : whole_frame_region(frame.image.x, frame.image.y);
+    const InfluenceRegion region =
+        use_region ? influence_region(compiled, frame)
+                   : whole_frame_region(image_size(frame).x, image_size(frame).y);
     std::fprintf(stderr,
                  "%s: %dx%d, %d rpp, %zu primitives, %zu lights, %.1f %% of the pixels "
                  "traced%s\n",

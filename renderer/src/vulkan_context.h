@@ -15,7 +15,9 @@
 
 #include <vulkan/vulkan.h>
 
-#include "camhead/renderer/gpu_tracer.h"
+#include "camhead/renderer/gpu_devices.h"
+#include "camhead/renderer/gpu_error.h"
+#include "camhead/renderer/image.h"
 
 namespace camhead::renderer::vk {
 

@@ -3,34 +3,18 @@
 
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/gpu_devices.h"
+#include "camhead/renderer/gpu_error.h"
 #include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/render_result.h"
 
 namespace camhead::renderer {
-
-class GpuError : public std::runtime_error {
-public:
-  using std::runtime_error::runtime_error;
-};
-
-struct GpuDeviceInfo {
-  int index = 0;
-  std::string name;
-  std::string type; // "cpu", "discrete", "integrated", "virtual", "other"
-};
-
-// Lists the Vulkan devices that can run the tracer (compute queue present).
-[[nodiscard]] std::vector<GpuDeviceInfo> list_gpu_devices();
-
-// One line per device, "  <index>: <name> (<type>)", for listings and errors.
-[[nodiscard]] std::string format_gpu_devices(const std::vector<GpuDeviceInfo> &devices);
 
 class GpuTracer {
 public:
