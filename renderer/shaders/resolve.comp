@@ -25,7 +25,9 @@ void main() {
   }
   bool has_plate = frame.image.z != 0u;
   vec4 camera = has_plate ? imageLoad(plate, i) : vec4(0.0f);
-  uint samples = frame.tracing.y != 0u ? sample_counts[i] : frame.sampling.z;
+  // The samples the accumulators hold: the last batch's end, the frame's
+  // count (or, continuing a history, the history's: GpuTracer::render_video).
+  uint samples = frame.tracing.y != 0u ? sample_counts[i] : frame.sampling.y;
   Resolved r = resolve_pixel(imageLoad(accum_mixed, i), imageLoad(accum_real, i),
                              imageLoad(accum_aux, i), camera, has_plate, samples);
   if ((RESOLVE_LAYERS & RESOLVE_COMPOSITE) != 0u) {

@@ -18,7 +18,10 @@ namespace camhead::renderer {
 
 struct GpuTracer::Impl::Frame {
   gpu::FrameParams params; // as the kernels see it
-  std::uint32_t total = 0; // samples per pixel
+  // Samples [first, total) of the pattern this frame traces; the composite is
+  // the mean of [0, total) (a live frame that continues a history: first > 0).
+  std::uint32_t first = 0;
+  std::uint32_t total = 0;
   LayerSelection selection;
   const AdaptiveSampling *adaptive = nullptr;
   bool region_given = false; // else the whole frame, and no region in the adaptive solve
@@ -76,6 +79,17 @@ GpuTracer::Impl::Frame GpuTracer::Impl::plan_frame(const gpu::FrameParams &reque
 
   Frame frame;
   frame.total = requested.sampling.z;
+  if (video != nullptr) {
+    const GpuTracer::SampleRange range = video->samples;
+    // first == end: a history already whole, resolved again over a new plate.
+    if (!(range.first <= range.end && range.end > 0 && range.end <= requested.sampling.z))
+      throw GpuError("samples [" + std::to_string(range.first) + ", " + std::to_string(range.end) +
+                     ") of a pattern of " + std::to_string(requested.sampling.z));
+    if (range.first > 0 && adaptive != nullptr)
+      throw GpuError("an adaptive frame does not continue the frames before");
+    frame.first = range.first;
+    frame.total = range.end;
+  }
   frame.selection = selection;
   frame.adaptive = adaptive;
   frame.region_given = region != nullptr;
@@ -147,7 +161,7 @@ GpuTracer::Impl::Frame GpuTracer::Impl::plan_frame(const gpu::FrameParams &reque
 void GpuTracer::Impl::record_frame_start(VkCommandBuffer command_buffer, const Frame &frame) {
   timestamps.reset(command_buffer);
   timestamps.write(command_buffer, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
-  if (frame.reads_untraced_pixels)
+  if (frame.reads_untraced_pixels && frame.first == 0) // else the history's start cleared them
     record_clear(command_buffer);
   if (frame.decode_plate) {
     dispatch_video(command_buffer, frame.decode, 0, frame.region_video);
@@ -223,14 +237,14 @@ FrameTimings GpuTracer::Impl::trace_frame(Frame &frame, const ProgressFn &progre
   FrameTimings timings;
   if (frame.adaptive == nullptr) {
     params.tracing.y = 0u;
-    timings.submissions = trace_batches(params, total, uniform_sizer, trace_region, start, end,
-                                        [&](std::uint32_t done) { report(done); });
+    timings.submissions = trace_batches(params, frame.first, total, uniform_sizer, trace_region,
+                                        start, end, [&](std::uint32_t done) { report(done); });
   } else {
     // adaptive.h: a pilot, each pixel's share from what it saw, the shares.
     const std::uint32_t pilot = adaptive_pilot(*frame.adaptive, total);
     params.tracing.y = 0u;
     params.sampling.z = pilot;
-    timings.submissions = trace_batches(params, pilot, uniform_sizer, trace_region, start, {},
+    timings.submissions = trace_batches(params, 0, pilot, uniform_sizer, trace_region, start, {},
                                         [&](std::uint32_t done) { report(done); });
     params.tracing.y = pilot;
     params.sampling.z = total;
@@ -241,7 +255,7 @@ FrameTimings GpuTracer::Impl::trace_frame(Frame &frame, const ProgressFn &progre
     // read-back); a batch past the largest share dispatches no workgroup.
     const std::uint32_t cap = std::uint32_t(params.adaptive.y);
     timings.submissions += trace_batches(
-        params, cap - pilot, second_pass_sizer,
+        params, 0, cap - pilot, second_pass_sizer,
         [&](VkCommandBuffer command_buffer) { record_queue_batch(command_buffer, params); },
         [&](VkCommandBuffer command_buffer) { record_allocation(command_buffer); }, end,
         [&](std::uint32_t done) {
@@ -277,7 +291,7 @@ RenderResult GpuTracer::Impl::read_layers(const Frame &frame) const {
   }
   if (selection.display)
     result.display.assign(mapped + r.display_offset, mapped + r.display_offset + r.display_bytes);
-  result.camera_rays = frame_region.pixels() * frame.total;
+  result.camera_rays = frame_region.pixels() * (frame.total - frame.first);
   if (frame.adaptive != nullptr) {
     gpu::AdaptiveSolution solution;
     std::memcpy(&solution, mapped + r.solution_offset, sizeof solution);

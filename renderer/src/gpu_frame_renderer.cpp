@@ -1,6 +1,10 @@
 // The GPU tracer as a live frame renderer (frame_renderer.h): the camera
 // frame's conversion, the trace and the outputs' conversion all on the
-// device, one submission for a steady frame (GpuTracer::render_video).
+// device, one submission for a steady frame (GpuTracer::render_video). A
+// held shot accumulates in the device's accumulators (frame_history.h):
+// every pixel of the region the next samples of one progressive pattern,
+// the shares by noise and the reconstruction being the CPU reference's
+// alone so far.
 #include <algorithm>
 #include <array>
 #include <optional>
@@ -8,6 +12,7 @@
 #include <string>
 
 #include "camhead/renderer/compiled_scene.h"
+#include "camhead/renderer/frame_history.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/influence_region.h"
@@ -42,6 +47,7 @@ public:
     const gpu::FrameParams frame = frame_params(request, plate.has_value());
     if (request.influence_region)
       static_cast<void>(regions_.build(frame));
+    history_valid_ = false; // the region it traced is no longer in regions_
     std::array<base::PixelFormat, VIDEO_MAX_OUTPUTS> pixels{};
     for (std::size_t k = 0; k < outputs.size(); ++k)
       pixels[k] = outputs[k].pixel;
@@ -65,34 +71,54 @@ public:
       return bad_frame("0 rays per pixel");
     if (request.accumulation.enabled && request.adaptive)
       return bad_frame("adaptive frames do not accumulate");
-    const gpu::FrameParams frame = frame_params(request, !plate.bytes.empty());
+    if (request.accumulation.enabled && request.accumulation.max_samples == 0)
+      return bad_frame("a history of at most 0 samples");
+    gpu::FrameParams frame = frame_params(request, !plate.bytes.empty());
+    const Shape shape = shape_of(plate, outputs, request.influence_region);
+    std::optional<GpuTracer::SampleRange> samples;
+    const bool continues = request.accumulation.enabled && continues_history(request, frame, shape);
     FrameReport report;
+    if (request.accumulation.enabled) {
+      if (continues) {
+        frame = history_; // its camera and seed, so that the samples stay one pattern's
+      } else {
+        history_ = frame;
+        history_shape_ = shape;
+        history_valid_ = true;
+        history_samples_ = 0;
+      }
+      const std::uint32_t end =
+          std::min(history_samples_ + request.rays_per_pixel, frame.sampling.z);
+      samples = GpuTracer::SampleRange{history_samples_, end};
+      history_samples_ = end;
+      report.history_samples = end;
+      report.history_restarted = !continues;
+    } else {
+      history_valid_ = false;
+    }
     try {
-      const InfluenceRegion &region = request.influence_region
-                                          ? regions_.build(frame)
-                                          : regions_.whole_frame(frame.image.x, frame.image.y);
-      report.traced_pixels = region.pixels();
+      if (!continues) // a history keeps the region of its start (frame_history.h)
+        region_ = request.influence_region ? &regions_.build(frame)
+                                           : &regions_.whole_frame(frame.image.x, frame.image.y);
+      report.traced_pixels = region_->pixels();
       report.frame_pixels = std::uint64_t(frame.image.x) * frame.image.y;
       const RenderResult result = tracer_.render_video(
-          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, &region);
+          frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, region_,
+          samples);
       report.camera_rays = result.camera_rays;
-      // No history on this executor yet: an accumulating frame starts one
-      // and ends it, which is what the report says.
-      if (request.accumulation.enabled) {
-        report.history_samples = request.rays_per_pixel;
-        report.history_restarted = true;
-      }
       // The conversions run on the device inside the frame's one
       // submission: their time is part of the trace time here.
       report.trace_s = result.timings.device_s > 0.0 ? result.timings.device_s : result.seconds;
       report.encode_s = result.timings.unpack_s; // the outputs' copy out of mapped memory
     } catch (const vk::VulkanError &e) {
+      history_valid_ = false;
       if (e.result() == VK_ERROR_DEVICE_LOST) {
         lost_ = true;
         return lost(e.what());
       }
       return bad_frame(e.what());
     } catch (const std::exception &e) {
+      history_valid_ = false;
       return bad_frame(e.what());
     }
     return report;
@@ -105,7 +131,50 @@ private:
     if (request.seed != 0)
       frame.sampling.w = request.seed;
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
+    if (request.accumulation.enabled) {
+      // A progressive pattern (sample i does not depend on the count) of the
+      // history's greatest size, every sample traced on its own.
+      frame.tracing.z = SAMPLER_SOBOL;
+      frame.sampling.z = std::max(request.accumulation.max_samples, 1u);
+      frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
+    }
     return frame;
+  }
+
+  // What a history's frames must share besides the camera: the kinds of
+  // frames in and out, and whether the region or every pixel is traced (the
+  // accumulators outside a region are cleared only where a frame reads them,
+  // which depends on the outputs' formats: GpuTracer::render_video).
+  struct Shape {
+    bool plate = false;
+    base::PixelFormat plate_pixel = base::PixelFormat::yuyv;
+    std::size_t outputs = 0;
+    std::array<base::PixelFormat, VIDEO_MAX_OUTPUTS> output_pixels{};
+    bool influence_region = true;
+    bool operator==(const Shape &) const = default;
+  };
+
+  static Shape shape_of(const VideoFrame &plate, std::span<const VideoBuffer> outputs,
+                        bool influence_region) {
+    Shape shape;
+    shape.plate = !plate.bytes.empty();
+    shape.plate_pixel = plate.format.pixel;
+    shape.outputs = outputs.size();
+    for (std::size_t k = 0; k < outputs.size(); ++k)
+      shape.output_pixels[k] = outputs[k].format.pixel;
+    shape.influence_region = influence_region;
+    return shape;
+  }
+
+  // Whether `frame` may add to the history: the one before accumulated, with
+  // the same settings and shape, and the camera moved less than the
+  // tolerance (frame_history.h).
+  bool continues_history(const FrameRequest &request, const gpu::FrameParams &frame,
+                         const Shape &shape) const {
+    if (!history_valid_ || frame.sampling.z != history_.sampling.z || !(shape == history_shape_))
+      return false;
+    const double change = frame_change_px(history_, frame, nearest_depth_m(compiled_, history_));
+    return change <= request.accumulation.tolerance_px;
   }
 
   static Scene without_plate(Scene scene) {
@@ -124,6 +193,12 @@ private:
   CompiledScene compiled_; // for each frame's influence region
   GpuTracer tracer_;
   InfluenceRegionBuilder regions_{compiled_};
+  const InfluenceRegion *region_ = nullptr; // this frame's, in regions_
+  // The history: the accumulators' camera and pattern, and what they hold.
+  gpu::FrameParams history_{};
+  Shape history_shape_;
+  bool history_valid_ = false;
+  std::uint32_t history_samples_ = 0; // every pixel of the region alike
   bool lost_ = false;
 };
 

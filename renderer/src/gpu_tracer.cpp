@@ -456,13 +456,13 @@ void GpuTracer::Impl::record_queue_batch(VkCommandBuffer command_buffer,
                         (QUEUE_DISPATCH + 4u * bin) * sizeof(std::uint32_t));
 }
 
-int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer,
-                                   Recorder trace, Recorder prologue, Recorder epilogue,
-                                   FunctionRef<void(std::uint32_t)> report) {
+int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t first, std::uint32_t end,
+                                   BatchSizer &sizer, Recorder trace, Recorder prologue,
+                                   Recorder epilogue, FunctionRef<void(std::uint32_t)> report) {
   // One uniform buffer suffices because each batch is waited for before the
   // next one rewrites it.
   int submissions = 0;
-  std::uint32_t done = 0;
+  std::uint32_t done = first;
   do {
     const std::uint32_t batch = std::min(sizer.next(), end - done);
     frame.sampling.x = done;
@@ -470,7 +470,7 @@ int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t end, B
     std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);
 
     VkCommandBuffer command_buffer = commands.begin();
-    if (done == 0 && prologue)
+    if (done == first && prologue)
       prologue(command_buffer);
     if (batch > 0) {
       trace(command_buffer);
@@ -546,8 +546,9 @@ RenderResult GpuTracer::render(const gpu::FrameParams &frame, const ProgressFn &
 RenderResult GpuTracer::render_video(const gpu::FrameParams &frame, const VideoFrame &plate,
                                      std::span<const VideoBuffer> outputs,
                                      const AdaptiveSampling *adaptive,
-                                     const InfluenceRegion *region) {
-  const VideoJob job{plate, outputs};
+                                     const InfluenceRegion *region,
+                                     std::optional<SampleRange> samples) {
+  const VideoJob job{plate, outputs, samples.value_or(SampleRange{0, frame.sampling.z})};
   return impl_->render(frame, {}, LayerSelection{false, false, false, false, false, false},
                        adaptive, region, &job);
 }

@@ -92,14 +92,15 @@ struct GpuTracer::Impl {
   void read_outputs(const Frame &frame) const;
   // Records commands into a command buffer.
   using Recorder = FunctionRef<void(VkCommandBuffer)>;
-  // Adds samples [0, end) of `frame` to the accumulators in batches sized by
-  // `sizer`, one submission each, each batch recorded by `trace` once
-  // frame.sampling holds its samples; `prologue` records commands into the
-  // first submission, before its batch, and `epilogue` into the last, after
-  // it (both submitted also when `end` is 0). `report` gets the samples done.
-  // Returns the number of submissions.
-  int trace_batches(gpu::FrameParams &frame, std::uint32_t end, BatchSizer &sizer, Recorder trace,
-                    Recorder prologue, Recorder epilogue, FunctionRef<void(std::uint32_t)> report);
+  // Adds samples [first, end) of `frame` to the accumulators in batches
+  // sized by `sizer`, one submission each, each batch recorded by `trace`
+  // once frame.sampling holds its samples; `prologue` records commands into
+  // the first submission, before its batch, and `epilogue` into the last,
+  // after it (both submitted also when there are none). `report` gets the
+  // samples done. Returns the number of submissions.
+  int trace_batches(gpu::FrameParams &frame, std::uint32_t first, std::uint32_t end,
+                    BatchSizer &sizer, Recorder trace, Recorder prologue, Recorder epilogue,
+                    FunctionRef<void(std::uint32_t)> report);
   void prepare_video(const gpu::FrameParams &frame, std::optional<base::PixelFormat> plate,
                      std::span<const base::PixelFormat> outputs, bool adaptive);
   // Records the accumulators' clear, ordered before the kernels.

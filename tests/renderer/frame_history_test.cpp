@@ -2,7 +2,8 @@
 // of one sample each are one frame of N samples, bit for bit; a change of
 // focus, aperture, image scale or pose beyond the tolerance starts afresh, so
 // the first frame after a jump carries nothing of the frames before it; and
-// pass-through and the influence region stay exact with it on.
+// pass-through and the influence region stay exact with it on. The same for
+// the GPU executor's history (every pixel alike), where Vulkan is.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/influence_region.h"
 #include "test_scenes.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -69,15 +71,21 @@ std::vector<std::uint8_t> camera_frame() {
   return bytes;
 }
 
-// Renders frames with one renderer and keeps what the last one gave.
+enum class Executor { cpu, gpu };
+
 // Renders frames with one renderer and keeps what the last one gave: RGB,
 // the camera's format, and with `and_yuyv` a YUYV output too, which makes
 // the renderer resolve every pixel rather than copy the camera's bytes
-// outside the influence region.
+// outside the influence region. The GPU executor's needs Vulkan (its tests
+// skip without; available() says).
 class Frames {
 public:
-  explicit Frames(const Scene &scene, bool and_yuyv = false)
-      : renderer_(make_cpu_frame_renderer(scene, 2)), and_yuyv_(and_yuyv) {}
+  explicit Frames(const Scene &scene, bool and_yuyv = false, Executor executor = Executor::cpu)
+      : renderer_(executor == Executor::cpu ? make_cpu_frame_renderer(scene, 2)
+                  : test::have_vulkan()     ? make_gpu_frame_renderer(scene)
+                                            : nullptr),
+        and_yuyv_(and_yuyv) {}
+  [[nodiscard]] bool available() const { return renderer_ != nullptr; }
 
   FrameReport render(const FrameRequest &request) {
     out_.assign(base::frame_bytes(rgb24()), 0);
@@ -193,20 +201,23 @@ TEST_P(FrameHistoryChange, TheFirstFrameAfterItCarriesNothingOfTheFramesBefore) 
   EXPECT_EQ(bytes_differing(held.out(), fresh.out()), 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Changes, FrameHistoryChange,
-    ::testing::Values(Change{"focus", [](FrameCamera &c) { c.focus_distance_m = 1.2f; }},
-                      Change{"aperture", [](FrameCamera &c) { c.f_number = 2.8f; }},
-                      Change{"breathing",
-                             [](FrameCamera &c) { c.projection_focal_length_mm = 50.5f; }},
-                      Change{"pupil", [](FrameCamera &c) { c.entrance_pupil_offset_m = 0.01f; }},
-                      Change{"position",
-                             [](FrameCamera &c) {
-                               c.position.x += 0.01f;
-                               c.look_at.x += 0.01f;
-                             }},
-                      Change{"direction", [](FrameCamera &c) { c.look_at.x += 0.01f; }}),
-    [](const ::testing::TestParamInfo<Change> &change) { return change.param.name; });
+const Change kChanges[] = {
+    {"focus", [](FrameCamera &c) { c.focus_distance_m = 1.2f; }},
+    {"aperture", [](FrameCamera &c) { c.f_number = 2.8f; }},
+    {"breathing", [](FrameCamera &c) { c.projection_focal_length_mm = 50.5f; }},
+    {"pupil", [](FrameCamera &c) { c.entrance_pupil_offset_m = 0.01f; }},
+    {"position",
+     [](FrameCamera &c) {
+       c.position.x += 0.01f;
+       c.look_at.x += 0.01f;
+     }},
+    {"direction", [](FrameCamera &c) { c.look_at.x += 0.01f; }},
+};
+
+INSTANTIATE_TEST_SUITE_P(Changes, FrameHistoryChange, ::testing::ValuesIn(kChanges),
+                         [](const ::testing::TestParamInfo<Change> &change) {
+                           return change.param.name;
+                         });
 
 TEST(FrameHistory, AChangeWithinTheToleranceKeepsTheHistoryAndItsCamera) {
   const Scene scene = ball_scene();
@@ -275,6 +286,97 @@ TEST(FrameHistory, AFullHistoryTracesNothingMore) {
   EXPECT_EQ(fourth.history_samples, 8u);
   EXPECT_EQ(fourth.camera_rays, 0u);
   EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
+}
+
+// The GPU executor accumulates every pixel alike (no shares by noise, no
+// reconstruction): the same sums in the same order as one frame of all the
+// samples, so the same bytes; a change starts afresh; a full history traces
+// nothing more.
+TEST(GpuFrameHistory, NStillFramesOfOneSampleAreOneFrameOfN) {
+  const Scene scene = ball_scene();
+  Frames one_at_a_time(scene, false, Executor::gpu);
+  if (!one_at_a_time.available())
+    GTEST_SKIP() << "no Vulkan device";
+  for (std::uint32_t n = 1; n <= 16; ++n) {
+    const FrameReport report = one_at_a_time.render(still_uniform(scene, 1, 100 + n));
+    EXPECT_EQ(report.history_samples, n);
+    EXPECT_EQ(report.history_restarted, n == 1);
+    EXPECT_EQ(report.camera_rays, report.traced_pixels);
+  }
+  Frames at_once(scene, false, Executor::gpu);
+  EXPECT_EQ(at_once.render(still_uniform(scene, 16, 101)).history_samples, 16u);
+  EXPECT_EQ(bytes_differing(one_at_a_time.out(), at_once.out()), 0u);
+
+  Frames uneven(scene, false, Executor::gpu);
+  for (const std::uint32_t rpp : {3u, 1u, 7u, 5u})
+    (void)uneven.render(still_uniform(scene, rpp, 101));
+  EXPECT_EQ(bytes_differing(uneven.out(), at_once.out()), 0u);
+
+  // The comparison can tell: a history held at one sample is not 16.
+  Frames one(scene, false, Executor::gpu);
+  for (int n = 0; n < 16; ++n) {
+    FrameRequest request = still_uniform(scene, 1, 101);
+    request.accumulation.max_samples = 1;
+    (void)one.render(request);
+  }
+  EXPECT_GT(bytes_differing(one.out(), at_once.out()), 100u);
+}
+
+TEST(GpuFrameHistory, TheFirstFrameAfterAChangeCarriesNothingOfTheFramesBefore) {
+  const Scene scene = ball_scene();
+  if (!Frames(scene, false, Executor::gpu).available())
+    GTEST_SKIP() << "no Vulkan device";
+  for (const Change &change : kChanges) {
+    Frames held(scene, false, Executor::gpu);
+    for (int n = 0; n < 8; ++n)
+      (void)held.render(still(scene, 1, 200 + n));
+    FrameRequest moved = still(scene, 2, 300);
+    change.apply(moved.camera);
+    const FrameReport report = held.render(moved);
+    EXPECT_TRUE(report.history_restarted) << change.name;
+    EXPECT_EQ(report.history_samples, 2u) << change.name;
+    Frames fresh(scene, false, Executor::gpu);
+    (void)fresh.render(moved);
+    EXPECT_EQ(bytes_differing(held.out(), fresh.out()), 0u) << change.name;
+  }
+}
+
+TEST(GpuFrameHistory, AFullHistoryTracesNothingMore) {
+  const Scene scene = ball_scene();
+  Frames frames(scene, false, Executor::gpu);
+  if (!frames.available())
+    GTEST_SKIP() << "no Vulkan device";
+  FrameRequest request = still_uniform(scene, 3);
+  request.accumulation.max_samples = 8;
+  EXPECT_EQ(frames.render(request).history_samples, 3u);
+  EXPECT_EQ(frames.render(request).history_samples, 6u);
+  const FrameReport third = frames.render(request);
+  EXPECT_EQ(third.history_samples, 8u);
+  EXPECT_EQ(third.camera_rays, third.traced_pixels * 2);
+  const std::vector<std::uint8_t> full = frames.out();
+  const FrameReport fourth = frames.render(request);
+  EXPECT_EQ(fourth.history_samples, 8u);
+  EXPECT_EQ(fourth.camera_rays, 0u);
+  EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
+}
+
+// Accumulated on the GPU and on the CPU reference, the same history comes
+// to the same picture, within the float rounding of two executors (the
+// CPU's is the reference's kernel compiled as C++).
+TEST(GpuFrameHistory, ConvergesAsTheCpuReferenceDoes) {
+  const Scene scene = ball_scene();
+  Frames gpu(scene, false, Executor::gpu);
+  if (!gpu.available())
+    GTEST_SKIP() << "no Vulkan device";
+  Frames cpu(scene);
+  for (std::uint32_t n = 1; n <= 8; ++n) {
+    (void)gpu.render(still_uniform(scene, 2, 100 + n));
+    (void)cpu.render(still_uniform(scene, 2, 100 + n));
+  }
+  std::size_t off_by_more_than_one = 0;
+  for (std::size_t i = 0; i < gpu.out().size(); ++i)
+    off_by_more_than_one += std::abs(int(gpu.out()[i]) - int(cpu.out()[i])) > 1;
+  EXPECT_LE(off_by_more_than_one, gpu.out().size() / 1000);
 }
 
 TEST(FrameHistory, TheRegionStaysExact) {

@@ -48,8 +48,8 @@ struct FrameRequest {
   std::uint32_t seed = 0;
   // Add this frame's `rays_per_pixel` samples to those of the frames before
   // while the camera stays within the tolerance (frame_history.h); not with
-  // `adaptive`. The GPU executor keeps no history yet: each of its frames
-  // starts one afresh (FrameReport says so).
+  // `adaptive`. The GPU executor gives every pixel of the region the same
+  // samples: it neither shares them by noise nor reconstructs yet.
   AccumulationSettings accumulation;
   // Trace only where the virtual objects can change the composite
   // (influence_region.h); the outputs are the same bit for bit, except for

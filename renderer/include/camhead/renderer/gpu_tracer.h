@@ -63,10 +63,22 @@ public:
   // each of `outputs` (at most VIDEO_MAX_OUTPUTS, layout.h); nothing else is
   // read back. Sizes as the loaded scene, width a multiple of 4 (the kernels
   // work on 4 x 2 blocks); the caller checks. A plate without bytes is none.
+  //
+  // `samples` [first, end) of the frame's pattern of frame.sampling.z
+  // samples (a progressive one: SAMPLER_SOBOL) add to those that the frames
+  // before left in the accumulators when first > 0, and the composite is the
+  // mean of samples [0, end): the frame before must have been render_video()
+  // of the same loaded scene, pattern, region and outputs, ending at
+  // `first`. Without it, samples [0, frame.sampling.z), afresh. Not with
+  // `adaptive`.
+  struct SampleRange {
+    std::uint32_t first = 0, end = 0;
+  };
   [[nodiscard]] RenderResult render_video(const gpu::FrameParams &frame, const VideoFrame &plate,
                                           std::span<const VideoBuffer> outputs,
                                           const AdaptiveSampling *adaptive = nullptr,
-                                          const InfluenceRegion *region = nullptr);
+                                          const InfluenceRegion *region = nullptr,
+                                          std::optional<SampleRange> samples = std::nullopt);
 
   // Builds every pipeline render_video() takes for frames like `frame`
   // with a camera frame in `plate` (none: no decode) and outputs in
@@ -79,6 +91,7 @@ private:
   struct VideoJob {
     VideoFrame plate;
     std::span<const VideoBuffer> outputs;
+    SampleRange samples;
   };
   struct Impl;
   std::unique_ptr<Impl> impl_;
