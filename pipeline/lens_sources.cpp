@@ -183,7 +183,13 @@ std::unique_ptr<hal::lens::LensEncoder> open_lens_source(const LensSourceConfig 
 }
 
 lens_control::EncoderSample to_encoder_sample(const hal::lens::EncoderReading &r) {
-  return {.t_ns = r.t_ns, .focus = r.focus, .iris = r.iris, .zoom = r.zoom};
+  return {.t_ns = r.t_ns,
+          .focus = r.focus,
+          .iris = r.iris,
+          .zoom = r.zoom,
+          .focus_distance_m = r.focus_distance_m,
+          .f_number = r.f_stop,
+          .focal_length_mm = r.focal_length_mm};
 }
 
 lens_control::LensProfile load_board_profile(const Board &board) {

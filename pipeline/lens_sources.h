@@ -28,8 +28,9 @@ namespace camhead::pipeline {
 [[nodiscard]] std::unique_ptr<hal::lens::LensEncoder>
 open_lens_source(const LensSourceConfig &source);
 
-// hal's raw reading as lens_control's sample (counts only: lens_control maps
-// counts through the profile).
+// hal's reading as lens_control's sample: counts, which lens_control maps
+// through the profile, and the calibrated values the source sent
+// (lens_tracker.h says which of the two an axis takes).
 [[nodiscard]] lens_control::EncoderSample to_encoder_sample(const hal::lens::EncoderReading &r);
 
 // The board's profile, or the flagged uncalibrated fallback when it names

@@ -173,39 +173,61 @@ double LensProfile::rest_counts_iris() const {
   return ys.front() <= ys.back() ? xs.front() : xs.back();
 }
 
-LensState LensProfile::evaluate(const LensCounts &counts) const {
+LensState LensProfile::evaluate(const LensCounts &counts, const LensValues &values) const {
   const AxisReading rest_focus{0.0, 0, false}; // its value: rest_focus_diopters
   const AxisReading rest_iris{rest_counts_iris(), 0, false};
   const AxisReading rest_zoom{zoom_counts_.front(), 0, false};
-  const AxisReading &fo = counts.focus ? *counts.focus : rest_focus;
-  const AxisReading &ir = counts.iris ? *counts.iris : rest_iris;
+  // An axis with counts takes them; one with a value alone, that value.
+  const std::optional<AxisReading> focus_value =
+      counts.focus ? std::nullopt : values.focus_diopters;
+  const std::optional<AxisReading> iris_value = counts.iris ? std::nullopt : values.iris_stops;
+  const std::optional<AxisReading> zoom_value =
+      counts.zoom ? std::nullopt : values.log_focal_length;
+  const AxisReading &fo = counts.focus ? *counts.focus : focus_value ? *focus_value : rest_focus;
+  const AxisReading &ir = counts.iris ? *counts.iris : iris_value ? *iris_value : rest_iris;
   // A prime has no zoom axis: its zoom quantities are as fresh as focus.
-  const AxisReading &zo = !is_zoom()    ? AxisReading{rest_zoom.counts, fo.t_ns, fo.fresh}
-                          : counts.zoom ? *counts.zoom
-                                        : rest_zoom;
+  const AxisReading zo = zoom_value
+                             ? AxisReading{rest_zoom.counts, zoom_value->t_ns, zoom_value->fresh}
+                         : !is_zoom()  ? AxisReading{rest_zoom.counts, fo.t_ns, fo.fresh}
+                         : counts.zoom ? *counts.zoom
+                                       : rest_zoom;
 
   const auto measured = [](Lookup l, const AxisReading &a) {
     return Measured{l.value, a.t_ns, a.fresh, l.clamped};
   };
   LensState s;
-  s.calibrated = calibrated_;
-  const MonotoneCurve::Result focus =
-      counts.focus ? focus_diopters(zo.counts, fo.counts) : rest_focus_diopters(zo.counts);
+  s.calibrated = calibrated_ || (focus_value && iris_value && zoom_value);
+  const MonotoneCurve::Result focus = counts.focus ? focus_diopters(zo.counts, fo.counts)
+                                      : focus_value
+                                          ? MonotoneCurve::Result{focus_value->counts, false}
+                                          : rest_focus_diopters(zo.counts);
   const Lookup focus_m{from_diopters(focus.y), focus.clamped};
   // With per-zoom tables focus depends on zoom too: as old as the older
   // reading, fresh only if both are (like the projection focal length).
-  s.focus_distance_m = has_per_zoom_focus() ? Measured{focus_m.value, std::min(fo.t_ns, zo.t_ns),
-                                                       fo.fresh && zo.fresh, focus_m.clamped}
-                                            : measured(focus_m, fo);
-  s.f_number = measured(f_number(ir.counts), ir);
-  if (const auto t = t_stop(ir.counts))
-    s.t_stop = measured(*t, ir);
-  s.focal_length_mm = measured(focal_length_mm(zo.counts), zo);
+  s.focus_distance_m = has_per_zoom_focus() && !focus_value
+                           ? Measured{focus_m.value, std::min(fo.t_ns, zo.t_ns),
+                                      fo.fresh && zo.fresh, focus_m.clamped}
+                           : measured(focus_m, fo);
+  if (iris_value) {
+    s.f_number = measured({std::exp2(0.5 * iris_value->counts), false}, ir);
+  } else {
+    s.f_number = measured(f_number(ir.counts), ir);
+    if (const auto t = t_stop(ir.counts))
+      s.t_stop = measured(*t, ir);
+  }
   s.entrance_pupil_offset_mm = measured(entrance_pupil_offset_mm(zo.counts), zo);
-  // Depends on focus and zoom: as old as the older one, fresh only if both are.
-  const Lookup proj = projection_for_focus(zo.counts, focus);
-  s.projection_focal_length_mm =
-      Measured{proj.value, std::min(fo.t_ns, zo.t_ns), fo.fresh && zo.fresh, proj.clamped};
+  if (zoom_value) {
+    const double mm = std::exp(zoom_value->counts);
+    s.focal_length_mm = measured({mm, false}, zo);
+    s.projection_focal_length_mm =
+        Measured{mm, std::min(fo.t_ns, zo.t_ns), fo.fresh && zo.fresh, false};
+  } else {
+    s.focal_length_mm = measured(focal_length_mm(zo.counts), zo);
+    // Depends on focus and zoom: as old as the older one, fresh only if both are.
+    const Lookup proj = projection_for_focus(zo.counts, focus);
+    s.projection_focal_length_mm =
+        Measured{proj.value, std::min(fo.t_ns, zo.t_ns), fo.fresh && zo.fresh, proj.clamped};
+  }
   s.distortion = distortion_;
   return s;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "camhead/lens_control/lens_tracker.h"
 #include "camhead/lens_control/time_alignment.h"
@@ -89,6 +90,27 @@ TEST(TimeAlignment, RejectsOutOfOrderAndWrapsTheRing) {
   EXPECT_TRUE(tl.at(85)->fresh);
 }
 
+// A sample of the axes given (GCC 12 takes a designated initializer that
+// leaves members out for a missing initializer).
+EncoderSample counts_at(std::int64_t t, std::optional<std::int32_t> focus,
+                        std::optional<std::int32_t> iris, std::optional<std::int32_t> zoom = {}) {
+  EncoderSample s;
+  s.t_ns = t;
+  s.focus = focus;
+  s.iris = iris;
+  s.zoom = zoom;
+  return s;
+}
+EncoderSample values_at(std::int64_t t, std::optional<double> focus_m,
+                        std::optional<double> f_number, std::optional<double> focal_mm = {}) {
+  EncoderSample s;
+  s.t_ns = t;
+  s.focus_distance_m = focus_m;
+  s.f_number = f_number;
+  s.focal_length_mm = focal_mm;
+  return s;
+}
+
 TEST(LensTracker, FrameStateFromRawSamples) {
   LensTrackerConfig cfg;
   cfg.focus.timeline.delay_ns = 5 * kMs;
@@ -103,7 +125,7 @@ TEST(LensTracker, FrameStateFromRawSamples) {
   // 100 Hz, focus still at the 2 m mark, iris at f/4.
   std::int64_t t = 0;
   for (int i = 0; i < 200; ++i, t += 10 * kMs)
-    tracker.push(EncoderSample{t, 9400, 1900, std::nullopt});
+    tracker.push(counts_at(t, 9400, 1900));
   const std::int64_t last = t - 10 * kMs;
   const LensState s = tracker.state_for_frame(last - 20 * kMs, 10 * kMs);
   EXPECT_TRUE(s.calibrated);
@@ -124,8 +146,68 @@ TEST(LensTracker, FrameStateFromRawSamples) {
 
   // With the uncalibrated fallback the same samples give the nominal lens.
   LensTracker fallback(LensProfile::uncalibrated());
-  fallback.push(EncoderSample{0, 9400, 1900, 5});
+  fallback.push(counts_at(0, 9400, 1900, 5));
   EXPECT_FALSE(fallback.state_at(0).calibrated);
+}
+
+// A source that sends physical values (a trace's focus_m, f_stop and
+// focal_mm columns, an engine's OpenTrackIO focusDistance and fStop) drives
+// the state: interpolated in diopters and stops, fresh while they come.
+TEST(LensTracker, CalibratedValuesAloneDriveTheState) {
+  LensTracker tracker(LensProfile::uncalibrated());
+  tracker.push(values_at(0, 4.0, 2.0));
+  tracker.push(values_at(10 * kMs, 1.0, 4.0));
+  const LensState mid = tracker.state_at(5 * kMs);
+  EXPECT_NEAR(mid.focus_distance_m.value, 1.0 / 0.625, 1e-9);  // halfway in diopters
+  EXPECT_NEAR(mid.f_number.value, 2.0 * std::sqrt(2.0), 1e-9); // halfway in stops
+  EXPECT_TRUE(mid.focus_distance_m.fresh);
+  EXPECT_TRUE(mid.f_number.fresh);
+  EXPECT_FALSE(mid.t_stop.has_value());
+  // No focal length sent: the fallback's nominal one, and not calibrated.
+  EXPECT_NEAR(mid.focal_length_mm.value, 35.0, 1e-9);
+  EXPECT_FALSE(mid.calibrated);
+
+  // With the focal length too, every axis is the sender's: calibrated.
+  tracker.push(values_at(20 * kMs, std::numeric_limits<double>::infinity(), 4.0, 50.0));
+  const LensState all = tracker.state_at(20 * kMs);
+  EXPECT_EQ(all.focus_distance_m.value, std::numeric_limits<double>::infinity());
+  EXPECT_NEAR(all.focal_length_mm.value, 50.0, 1e-9);
+  EXPECT_NEAR(all.projection_focal_length_mm.value, 50.0, 1e-9);
+  EXPECT_TRUE(all.calibrated);
+}
+
+// Both ways at once: the counts through a calibrated profile win (camhead's
+// own calibration of this lens); with the uncalibrated fallback, the values.
+TEST(LensTracker, CountsWinWithAProfileValuesWithout) {
+  EncoderSample both = counts_at(0, 9400, 1900);
+  both.focus_distance_m = 5.0;
+  both.f_number = 8.0;
+  LensTracker profiled(
+      LensProfile::load(std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/example_35mm.json"));
+  profiled.push(both);
+  EXPECT_NEAR(profiled.state_at(0).focus_distance_m.value, 2.0, 1e-9); // the 2 m mark
+  EXPECT_NEAR(profiled.state_at(0).f_number.value, 4.0, 1e-9);
+
+  LensTracker fallback(LensProfile::uncalibrated());
+  fallback.push(both);
+  EXPECT_NEAR(fallback.state_at(0).focus_distance_m.value, 5.0, 1e-9);
+  EXPECT_NEAR(fallback.state_at(0).f_number.value, 8.0, 1e-9);
+}
+
+// A focus sent as a distance still breathes as the profile says: the
+// projection focal length at 2 m is the one the counts at the 2 m mark give.
+TEST(LensTracker, AFocusValueBreathesAsTheProfileSays) {
+  const LensProfile profile =
+      LensProfile::load(std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/example_35mm.json");
+  LensTracker by_value(profile);
+  EncoderSample value = counts_at(0, std::nullopt, 1900);
+  value.focus_distance_m = 2.0;
+  by_value.push(value);
+  LensTracker by_counts(profile);
+  by_counts.push(counts_at(0, 9400, 1900));
+  EXPECT_NEAR(by_value.state_at(0).projection_focal_length_mm.value,
+              by_counts.state_at(0).projection_focal_length_mm.value, 1e-9);
+  EXPECT_NEAR(by_value.state_at(0).projection_focal_length_mm.value, 35.6, 1e-9);
 }
 
 } // namespace

@@ -138,17 +138,21 @@ TEST_F(LensSources, AMissingTraceIsNamedWithItsSource) {
   }
 }
 
-TEST(LensSample, CarriesCountsAndTimeOnly) {
+TEST(LensSample, CarriesCountsAndCalibratedValues) {
   hal::lens::EncoderReading r;
   r.t_ns = 42;
   r.focus = 7;
   r.zoom = -3;
   r.focus_distance_m = 2.0;
+  r.f_stop = 2.8;
   const lens_control::EncoderSample s = to_encoder_sample(r);
   EXPECT_EQ(s.t_ns, 42);
   EXPECT_EQ(s.focus, 7);
   EXPECT_FALSE(s.iris.has_value());
   EXPECT_EQ(s.zoom, -3);
+  EXPECT_EQ(s.focus_distance_m, 2.0);
+  EXPECT_EQ(s.f_number, 2.8);
+  EXPECT_FALSE(s.focal_length_mm.has_value());
 }
 
 } // namespace

@@ -190,6 +190,51 @@ TEST_F(RunLoop, EveryFrameGetsTheLensStateOfItsMidExposure) {
   }
 }
 
+// A lens source that sends calibrated values only (a trace's focus_m,
+// f_stop and focal_mm columns, as an engine's OpenTrackIO focusDistance and
+// fStop come) drives the render: every frame has the trace's lens, fresh.
+// (They were dropped on the way into the lens chain, and every frame had
+// the profile's rest state, stale.)
+TEST_F(RunLoop, ACalibratedTraceDrivesTheLens) {
+  const int w = 48, h = 32, n = 6;
+  const std::vector<std::vector<std::uint8_t>> frames(
+      n, std::vector<std::uint8_t>(std::size_t(w) * h * 2, 128));
+  const fs::path input = write("in.y4m", y4m_422(w, h, frames));
+  std::string trace = "# camhead lens trace v1\nt_s,focus_m,f_stop,focal_mm\n";
+  for (int k = 0; k <= 2000; ++k) // 20 s at 100 Hz
+    trace += std::to_string(0.01 * k) + ",1.5,2.8,50\n";
+  const fs::path trace_file = write("calibrated.csv", trace);
+  for (const bool with_profile : {true, false}) {
+    const std::string profile =
+        with_profile ? R"("profile": ")" + (kLenses / "example_35mm.json").string() + "\", " : "";
+    RunOptions options;
+    options.board = load_board(write("board.json", R"({"format": "camhead-board", "version": 1,
+      "name": "t", "lens": {)" + profile + R"("sources": [{"type": "trace", "file": ")" +
+                                                       trace_file.string() + R"("}]},
+      "camera": {"type": "file", "path": ")" + input.string() +
+                                                       R"(", "loop": false, "realtime": false,
+                 "width": 48, "height": 32},
+      "scene": ")" + real_scene(w, h).string() + "\"}"));
+    options.outputs = {"null"};
+    options.stats_file = dir_ / "stats.jsonl";
+    options.status = nullptr;
+    const RunSummary summary = run_pipeline(options);
+    EXPECT_EQ(summary.lens_late, 0u);
+    std::ifstream stats(dir_ / "stats.jsonl");
+    int composites = 0;
+    for (std::string line; std::getline(stats, line);) {
+      if (line.find("\"kind\":\"composite\"") == std::string::npos)
+        continue;
+      ++composites;
+      EXPECT_NEAR(json_number(line, "focus_m"), 1.5, 1e-6) << line;
+      EXPECT_NEAR(json_number(line, "f_number"), 2.8, 1e-6) << line;
+      EXPECT_NEAR(json_number(line, "focal_length_mm"), 50.0, 1e-6) << line;
+      EXPECT_NE(line.find("\"lens_fresh\":true"), std::string::npos) << line;
+    }
+    EXPECT_EQ(composites, n) << (with_profile ? "with a profile" : "without");
+  }
+}
+
 TEST_F(RunLoop, RefusesABoardWithoutCameraOrOutput) {
   RunOptions options;
   options.board = load_board(resolve_board("sim"));

@@ -88,7 +88,13 @@ public:
   // each table, at the current zoom), iris wide open, zoom at its first
   // calibration point. With per-zoom focus tables the focus distance depends
   // on zoom too: as old as the older reading, fresh only if both are.
-  [[nodiscard]] LensState evaluate(const LensCounts &counts) const;
+  // An axis in `values` (and not in `counts`) takes that value instead of
+  // a lookup: the focal length as given (and the projection focal length
+  // equal to it, the tables' breathing being over zoom counts), the f-number
+  // as given (no T-stop), the focus as given (breathing from the tables at
+  // the zoom there is). The state is calibrated if the profile is, or if
+  // every axis came as a value.
+  [[nodiscard]] LensState evaluate(const LensCounts &counts, const LensValues &values = {}) const;
 
 private:
   friend class ProfileReader; // profile_reader.cpp fills the tables

@@ -14,10 +14,15 @@ namespace camhead::lens_control {
 
 // One reading from a lens-encoder source. t_ns is on the monotonic clock
 // (CLOCK_MONOTONIC) as stamped by the source; an axis that the source does not
-// report in this sample (absent, or dropped out) is empty.
+// report in this sample (absent, or dropped out) is empty. An axis may come
+// as raw counts, as the physical value the source already knows (a trace's
+// focus_m column, OpenTrackIO's focusDistance), or both: LensTracker says
+// which it takes.
 struct EncoderSample {
   std::int64_t t_ns = 0;
   std::optional<std::int32_t> focus, iris, zoom;
+  // Metres from the entrance pupil (+infinity allowed), the f-number, mm.
+  std::optional<double> focus_distance_m, f_number, focal_length_mm;
 };
 
 // One axis sample inside the chain: raw counts after spike rejection, or
@@ -38,6 +43,14 @@ struct AxisReading {
 // The three axes at one instant; an axis the rig has no encoder for is empty.
 struct LensCounts {
   std::optional<AxisReading> focus, iris, zoom;
+};
+
+// Axes known at one instant as physical values instead of counts, in the
+// spaces they are interpolated in: focus in diopters (1/m, infinity = 0),
+// the iris in stops (2 log2 N), the focal length as ln(mm). AxisReading's
+// `counts` holds the value.
+struct LensValues {
+  std::optional<AxisReading> focus_diopters, iris_stops, log_focal_length;
 };
 
 // A physical quantity with the instant it describes and whether the data

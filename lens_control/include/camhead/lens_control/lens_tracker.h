@@ -9,6 +9,17 @@
 // independent of the profile, so a profile can be swapped without losing the
 // history, and the nonlinear map is applied once per frame, not per sample.
 //
+// A source that sends an axis's physical value (EncoderSample's
+// focus_distance_m, f_number, focal_length_mm: it was calibrated at the
+// sender) has it kept on a timeline of its own, in the space the profile
+// interpolates that quantity in (diopters, stops, ln mm), without the
+// encoder filter (made for counts) and with the same delay. Where an axis
+// comes both ways, the counts win when the profile is calibrated (camhead's
+// own calibration of this lens, the one its renders are checked against),
+// and the value wins with the uncalibrated fallback (whose nominal lens
+// says nothing of this one). The state at a frame takes, per axis, the
+// counts if it has any, else the value (LensProfile::evaluate).
+//
 // Thread safety: none. The pipeline's lens thread owns it; frames ask for
 // their state through that thread (pipeline/ queues the request).
 #pragma once
@@ -35,7 +46,7 @@ class LensTracker {
 public:
   explicit LensTracker(LensProfile profile, LensTrackerConfig config = {});
 
-  // Feeds one raw sample; axes it does not carry are left alone (a dropout
+  // Feeds one sample; axes it does not carry are left alone (a dropout
   // there shows up as staleness when the state is read).
   void push(const EncoderSample &sample);
 
@@ -59,6 +70,7 @@ private:
 
   LensProfile profile_;
   Axis focus_, iris_, zoom_;
+  AxisTimeline focus_diopters_, iris_stops_, log_focal_length_; // values, not counts
 };
 
 } // namespace camhead::lens_control
