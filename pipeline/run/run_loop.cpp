@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <cinttypes>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -13,8 +12,6 @@
 #include <thread>
 #include <utility>
 #include <variant>
-
-#include <unistd.h>
 
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
@@ -31,6 +28,7 @@
 #include "placeholder.h"
 #include "rig_setup.h"
 #include "run_paths.h"
+#include "run_status.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -52,17 +50,6 @@ struct Slot {
 struct Delivered {
   hal::camera::FrameLease frame;
   std::int64_t at_ns = 0;
-};
-
-// The counters every thread adds to; the status line and the summary read them.
-struct Counters {
-  std::atomic<std::uint64_t> frames_in{0}, frames_out{0}, render_busy{0}, output_busy{0},
-      render_failed{0}, placeholders{0}, repeats{0}, sink_errors{0}, lens_late{0};
-  std::atomic<std::uint32_t> rpp{0};
-  std::atomic<std::uint32_t> traced_permille{1000}; // of the last frame's pixels
-  std::atomic<std::int64_t> latency_ns{0};          // capture to output, last frame
-  std::atomic<bool> camera_lost{false};
-  std::atomic<bool> renderer_lost{false}; // the GPU is gone: placeholders from now on
 };
 
 // A camera without a frame for this long (or four frame intervals, if
@@ -89,9 +76,6 @@ private:
   void render_loop();
   void output_loop();
   void status_loop();
-  void print_status(std::int64_t now, double dt, std::uint64_t in, std::uint64_t out, bool tty);
-  void report_sink_errors(bool tty);
-  void report_camera(bool tty);
   // A frame's request as the board and the options make it.
   [[nodiscard]] renderer::FrameRequest board_request() const;
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
@@ -117,19 +101,17 @@ private:
   std::string executor_name_;
 
   std::vector<Slot> slots_{kSlots};
-  std::vector<std::vector<std::uint8_t>> last_frames_; // what each sink showed last
+  std::vector<std::vector<std::uint8_t>> last_frames_;  // what each sink showed last
   std::vector<std::vector<std::uint8_t>> placeholders_; // each sink's, made once
   // Render thread: where a frame's composite goes, its slot's buffers
   // (named anew each frame: the output thread swaps them).
   std::vector<renderer::VideoBuffer> targets_;
-  std::vector<std::uint64_t> sink_errors_seen_; // status thread: reported so far
-  std::string camera_detail_seen_;              // status thread: reported last
-  std::uint64_t camera_errors_seen_ = 0;        // status thread: reported so far
-  std::string camera_failure_;                  // capture thread; read after it is joined
-  std::string render_failure_;                  // render thread: the first; after the join
+  std::string camera_failure_; // capture thread; read after it is joined
+  std::string render_failure_; // render thread: the first; after the join
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
-  Counters counters_;
+  RunCounters counters_;
+  std::optional<RunStatus> status_; // the status line, unless options_.status is null
   std::atomic<bool> stopping_{false};
   // A camera that waits for its consumer (a file not played in real time):
   // the capture thread waits for the renderer instead of replacing frames.
@@ -199,12 +181,13 @@ Pipeline::Pipeline(const RunOptions &options)
     fill_placeholder(sink->format(), placeholders_.emplace_back(last_frames_.back().size()));
   }
   targets_.resize(sinks_.size());
-  sink_errors_seen_.assign(sinks_.size(), 0);
   sink_failed_.assign(sinks_.size(), 0);
   for (int i = 0; i < kSlots; ++i)
     (void)free_slots_.push(i);
   if (const auto *file = std::get_if<FileCameraConfig>(&board_.camera->kind))
     lossless_ = !file->realtime;
+  if (options.status != nullptr)
+    status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_);
   // Last: a trace played from the rig's start starts with the run, not a
   // set-up's time (a renderer's kernel compiles) before its first frame.
   lens_.start();
@@ -434,74 +417,10 @@ void Pipeline::output_loop() {
   }
 }
 
-void Pipeline::print_status(std::int64_t now, double dt, std::uint64_t in, std::uint64_t out,
-                            bool tty) {
-  const hal::camera::CameraStatus cam = camera_->status();
-  const LensSnapshot lens = lens_.state_at(now);
-  char focus[32];
-  if (std::isinf(lens.state.focus_distance_m.value))
-    std::snprintf(focus, sizeof focus, "inf");
-  else
-    std::snprintf(focus, sizeof focus, "%.2f m", lens.state.focus_distance_m.value);
-  const char *alarm = counters_.renderer_lost ? "  GPU LOST: placeholder"
-                      : counters_.camera_lost ? "  CAMERA LOST: placeholder"
-                                              : "";
-  char output_errors[48] = "";
-  if (const std::uint64_t errors = counters_.sink_errors; errors > 0)
-    std::snprintf(output_errors, sizeof output_errors, "  OUTPUT ERRORS %" PRIu64, errors);
-  char lens_late[64] = "";
-  if (const std::uint64_t late = counters_.lens_late; late > 0)
-    std::snprintf(lens_late, sizeof lens_late, " (%" PRIu64 " frames without it)", late);
-  std::fprintf(options_.status,
-               "%sin %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
-               " (camera %" PRIu64 ", render busy %" PRIu64 ", output busy %" PRIu64
-               ")  focus %s f/%.1f %.0f mm%s%s  latency %.0f ms%s%s%s",
-               tty ? "\r\033[K" : "", double(in) / dt, double(out) / dt, counters_.rpp.load(),
-               0.1 * counters_.traced_permille.load(),
-               cam.dropped + counters_.render_busy + counters_.output_busy, cam.dropped,
-               counters_.render_busy.load(), counters_.output_busy.load(), focus,
-               lens.state.f_number.value, lens.state.focal_length_mm.value,
-               lens.fresh ? "" : " (stale)", lens_late, 1e-6 * double(counters_.latency_ns.load()),
-               alarm, output_errors, tty ? "" : "\n");
-  std::fflush(options_.status);
-}
-
-// An output that failed since the last look says what failed (the device or
-// file, and why) on a line of its own: a count alone tells nobody which of
-// them ran out of disk.
-void Pipeline::report_sink_errors(bool tty) {
-  for (std::size_t i = 0; i < sinks_.size(); ++i) {
-    const hal::output::SinkStatus status = sinks_[i]->status();
-    if (status.errors == sink_errors_seen_[i])
-      continue;
-    std::fprintf(options_.status, "%scamhead run: %s (%" PRIu64 " failed so far)\n",
-                 tty ? "\r\033[K" : "", status.detail.c_str(), status.errors);
-    sink_errors_seen_[i] = status.errors;
-  }
-}
-
-// A camera that failed or went away says why: once for each new error (a
-// take's frame that cannot be read; the detail keeps it after the camera is
-// back), and once each time a lost camera's word changes (a device gone).
-void Pipeline::report_camera(bool tty) {
-  const hal::camera::CameraStatus status = camera_->status();
-  const bool new_error = status.errors != camera_errors_seen_;
-  const bool new_loss = !status.connected && status.detail != camera_detail_seen_;
-  camera_errors_seen_ = status.errors;
-  if (!new_error && !new_loss)
-    return;
-  camera_detail_seen_ = status.detail;
-  std::fprintf(options_.status, "%scamhead run: camera: %s\n", tty ? "\r\033[K" : "",
-               status.detail.c_str());
-}
-
-// The status line: redrawn in place on a terminal, a line a second in logs.
+// The status line (run_status.h), a line a second.
 void Pipeline::status_loop() {
-  const bool tty = options_.status != nullptr && isatty(fileno(options_.status)) != 0;
-  if (options_.status != nullptr)
-    std::fprintf(options_.status, "camhead run: %s -> %zu output%s, %s, lens %s\n",
-                 camera_->name().c_str(), sinks_.size(), sinks_.size() == 1 ? "" : "s",
-                 executor_name_.c_str(), lens_.source_name().c_str());
+  if (status_)
+    status_->start();
   std::uint64_t last_in = 0, last_out = 0;
   std::int64_t last_ns = start_ns_;
   // Awake often, so that a run ends as soon as its last frame is out (it
@@ -509,18 +428,16 @@ void Pipeline::status_loop() {
   while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
     std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
-    if (options_.status == nullptr || now - last_ns < 1'000'000'000)
+    if (!status_ || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
-    report_camera(tty);
-    report_sink_errors(tty);
-    print_status(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out, tty);
+    status_->second(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out);
     last_in = in;
     last_out = out;
     last_ns = now;
   }
-  if (tty)
-    std::fprintf(options_.status, "\n");
+  if (status_)
+    status_->end();
 }
 
 RunSummary Pipeline::run() {
@@ -559,8 +476,8 @@ RunSummary Pipeline::run() {
 
 RunSummary Pipeline::finish() {
   RunSummary summary;
-  if (options_.status != nullptr)
-    report_sink_errors(false); // those of the last second
+  if (status_)
+    status_->report_sink_errors(); // those of the last second
   for (std::size_t i = 0; i < sinks_.size(); ++i) {
     FrameSink &sink = *sinks_[i];
     const bool closed = sink.close();
