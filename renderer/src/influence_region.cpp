@@ -32,6 +32,9 @@
 // 3. Pixels and tiles. Each hull, widened by the pixel filter and a pixel of
 //    margin, marks the tiles it touches, a row of tiles at a time; runs of
 //    tiles are merged into rectangles.
+//
+// Step 1 depends on the scene alone: InfluenceRegionBuilder makes it once,
+// and steps 2 and 3 run per frame in storage it keeps (FrameProjector).
 #include "camhead/renderer/influence_region.h"
 
 #include <algorithm>
@@ -373,12 +376,12 @@ public:
   // The marked tiles as rectangles, into `region` (its storage reused).
   void finish(InfluenceRegion &region);
 
-  // Marks every tile: where a piece's image is not known.
-  void mark_everywhere() { std::fill(marked_.begin(), marked_.end(), std::uint8_t(1)); }
-
   [[nodiscard]] std::size_t rects_capacity() const { return rects_capacity_; }
 
 private:
+  // Marks every tile: where a piece's image is not known.
+  void mark_everywhere() { std::fill(marked_.begin(), marked_.end(), std::uint8_t(1)); }
+
   // Marks the tiles of the pixels whose samples (the pixel's centre within
   // half the filter width, and one pixel more for the rays' rounding) can
   // fall in a convex polygon (image coordinates, in order), a row of

@@ -7,93 +7,39 @@
 // file and the per-frame record. The renderer is prepared before the first
 // frame (FrameRenderer::prepare), so there is no warm-up to leave out.
 //
-// Counted: C++ allocations (operator new), not the C library's malloc (stdio
-// buffers its streams with it, once).
-#include <atomic>
+// Counted (tests/support/counting_new.h): C++ allocations, not the C
+// library's malloc (stdio buffers its streams with it, once).
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
-#include <new>
 #include <string>
 #include <vector>
 
 #include <pthread.h>
 
+#include "counting_new.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
 
-// GCC takes the replaced delete's free() for a mismatch with the new that it
-// cannot see is replaced too.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-
 namespace {
 
-std::atomic<bool> counting{false};
-std::atomic<std::uint64_t> render_allocations{0}, output_allocations{0};
+constexpr int kRender = 0, kOutput = 1;
 
-// Counts an allocation by the name of the thread that makes it.
-void count() {
-  if (!counting.load(std::memory_order_relaxed))
-    return;
+// The bucket of the calling thread, by the name run_loop.cpp gives it.
+int thread_bucket() {
   char name[16] = {};
   if (pthread_getname_np(pthread_self(), name, sizeof name) != 0)
-    return;
+    return -1;
   if (std::strcmp(name, "camhead-render") == 0 || std::strcmp(name, "camhead-worker") == 0)
-    render_allocations.fetch_add(1, std::memory_order_relaxed);
-  else if (std::strcmp(name, "camhead-output") == 0)
-    output_allocations.fetch_add(1, std::memory_order_relaxed);
-}
-
-// Every unaligned form is replaced, so that whatever the process allocates
-// with one it frees with its own kind; the aligned forms stay the library's.
-void *counted(std::size_t bytes) noexcept {
-  count();
-  return std::malloc(bytes == 0 ? 1 : bytes);
-}
-
-void *counted_or_throw(std::size_t bytes) {
-  if (void *p = counted(bytes))
-    return p;
-  throw std::bad_alloc();
+    return kRender;
+  if (std::strcmp(name, "camhead-output") == 0)
+    return kOutput;
+  return -1;
 }
 
 } // namespace
-
-void *operator new(std::size_t bytes) {
-  return counted_or_throw(bytes);
-}
-void *operator new[](std::size_t bytes) {
-  return counted_or_throw(bytes);
-}
-void *operator new(std::size_t bytes, const std::nothrow_t &) noexcept {
-  return counted(bytes);
-}
-void *operator new[](std::size_t bytes, const std::nothrow_t &) noexcept {
-  return counted(bytes);
-}
-void operator delete(void *p) noexcept {
-  std::free(p);
-}
-void operator delete[](void *p) noexcept {
-  std::free(p);
-}
-void operator delete(void *p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void *p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete(void *p, const std::nothrow_t &) noexcept {
-  std::free(p);
-}
-void operator delete[](void *p, const std::nothrow_t &) noexcept {
-  std::free(p);
-}
 
 namespace camhead::pipeline {
 namespace {
@@ -132,12 +78,11 @@ protected:
     options.frames = 40;
     options.threads = 2;
     options.status = nullptr;
-    render_allocations = 0;
-    output_allocations = 0;
-    counting = true;
+    test::counting_new::start(thread_bucket);
     const RunSummary summary = run_pipeline(options);
-    counting = false;
-    return {render_allocations.load(), output_allocations.load(), summary.frames_out};
+    test::counting_new::stop();
+    return {test::counting_new::count(kRender), test::counting_new::count(kOutput),
+            summary.frames_out};
   }
 };
 

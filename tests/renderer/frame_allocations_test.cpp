@@ -5,95 +5,32 @@
 // every frame (a focus pull with a pan: a new history and influence region
 // each frame). On the GPU, a pipeline built in a frame would count too.
 //
-// Counted: C++ allocations (operator new), not the C library's malloc. The
-// CPU reference is counted on every thread (its workers too); the GPU
-// executor on the thread that renders, as the driver's own threads are not
-// camhead's: lavapipe (Mesa 22.3.6) JIT-compiles an LLVM module on its queue
-// thread for every frame whose camera frame it decodes, about 130 C++
-// allocations a frame (an empty decode kernel too; bench/RESULTS.md).
-#include <atomic>
+// Counted (tests/support/counting_new.h): C++ allocations, not the C
+// library's malloc. The CPU reference is counted on every thread (its
+// workers too); the GPU executor on the thread that renders, as the
+// driver's own threads are not camhead's: lavapipe (Mesa 22.3.6)
+// JIT-compiles an LLVM module on its queue thread for every frame whose
+// camera frame it decodes, about 130 C++ allocations a frame (an empty
+// decode kernel too; bench/RESULTS.md).
 #include <cstdint>
-#include <cstdlib>
 #include <memory>
-#include <new>
 #include <span>
 #include <vector>
 
 #include "camhead/base/video_format.h"
 #include "camhead/renderer/frame_renderer.h"
+#include "counting_new.h"
 #include "test_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
 
-// GCC takes the replaced delete's free() for a mismatch with the new that it
-// cannot see is replaced too.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-
 namespace {
 
-// Whose allocations count: nobody's, every thread's, or those of the
-// threads that set counted_thread.
-enum class Counting { off, every_thread, counted_threads };
-std::atomic<Counting> counting{Counting::off};
-thread_local bool counted_thread = false;
-std::atomic<std::uint64_t> allocations{0};
+// The calling thread is the one that renders (the GPU executor's count).
+thread_local bool rendering_thread = false;
 
 } // namespace
-
-// The replacements count while `counting` is on, on whatever thread. Every
-// unaligned form is replaced, so that whatever the process allocates with
-// one (a sanitizer's runtime, lavapipe's LLVM) it frees with its own kind;
-// the aligned forms stay the library's, a matched pair.
-namespace {
-
-void *counted(std::size_t bytes) noexcept {
-  const Counting mode = counting.load(std::memory_order_relaxed);
-  if (mode == Counting::every_thread || (mode == Counting::counted_threads && counted_thread))
-    allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(bytes == 0 ? 1 : bytes);
-}
-
-void *counted_or_throw(std::size_t bytes) {
-  if (void *p = counted(bytes))
-    return p;
-  throw std::bad_alloc();
-}
-
-} // namespace
-
-void *operator new(std::size_t bytes) {
-  return counted_or_throw(bytes);
-}
-void *operator new[](std::size_t bytes) {
-  return counted_or_throw(bytes);
-}
-void *operator new(std::size_t bytes, const std::nothrow_t &) noexcept {
-  return counted(bytes);
-}
-void *operator new[](std::size_t bytes, const std::nothrow_t &) noexcept {
-  return counted(bytes);
-}
-void operator delete(void *p) noexcept {
-  std::free(p);
-}
-void operator delete[](void *p) noexcept {
-  std::free(p);
-}
-void operator delete(void *p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void *p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete(void *p, const std::nothrow_t &) noexcept {
-  std::free(p);
-}
-void operator delete[](void *p, const std::nothrow_t &) noexcept {
-  std::free(p);
-}
 
 namespace camhead::renderer {
 namespace {
@@ -155,12 +92,13 @@ public:
 
   // Allocations while `run` runs, on the threads that are the executor's.
   template <typename Run> std::uint64_t allocations_in(Run run) {
-    allocations = 0;
-    counted_thread = true;
-    counting = executor_ == Executor::cpu ? Counting::every_thread : Counting::counted_threads;
+    rendering_thread = true;
+    test::counting_new::start(executor_ == Executor::cpu
+                                  ? test::counting_new::Classifier([] { return 0; })
+                                  : [] { return rendering_thread ? 0 : -1; });
     run();
-    counting = Counting::off;
-    return allocations.load();
+    test::counting_new::stop();
+    return test::counting_new::count(0);
   }
 
   FrameRequest request;

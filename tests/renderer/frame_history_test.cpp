@@ -145,30 +145,36 @@ double virtual_error(const Frames &frames, const Frames &reference) {
   return std::sqrt(diff / ref);
 }
 
-TEST(FrameHistory, NStillFramesOfOneSampleAreOneFrameOfN) {
+// Both executors (the GPU's where Vulkan is).
+class FrameHistoryOn : public ::testing::TestWithParam<Executor> {};
+
+TEST_P(FrameHistoryOn, NStillFramesOfOneSampleAreOneFrameOfN) {
   const Scene scene = ball_scene();
-  Frames one_at_a_time(scene);
+  Frames one_at_a_time(scene, false, GetParam());
+  if (!one_at_a_time.available())
+    GTEST_SKIP() << "no Vulkan device";
   for (std::uint32_t n = 1; n <= 16; ++n) {
     // Each frame has its own seed, as the run loop's do: a continuing
     // history keeps its own.
     const FrameReport report = one_at_a_time.render(still_uniform(scene, 1, 100 + n));
     EXPECT_EQ(report.history_samples, n);
     EXPECT_EQ(report.history_restarted, n == 1);
+    EXPECT_EQ(report.camera_rays, report.traced_pixels);
   }
-  Frames at_once(scene);
+  Frames at_once(scene, false, GetParam());
   const FrameReport report = at_once.render(still_uniform(scene, 16, 101));
   EXPECT_EQ(report.history_samples, 16u);
   EXPECT_EQ(bytes_differing(one_at_a_time.out(), at_once.out()), 0u);
 
   // In uneven steps too.
-  Frames uneven(scene);
+  Frames uneven(scene, false, GetParam());
   for (const std::uint32_t rpp : {3u, 1u, 7u, 5u})
     (void)uneven.render(still_uniform(scene, rpp, 101));
   EXPECT_EQ(bytes_differing(uneven.out(), at_once.out()), 0u);
 
   // The comparison can tell: 16 frames of a history held at one sample
   // (the same pattern, the same first sample) are not 16 samples.
-  Frames one(scene);
+  Frames one(scene, false, GetParam());
   for (int n = 0; n < 16; ++n) {
     FrameRequest request = still_uniform(scene, 1, 101);
     request.accumulation.max_samples = 1;
@@ -177,28 +183,58 @@ TEST(FrameHistory, NStillFramesOfOneSampleAreOneFrameOfN) {
   EXPECT_GT(bytes_differing(one.out(), at_once.out()), 100u);
 }
 
+TEST_P(FrameHistoryOn, AFullHistoryTracesNothingMore) {
+  const Scene scene = ball_scene();
+  Frames frames(scene, false, GetParam());
+  if (!frames.available())
+    GTEST_SKIP() << "no Vulkan device";
+  FrameRequest request = still_uniform(scene, 3);
+  request.accumulation.max_samples = 8;
+  EXPECT_EQ(frames.render(request).history_samples, 3u);
+  EXPECT_EQ(frames.render(request).history_samples, 6u);
+  const FrameReport third = frames.render(request);
+  EXPECT_EQ(third.history_samples, 8u);
+  EXPECT_EQ(third.camera_rays, third.traced_pixels * 2);
+  const std::vector<std::uint8_t> full = frames.out();
+  const FrameReport fourth = frames.render(request);
+  EXPECT_EQ(fourth.history_samples, 8u);
+  EXPECT_EQ(fourth.camera_rays, 0u);
+  EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Executors, FrameHistoryOn, ::testing::Values(Executor::cpu, Executor::gpu),
+                         [](const ::testing::TestParamInfo<Executor> &executor) {
+                           return executor.param == Executor::cpu ? "cpu" : "gpu";
+                         });
+
 // The changes that start a history afresh, each the size of a real move.
 struct Change {
   const char *name;
   void (*apply)(FrameCamera &);
 };
 
-class FrameHistoryChange : public ::testing::TestWithParam<Change> {};
-
-TEST_P(FrameHistoryChange, TheFirstFrameAfterItCarriesNothingOfTheFramesBefore) {
+// Eight frames of a held shot, then one after `change`: it starts afresh,
+// and has a fresh renderer's bytes.
+void expect_the_change_starts_afresh(Executor executor, const Change &change) {
   const Scene scene = ball_scene();
-  Frames held(scene);
+  Frames held(scene, false, executor);
   for (int n = 0; n < 8; ++n)
     (void)held.render(still(scene, 1, 200 + n));
   FrameRequest moved = still(scene, 2, 300);
-  GetParam().apply(moved.camera);
+  change.apply(moved.camera);
   const FrameReport report = held.render(moved);
-  EXPECT_TRUE(report.history_restarted);
-  EXPECT_EQ(report.history_samples, 2u);
+  EXPECT_TRUE(report.history_restarted) << change.name;
+  EXPECT_EQ(report.history_samples, 2u) << change.name;
 
-  Frames fresh(scene);
+  Frames fresh(scene, false, executor);
   (void)fresh.render(moved);
-  EXPECT_EQ(bytes_differing(held.out(), fresh.out()), 0u);
+  EXPECT_EQ(bytes_differing(held.out(), fresh.out()), 0u) << change.name;
+}
+
+class FrameHistoryChange : public ::testing::TestWithParam<Change> {};
+
+TEST_P(FrameHistoryChange, TheFirstFrameAfterItCarriesNothingOfTheFramesBefore) {
+  expect_the_change_starts_afresh(Executor::cpu, GetParam());
 }
 
 const Change kChanges[] = {
@@ -271,93 +307,14 @@ TEST(FrameHistory, ANonAccumulatingFrameEndsTheHistory) {
   EXPECT_EQ(report.history_samples, 1u);
 }
 
-TEST(FrameHistory, AFullHistoryTracesNothingMore) {
-  const Scene scene = ball_scene();
-  Frames frames(scene);
-  FrameRequest request = still_uniform(scene, 3);
-  request.accumulation.max_samples = 8;
-  EXPECT_EQ(frames.render(request).history_samples, 3u);
-  EXPECT_EQ(frames.render(request).history_samples, 6u);
-  const FrameReport third = frames.render(request);
-  EXPECT_EQ(third.history_samples, 8u);
-  EXPECT_EQ(third.camera_rays, third.traced_pixels * 2);
-  const std::vector<std::uint8_t> full = frames.out();
-  const FrameReport fourth = frames.render(request);
-  EXPECT_EQ(fourth.history_samples, 8u);
-  EXPECT_EQ(fourth.camera_rays, 0u);
-  EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
-}
-
 // The GPU executor accumulates every pixel alike (no shares by noise, no
-// reconstruction): the same sums in the same order as one frame of all the
-// samples, so the same bytes; a change starts afresh; a full history traces
-// nothing more.
-TEST(GpuFrameHistory, NStillFramesOfOneSampleAreOneFrameOfN) {
-  const Scene scene = ball_scene();
-  Frames one_at_a_time(scene, false, Executor::gpu);
-  if (!one_at_a_time.available())
-    GTEST_SKIP() << "no Vulkan device";
-  for (std::uint32_t n = 1; n <= 16; ++n) {
-    const FrameReport report = one_at_a_time.render(still_uniform(scene, 1, 100 + n));
-    EXPECT_EQ(report.history_samples, n);
-    EXPECT_EQ(report.history_restarted, n == 1);
-    EXPECT_EQ(report.camera_rays, report.traced_pixels);
-  }
-  Frames at_once(scene, false, Executor::gpu);
-  EXPECT_EQ(at_once.render(still_uniform(scene, 16, 101)).history_samples, 16u);
-  EXPECT_EQ(bytes_differing(one_at_a_time.out(), at_once.out()), 0u);
-
-  Frames uneven(scene, false, Executor::gpu);
-  for (const std::uint32_t rpp : {3u, 1u, 7u, 5u})
-    (void)uneven.render(still_uniform(scene, rpp, 101));
-  EXPECT_EQ(bytes_differing(uneven.out(), at_once.out()), 0u);
-
-  // The comparison can tell: a history held at one sample is not 16.
-  Frames one(scene, false, Executor::gpu);
-  for (int n = 0; n < 16; ++n) {
-    FrameRequest request = still_uniform(scene, 1, 101);
-    request.accumulation.max_samples = 1;
-    (void)one.render(request);
-  }
-  EXPECT_GT(bytes_differing(one.out(), at_once.out()), 100u);
-}
-
+// reconstruction): above, FrameHistoryOn; here, a change starts afresh, and
+// the history comes to the CPU reference's picture.
 TEST(GpuFrameHistory, TheFirstFrameAfterAChangeCarriesNothingOfTheFramesBefore) {
-  const Scene scene = ball_scene();
-  if (!Frames(scene, false, Executor::gpu).available())
+  if (!Frames(ball_scene(), false, Executor::gpu).available())
     GTEST_SKIP() << "no Vulkan device";
-  for (const Change &change : kChanges) {
-    Frames held(scene, false, Executor::gpu);
-    for (int n = 0; n < 8; ++n)
-      (void)held.render(still(scene, 1, 200 + n));
-    FrameRequest moved = still(scene, 2, 300);
-    change.apply(moved.camera);
-    const FrameReport report = held.render(moved);
-    EXPECT_TRUE(report.history_restarted) << change.name;
-    EXPECT_EQ(report.history_samples, 2u) << change.name;
-    Frames fresh(scene, false, Executor::gpu);
-    (void)fresh.render(moved);
-    EXPECT_EQ(bytes_differing(held.out(), fresh.out()), 0u) << change.name;
-  }
-}
-
-TEST(GpuFrameHistory, AFullHistoryTracesNothingMore) {
-  const Scene scene = ball_scene();
-  Frames frames(scene, false, Executor::gpu);
-  if (!frames.available())
-    GTEST_SKIP() << "no Vulkan device";
-  FrameRequest request = still_uniform(scene, 3);
-  request.accumulation.max_samples = 8;
-  EXPECT_EQ(frames.render(request).history_samples, 3u);
-  EXPECT_EQ(frames.render(request).history_samples, 6u);
-  const FrameReport third = frames.render(request);
-  EXPECT_EQ(third.history_samples, 8u);
-  EXPECT_EQ(third.camera_rays, third.traced_pixels * 2);
-  const std::vector<std::uint8_t> full = frames.out();
-  const FrameReport fourth = frames.render(request);
-  EXPECT_EQ(fourth.history_samples, 8u);
-  EXPECT_EQ(fourth.camera_rays, 0u);
-  EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
+  for (const Change &change : kChanges)
+    expect_the_change_starts_afresh(Executor::gpu, change);
 }
 
 // Accumulated on the GPU and on the CPU reference, the same history comes
