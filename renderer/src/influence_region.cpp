@@ -747,8 +747,11 @@ const InfluenceRegion &InfluenceRegionBuilder::build(const gpu::FrameParams &fra
       std::max(s.object_scale, glm::length(dvec3(frame.cam_position) - dvec3(s.scene.origin)));
   if (!std::isfinite(scale))
     return whole_frame(frame.image.x, frame.image.y); // a camera nowhere: unknown
-  if (scale > s.pieces_scale) // rounded up, so that a camera moving about rarely rebuilds
-    s.build_pieces(scale > 0.0 ? std::exp2(std::ceil(std::log2(scale))) : 0.0);
+  // The first build for the scale there is; a later one, for a camera gone
+  // further out, with a quarter more, so that a camera moving about rarely
+  // rebuilds (a larger margin is safe, a little more is traced).
+  if (scale > s.pieces_scale)
+    s.build_pieces(s.pieces_scale < 0.0 ? scale : 1.25 * scale);
   if (s.reserved_width != frame.image.x || s.reserved_height != frame.image.y)
     s.reserve(frame.image.x, frame.image.y);
   s.projector.start(frame, dvec3(s.scene.origin));

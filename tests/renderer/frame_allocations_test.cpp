@@ -146,9 +146,8 @@ TEST_P(FrameAllocations, AFocusPullWithAPanAllocatesNothingFrameAfterFrame) {
   live.prepare();
   EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull); }), 0u);
 
-  // The count works: a camera gone far beyond twice the scene's size from
-  // its origin builds the region's world-space part again
-  // (influence_region.h).
+  // The count works: a camera gone far beyond the scene's objects from its
+  // origin builds the region's world-space part again (influence_region.h).
   EXPECT_GT(live.allocations_in([&] {
     live.frames(1, [&](int) {
       live.request.camera.position = rest.position + glm::vec3(0.0f, 0.0f, 100.0f);

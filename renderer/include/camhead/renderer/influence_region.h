@@ -53,9 +53,10 @@ struct InfluenceRegion {
 // world-space part (influence_region.cpp, step 1) depends on the scene
 // alone and is built once; build() projects it through each frame's lens
 // into storage the builder keeps. After the first frame of a size, a frame
-// allocates nothing (tests/renderer/frame_allocations_test.cpp), until the
-// camera goes more than twice as far from the scene's origin as it has
-// been (the margin grows with that distance, and step 1 is built again).
+// allocates nothing (tests/renderer/frame_allocations_test.cpp), unless the
+// camera goes further from the scene's origin than the scene's objects and
+// than it has been: the margin grows with that distance, and step 1 is
+// built again, with a quarter more room.
 // `scene` must outlive the builder.
 class InfluenceRegionBuilder {
 public:
