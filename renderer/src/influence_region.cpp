@@ -277,7 +277,7 @@ public:
   // frames of width x height: after this, start(), add() and finish()
   // allocate nothing.
   void reserve(std::size_t vertices, std::size_t faces, std::uint32_t width, std::uint32_t height) {
-    // Three cuts deep at most (behind the lens, then near or far), each
+    // Two cuts deep at most (behind the lens, then near or far), each
     // growing a piece as clip_into() says.
     std::size_t v = vertices, f = faces;
     for (int cut = 0; cut < 2; ++cut) {
