@@ -46,16 +46,15 @@ double nearest_depth_m(const CompiledScene &scene, const gpu::FrameParams &frame
 }
 
 double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, double nearest_m) {
-  // What no tolerance covers: the view turning (its axes are compared
-  // exactly: only a pose source turns them, and a tracked pose that jitters
-  // is issue 25's to model), and what is not the camera.
-  if (a.cam_right != b.cam_right || a.cam_up != b.cam_up || a.cam_forward != b.cam_forward ||
-      a.lens.w != b.lens.w || a.world_color != b.world_color || a.image != b.image ||
+  // What no tolerance covers: what is not the camera.
+  if (a.lens.w != b.lens.w || a.world_color != b.world_color || a.image != b.image ||
       a.tracing.x != b.tracing.x)
     return kInfinity;
   for (const gpu::FrameParams *frame : {&a, &b})
     for (int k = 0; k < 4; ++k)
-      if (!std::isfinite(frame->lens[k]) || !std::isfinite(frame->cam_position[k]))
+      if (!std::isfinite(frame->lens[k]) || !std::isfinite(frame->cam_position[k]) ||
+          !std::isfinite(frame->cam_right[k]) || !std::isfinite(frame->cam_up[k]) ||
+          !std::isfinite(frame->cam_forward[k]))
         return kInfinity; // no bound to give
   const double width = a.image.x;
   const double height = a.image.y;
@@ -87,7 +86,21 @@ double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, dou
   change += blur;
   // ... and the pupil moving along the view changes every depth, so every
   // 1/z by up to |dp| / nearest^2, and a radius by A f times that.
-  change += moved * f * std::max(double(a.lens.x), double(b.lens.x)) / (nearest_m * nearest_m);
+  const double aperture = std::max(double(a.lens.x), double(b.lens.x));
+  change += moved * f * aperture / (nearest_m * nearest_m);
+  // 3. Turning (a tracked pose that jitters). The two views' axes differ by
+  //    a rotation of angle theta, |B_b - B_a| = 2 sqrt(2) sin(theta / 2)
+  //    (Frobenius). A point at tan phi from the axis moves by at most
+  //    f theta (1 + tan^2 phi) (a pan or tilt: d tan / d phi; a roll moves
+  //    it by f theta tan phi, less), and its depth along the view by up to
+  //    z theta tan phi, which changes its blur radius by f A theta tan phi / z.
+  const double turned2 =
+      glm::dot(xyz(b.cam_right) - xyz(a.cam_right), xyz(b.cam_right) - xyz(a.cam_right)) +
+      glm::dot(xyz(b.cam_up) - xyz(a.cam_up), xyz(b.cam_up) - xyz(a.cam_up)) +
+      glm::dot(xyz(b.cam_forward) - xyz(a.cam_forward), xyz(b.cam_forward) - xyz(a.cam_forward));
+  const double theta = 2.0 * std::asin(std::min(1.0, std::sqrt(turned2 / 8.0)));
+  change += f * theta * (1.0 + max_tan * max_tan);
+  change += f * aperture * theta * max_tan / nearest_m;
   return std::isfinite(change) ? change : kInfinity;
 }
 

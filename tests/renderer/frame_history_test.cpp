@@ -465,10 +465,54 @@ TEST(FrameChange, IsTheLargestMoveOfABlurCircleOrAPoint) {
   EXPECT_NEAR(frame_change_px(a, make_frame_params(scene, refocused), nearest), expected,
               1e-3 * expected);
 
-  // A turn of the view is no small change.
-  FrameCamera turned = camera;
-  turned.look_at.x += 1e-3f;
-  EXPECT_TRUE(std::isinf(frame_change_px(a, make_frame_params(scene, turned), nearest)));
+  // A turn of the view by theta moves the point on the axis by f theta
+  // pixels; the bound is at least that, and not many times more (points off
+  // the axis move by up to f theta (1 + tan^2), and their blur changes).
+  const auto turn_by = [&](double theta) {
+    FrameCamera turned = camera;
+    const glm::vec3 view = camera.look_at - camera.position;
+    const float c = float(std::cos(theta)), s = float(std::sin(theta));
+    turned.look_at =
+        camera.position + glm::vec3(c * view.x - s * view.z, view.y, s * view.x + c * view.z);
+    return frame_change_px(a, make_frame_params(scene, turned), nearest);
+  };
+  const double f = a.lens.z;
+  for (const double theta : {1e-4, 1e-3, 1e-2}) {
+    EXPECT_GE(turn_by(theta), 0.99 * f * theta) << theta;
+    EXPECT_LE(turn_by(theta), 3.0 * f * theta) << theta;
+  }
+}
+
+// A tracked pose jitters: a turn of the view that moves no point by the
+// tolerance keeps the history (and its camera), one that does ends it.
+TEST(FrameHistory, ATurnWithinTheToleranceKeepsTheHistory) {
+  const Scene scene = ball_scene();
+  const gpu::FrameParams a = make_frame_params(scene, scene_camera(scene));
+  const double nearest = nearest_depth_m(compile_scene(scene), a);
+  for (const double fraction : {0.5, 2.0}) {
+    // A yaw whose bound is `fraction` of the tolerance.
+    const double tolerance = AccumulationSettings{}.tolerance_px;
+    FrameCamera turned = scene_camera(scene);
+    const auto turn = [&](double theta) {
+      FrameCamera c = scene_camera(scene);
+      const glm::vec3 view = c.look_at - c.position;
+      c.look_at =
+          c.position + glm::vec3(float(std::cos(theta)) * view.x - float(std::sin(theta)) * view.z,
+                                 view.y,
+                                 float(std::sin(theta)) * view.x + float(std::cos(theta)) * view.z);
+      return c;
+    };
+    double theta = 1e-4;
+    for (int step = 0; step < 4; ++step)
+      theta *=
+          fraction * tolerance / frame_change_px(a, make_frame_params(scene, turn(theta)), nearest);
+    turned = turn(theta);
+    Frames frames(scene);
+    (void)frames.render(still_uniform(scene, 1));
+    FrameRequest moved = still_uniform(scene, 1);
+    moved.camera = turned;
+    EXPECT_EQ(frames.render(moved).history_restarted, fraction > 1.0) << fraction;
+  }
 }
 
 } // namespace

@@ -31,10 +31,11 @@ inline constexpr double kNearestDepthM = 0.05;
 
 // An upper bound, in pixels, on how far any point of the scene at a depth of
 // at least `nearest_m` moves between frames `a` and `b`, in position (the
-// pupil moving, the image scale breathing) plus in blur-circle radius (focus
-// and aperture), to first order in the change. Infinity where the frames
-// differ in anything else that shapes the image: the view's direction, the
-// image size, the pixel filter, the lights, the world colour or the plate.
+// pupil moving, the view turning, the image scale breathing) plus in
+// blur-circle radius (focus, aperture, the depth along a turned view), to
+// first order in the change. Infinity where the frames differ in anything
+// else that shapes the image: the image size, the pixel filter, the lights,
+// the world colour or the plate.
 [[nodiscard]] double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b,
                                      double nearest_m);
 
