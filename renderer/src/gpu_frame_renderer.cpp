@@ -2,7 +2,7 @@
 // frame's conversion, the trace and the outputs' conversion all on the
 // device, one submission for a steady frame (GpuTracer::render_video). A
 // held shot accumulates in the device's accumulators (frame_history.h):
-// every pixel of the region the next samples of one progressive pattern,
+// every pixel of the region the next samples of one CMJ pattern,
 // the shares by noise and the reconstruction being the CPU reference's
 // alone so far.
 #include <algorithm>
@@ -132,9 +132,12 @@ private:
       frame.sampling.w = request.seed;
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
     if (request.accumulation.enabled) {
-      // A progressive pattern (sample i does not depend on the count) of the
-      // history's greatest size, every sample traced on its own.
-      frame.tracing.z = SAMPLER_SOBOL;
+      // One pattern of the history's greatest size, its samples taken in
+      // order, every sample traced on its own. CMJ, not the CPU reference's
+      // Owen-scrambled Sobol': each CMJ sample is uniform on its own, so any
+      // prefix is an unbiased estimate (less evenly spread than a Sobol' one),
+      // and on lavapipe a Sobol' frame of the rig took 381 ms against 29 ms
+      // (bench/RESULTS.md).
       frame.sampling.z = std::max(request.accumulation.max_samples, 1u);
       frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
     }

@@ -65,7 +65,7 @@ public:
   // work on 4 x 2 blocks); the caller checks. A plate without bytes is none.
   //
   // `samples` [first, end) of the frame's pattern of frame.sampling.z
-  // samples (a progressive one: SAMPLER_SOBOL) add to those that the frames
+  // samples (CMJ or Sobol': any prefix is unbiased) add to those that the frames
   // before left in the accumulators when first > 0, and the composite is the
   // mean of samples [0, end): the frame before must have been render_video()
   // of the same loaded scene, pattern, region and outputs, ending at
