@@ -53,8 +53,10 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
 }
 
 // How the frames are made: each afresh (the live path before issue 24); as
-// camhead run makes them, accumulating with the reconstruction, during the
-// pull (each frame starts a new history); the same with the lens still.
+// camhead run makes them, accumulating (on the CPU reference with the
+// shares by noise and the reconstruction; on the GPU every pixel alike),
+// during the pull (each frame starts a new history); the same with the lens
+// still.
 enum class Method { fresh, pull, still };
 
 void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
