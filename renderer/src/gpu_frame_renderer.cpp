@@ -136,8 +136,8 @@ private:
       // order, every sample traced on its own. CMJ, not the CPU reference's
       // Owen-scrambled Sobol': each CMJ sample is uniform on its own, so any
       // prefix is an unbiased estimate (less evenly spread than a Sobol' one),
-      // and on lavapipe a Sobol' frame of the rig took 381 ms against 29 ms
-      // (bench/RESULTS.md).
+      // and on lavapipe a Sobol' frame of the rig costs 13 times a CMJ one
+      // (bench/RESULTS.md, "The GPU executor's history").
       frame.sampling.z = std::max(request.accumulation.max_samples, 1u);
       frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
     }
