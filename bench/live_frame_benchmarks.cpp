@@ -28,8 +28,8 @@ namespace {
 constexpr int kWidth = 720;
 constexpr int kHeight = 576;
 // The rig's focus pull (scenes/lenses/make_sim_focus_pull.py: 14 m to 0.4 m
-// while the iris opens from f/4 to f/2) in as many steps as frames of a
-// second, then back.
+// at a still iris, f/2.8 here) in as many steps as frames of a second, then
+// back.
 constexpr int kLensStates = 25;
 
 renderer::Scene sim_rig_scene() {
@@ -55,9 +55,11 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
 // How the frames are made: each afresh (the live path before issue 24); as
 // camhead run makes them, accumulating (on the CPU reference with the
 // shares by noise and the reconstruction; on the GPU every pixel alike),
-// during the pull (each frame starts a new history); the same with the lens
-// still.
-enum class Method { fresh, pull, still };
+// during the pull (each frame starts a new history, with the samples of the
+// frames before moved through the new focus: accumulation.h, reproject;
+// the CPU reference's only), the same without them (pull_afresh), and with
+// the lens still.
+enum class Method { fresh, pull, pull_afresh, still };
 
 void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   const renderer::Scene scene = sim_rig_scene();
@@ -82,6 +84,8 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   request.rays_per_pixel = 1;
   request.influence_region = region;
   request.accumulation.enabled = method != Method::fresh;
+  request.accumulation.reproject = method != Method::pull_afresh;
+  request.camera.f_number = 2.8f;
   std::uint64_t frame = 0;
   double traced = 0.0;
   for (auto _ : state) {
@@ -90,7 +94,6 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
     const double t =
         double(step < kLensStates ? step : 2 * kLensStates - 2 - step) / double(kLensStates - 1);
     request.camera.focus_distance_m = float(1.0 / (1.0 / 14.0 + t * (1.0 / 0.4 - 1.0 / 14.0)));
-    request.camera.f_number = float(4.0 - 2.0 * t);
     request.seed = std::uint32_t(++frame * 2654435761u) | 1u;
     const renderer::FrameReport report = frames->render(request, {format, plate}, outputs);
     if (report.status != renderer::FrameStatus::ok) {
@@ -110,12 +113,16 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
 void register_live_frame_benchmarks() {
   for (const bool gpu : {false, true})
     for (const bool region : {true, false})
-      for (const Method method : {Method::fresh, Method::pull, Method::still}) {
+      for (const Method method :
+           {Method::fresh, Method::pull, Method::pull_afresh, Method::still}) {
         if (method != Method::fresh && !region)
           continue; // a history is kept over the region
-        const char *name = method == Method::fresh  ? "fresh"
-                           : method == Method::pull ? "live_pull"
-                                                    : "live_still";
+        if (method == Method::pull_afresh && gpu)
+          continue; // the GPU executor does not reproject
+        const char *name = method == Method::fresh         ? "fresh"
+                           : method == Method::pull        ? "live_pull"
+                           : method == Method::pull_afresh ? "live_pull_afresh"
+                                                           : "live_still";
         benchmark::RegisterBenchmark((std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
                                       "/sim_rig/720x576/rpp:1/" +
                                       (region ? "region" : "every_pixel") + "/" + name)

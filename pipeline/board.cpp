@@ -241,9 +241,9 @@ private:
   }
 
   static RenderConfig read_render(const JsonValue &d) {
-    d.object({},
-             {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel", "adaptive",
-              "accumulate", "accumulate_tolerance_px", "accumulate_max_samples", "reconstruct"});
+    d.object({}, {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel",
+                  "adaptive", "accumulate", "accumulate_tolerance_px", "accumulate_max_samples",
+                  "reconstruct", "reproject"});
     RenderConfig render;
     if (const auto executor = d.find("executor")) {
       const std::string e = executor->string();
@@ -281,6 +281,8 @@ private:
       accumulation.max_samples = rpp("accumulate_max_samples");
     if (d.has("reconstruct"))
       accumulation.reconstruct = d.at("reconstruct").boolean();
+    if (d.has("reproject"))
+      accumulation.reproject = d.at("reproject").boolean();
     return render;
   }
 

@@ -5,10 +5,12 @@
 // at the camera's rate, accumulating (frame_history.h), and each frame's
 // composite is measured against a converged render of the same camera; so
 // are fresh frames of 1, 9 and 49 rays per pixel (the paper's settings, in
-// the same run), and the frames of a focus pull, where every frame starts a
-// new history. Error = relative RMSE of the composite over the influence
-// region (elsewhere the composite is the camera image, exactly), in linear
-// light before the outputs' 8-bit rounding.
+// the same run), and frames of a focus pull: each state reached by a pull at
+// the rig's speed, every frame a new history, which starts with the frames
+// before moved through the new focus (accumulation.h, reproject) or, as
+// before that, afresh. Error = relative RMSE of the composite over the
+// influence region (elsewhere the composite is the camera image, exactly),
+// in linear light before the outputs' 8-bit rounding.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -136,14 +138,22 @@ public:
 
   // The live frame: `rpp` more rays while the camera holds still.
   double live_error(std::uint32_t rpp, std::uint32_t seed, std::uint32_t *history) {
-    FrameRequest request;
-    request.camera = camera_;
-    request.rays_per_pixel = rpp;
-    request.seed = seed;
-    request.accumulation.enabled = true;
-    request.accumulation.reconstruct = args_.reconstruct > 0.0;
-    request.accumulation.reconstruct_strength = args_.reconstruct;
-    *history = render(request, "a live frame").history_samples;
+    *history = render(live_request(camera_, rpp, seed, true), "a live frame").history_samples;
+    return error();
+  }
+
+  // The live frame at the end of a pull through `focus_before` (metres, the
+  // frames before it, in order), each frame `rpp` rays; with `reproject`,
+  // each frame's history starts with the frames before it moved.
+  double pull_error(std::uint32_t rpp, std::uint32_t seed, std::span<const float> focus_before,
+                    bool reproject, std::uint32_t *history) {
+    for (std::size_t k = 0; k < focus_before.size(); ++k) {
+      FrameCamera camera = camera_;
+      camera.focus_distance_m = focus_before[k];
+      (void)render(live_request(camera, rpp, seed + 1 + std::uint32_t(k), reproject),
+                   "a pull frame");
+    }
+    *history = render(live_request(camera_, rpp, seed, reproject), "a pull frame").history_samples;
     return error();
   }
 
@@ -152,6 +162,19 @@ public:
   }
 
 private:
+  FrameRequest live_request(const FrameCamera &camera, std::uint32_t rpp, std::uint32_t seed,
+                            bool reproject) const {
+    FrameRequest request;
+    request.camera = camera;
+    request.rays_per_pixel = rpp;
+    request.seed = seed;
+    request.accumulation.enabled = true;
+    request.accumulation.reconstruct = args_.reconstruct > 0.0;
+    request.accumulation.reconstruct_strength = args_.reconstruct;
+    request.accumulation.reproject = reproject;
+    return request;
+  }
+
   static void check(const FrameReport &report, const std::string &what) {
     if (report.status != FrameStatus::ok)
       throw std::runtime_error(what + ": " + report.detail);
@@ -193,6 +216,10 @@ struct RestCurve {
   double uniform1 = 0.0, uniform9 = 0.0, uniform49 = 0.0;
   std::vector<double> seconds, error;
   std::vector<std::uint32_t> samples;
+  // Pull frames: the live frame afresh (no samples moved from the frames
+  // before) and its samples held.
+  double afresh = 0.0;
+  std::uint32_t afresh_samples = 0;
   // Pull frames: 1 rpp, the live frame, 9 rpp, the reference (RGB, 8 bits).
   std::vector<std::vector<std::uint8_t>> pictures;
 };
@@ -228,13 +255,19 @@ void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
   if (!csv)
     throw std::runtime_error("cannot write " + csv_path.string());
   csv << "shot,lens,frame,seconds,history_samples,error,uniform_1,uniform_9,uniform_49\n";
-  for (const auto *set : {&rest, &pull})
-    for (const RestCurve &c : *set)
-      for (std::size_t k = 0; k < c.error.size(); ++k)
-        csv << (set == &rest ? "still" : "pull") << "," << c.lens.name << "," << k + 1 << ","
-            << fmt(c.seconds[k]) << "," << c.samples[k] << "," << fmt(c.error[k], "%.6g") << ","
-            << fmt(c.uniform1, "%.6g") << "," << fmt(c.uniform9, "%.6g") << ","
-            << fmt(c.uniform49, "%.6g") << "\n";
+  const auto row = [&](const char *shot, const RestCurve &c, std::size_t k, std::uint32_t samples,
+                       double error) {
+    csv << shot << "," << c.lens.name << "," << k + 1 << "," << fmt(c.seconds[k]) << "," << samples
+        << "," << fmt(error, "%.6g") << "," << fmt(c.uniform1, "%.6g") << ","
+        << fmt(c.uniform9, "%.6g") << "," << fmt(c.uniform49, "%.6g") << "\n";
+  };
+  for (const RestCurve &c : rest)
+    for (std::size_t k = 0; k < c.error.size(); ++k)
+      row("still", c, k, c.samples[k], c.error[k]);
+  for (const RestCurve &c : pull) {
+    row("pull_afresh", c, 0, c.afresh_samples, c.afresh);
+    row("pull", c, 0, c.samples[0], c.error[0]);
+  }
   std::printf("wrote %s\n", csv_path.string().c_str());
 
   std::vector<chart::Panel> panels;
@@ -321,11 +354,26 @@ int run_live(const LiveArgs &args) {
                                                " m f/" + fmt(scene.camera.f_number, "%.1f"),
                                            scene.camera.focus_distance_m, scene.camera.f_number},
                                           {"near 0.4 m f/2", 0.4f, 2.0f}};
+    // The pull: five states even in diopters between the holds; each is
+    // reached by kPullFrames frames at the rig's pull's mean speed (its 1.5
+    // s from 14 to 0.4 m), from the far side, the far end from the near
+    // side (the pull back).
+    constexpr float kFarW = 1.0f / 14.0f, kNearW = 1.0f / 0.4f;
+    const float pull_speed = (kNearW - kFarW) / float(1.5 * args.fps); // diopters a frame
+    constexpr int kPullFrames = 12;
     std::vector<LensPoint> pulling;
     for (int k = 0; k < 5; ++k) {
-      const float w = 1.0f / 14.0f + (1.0f / 0.4f - 1.0f / 14.0f) * float(k) / 4.0f;
+      const float w = kFarW + (kNearW - kFarW) * float(k) / 4.0f;
       pulling.push_back({"pull " + fmt(1.0 / w, "%.2f") + " m f/2.8", 1.0f / w, 2.8f});
     }
+    const auto approach = [&](const LensPoint &lens) {
+      std::vector<float> focus;
+      const float w = 1.0f / lens.focus_m;
+      const float step = w <= kFarW ? pull_speed : -pull_speed;
+      for (int j = kPullFrames; j >= 1; --j)
+        focus.push_back(1.0f / std::clamp(w + step * float(j), kFarW, kNearW));
+      return focus;
+    };
 
     std::vector<RestCurve> rest, pull;
     for (const bool is_still : {true, false})
@@ -340,13 +388,22 @@ int run_live(const LiveArgs &args) {
         c.uniform9 = shot.uniform_error(9, 0x1009u);
         const std::vector<std::uint8_t> nine = shot.picture();
         c.uniform49 = shot.uniform_error(49, 0x1049u);
-        // Still: frame after frame; pulling: each frame a new history, one.
-        const int frames = is_still ? args.frames : 1;
-        for (int k = 0; k < frames; ++k) {
+        // Still: frame after frame; pulling: the state's frame at the end
+        // of the pull, afresh, then with the frames before moved.
+        if (is_still) {
+          for (int k = 0; k < args.frames; ++k) {
+            std::uint32_t samples = 0;
+            c.error.push_back(shot.live_error(args.rpp, 0x2000u + std::uint32_t(k), &samples));
+            c.samples.push_back(samples);
+            c.seconds.push_back((k + 1) * frame_s);
+          }
+        } else {
+          const std::vector<float> before = approach(lens);
+          c.afresh = shot.pull_error(args.rpp, 0x2000u, before, false, &c.afresh_samples);
           std::uint32_t samples = 0;
-          c.error.push_back(shot.live_error(args.rpp, 0x2000u + std::uint32_t(k), &samples));
+          c.error.push_back(shot.pull_error(args.rpp, 0x2000u, before, true, &samples));
           c.samples.push_back(samples);
-          c.seconds.push_back((k + 1) * frame_s);
+          c.seconds.push_back(frame_s);
         }
         if (!is_still) {
           c.pictures.push_back(shot.picture());
@@ -378,12 +435,13 @@ int run_live(const LiveArgs &args) {
                   at(12).c_str(), at(25).c_str(), at(args.frames).c_str(), when(c.uniform9).c_str(),
                   when(c.uniform49).c_str());
     }
-    std::printf(
-        "\n| pull frame | region | uniform 1 / 9 / 49 rpp | live frame |\n|---|---|---|---|\n");
+    std::printf("\n| pull frame | region | uniform 1 / 9 / 49 rpp | live, afresh | live, frames "
+                "before moved (samples held) | against 9 rpp |\n|---|---|---|---|---|---|\n");
     for (const RestCurve &c : pull)
-      std::printf("| %s | %.1f %% | %s / %s / %s | %s |\n", c.lens.name.c_str(), 100.0 * c.region,
-                  fmt(c.uniform1).c_str(), fmt(c.uniform9).c_str(), fmt(c.uniform49).c_str(),
-                  fmt(c.error.front()).c_str());
+      std::printf("| %s | %.1f %% | %s / %s / %s | %s | %s (%u) | %.2fx |\n", c.lens.name.c_str(),
+                  100.0 * c.region, fmt(c.uniform1).c_str(), fmt(c.uniform9).c_str(),
+                  fmt(c.uniform49).c_str(), fmt(c.afresh).c_str(), fmt(c.error.front()).c_str(),
+                  c.samples.front(), c.error.front() / c.uniform9);
     std::printf("\n");
     write_outputs(args, rest, pull);
     write_pull_pictures(args, scene, pull);
@@ -403,7 +461,9 @@ void add_bench_live_command(CLI::App &bench) {
               "reference: for three still lens states (the simulated rig's far and near\n"
               "holds and the scene's own focus) each frame's composite after the lens\n"
               "came to rest, accumulating --rpp rays a frame, and for five states of a\n"
-              "focus pull a frame that starts afresh; each against a --ref-rpp reference\n"
+              "focus pull the frame that reaches it after 12 frames of a pull at the\n"
+              "rig's speed, its history started with the frames before moved through\n"
+              "the new focus, and afresh; each against a --ref-rpp reference\n"
               "of the same camera and against fresh frames of 1, 9 and 49 rays per pixel\n"
               "measured in the same run. Error: relative RMSE of the composite over the\n"
               "influence region, linear light. Writes DIR/live.csv, DIR/live.png (the\n"

@@ -13,23 +13,22 @@ void write_filler_record(std::FILE *out, std::uint64_t output_frame, const char 
 
 void write_composite_record(std::FILE *out, std::uint64_t output_frame, const FrameRecord &r,
                             std::int64_t output_ns, const std::string &executor) {
-  std::fprintf(out,
-               "{\"output_frame\":%" PRIu64 ",\"kind\":\"composite\",\"sequence\":%" PRIu64
-               ",\"capture_ns\":%" PRId64 ",\"exposure_mid_ns\":%" PRId64
-               ",\"delivered_ns\":%" PRId64 ",\"render_start_ns\":%" PRId64
-               ",\"render_end_ns\":%" PRId64 ",\"output_ns\":%" PRId64
-               ",\"focus_m\":%s,\"f_number\":%.6g"
-               ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
-               ",\"camera_rays\":%" PRIu64
-               ",\"history_samples\":%u,\"traced\":%.4f,\"dropped_before\":%" PRIu64
-               ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
-               ",\"encode_ms\":%.3f,\"executor\":\"%s\"}\n",
-               output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns,
-               r.render_start_ns, r.render_end_ns, output_ns,
-               std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
-               r.focal_length_mm, r.lens_fresh ? "true" : "false", 1e3 * r.lens_wait_s, r.rpp,
-               r.camera_rays, r.history_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
-               1e3 * r.trace_s, 1e3 * r.encode_s, executor.c_str());
+  std::fprintf(
+      out,
+      "{\"output_frame\":%" PRIu64 ",\"kind\":\"composite\",\"sequence\":%" PRIu64
+      ",\"capture_ns\":%" PRId64 ",\"exposure_mid_ns\":%" PRId64 ",\"delivered_ns\":%" PRId64
+      ",\"render_start_ns\":%" PRId64 ",\"render_end_ns\":%" PRId64 ",\"output_ns\":%" PRId64
+      ",\"focus_m\":%s,\"f_number\":%.6g"
+      ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
+      ",\"camera_rays\":%" PRIu64 ",\"history_samples\":%u,\"reprojected_samples\":%" PRIu64
+      ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
+      ",\"encode_ms\":%.3f,\"executor\":\"%s\"}\n",
+      output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns, r.render_start_ns,
+      r.render_end_ns, output_ns,
+      std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
+      r.focal_length_mm, r.lens_fresh ? "true" : "false", 1e3 * r.lens_wait_s, r.rpp, r.camera_rays,
+      r.history_samples, r.reprojected_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
+      1e3 * r.trace_s, 1e3 * r.encode_s, executor.c_str());
 }
 
 } // namespace camhead::pipeline

@@ -21,9 +21,10 @@ struct FrameRecord {
   double lens_wait_s = 0.0; // how long the frame waited for it (bounded; run_loop.h)
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;
-  std::uint32_t history_samples = 0; // samples per pixel the image holds (accumulating; else 0)
-  double traced = 1.0;               // the fraction of the pixels traced (the influence region)
-  std::uint64_t dropped_before = 0;  // camera, render-busy and output-busy drops since the last
+  std::uint32_t history_samples = 0;     // samples per pixel the image holds (accumulating; else 0)
+  std::uint64_t reprojected_samples = 0; // of them moved from the frames before (a new history)
+  double traced = 1.0;                   // the fraction of the pixels traced (the influence region)
+  std::uint64_t dropped_before = 0;      // camera, render-busy and output-busy drops since the last
   double decode_s = 0.0, trace_s = 0.0, encode_s = 0.0;
 };
 

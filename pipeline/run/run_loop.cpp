@@ -323,6 +323,7 @@ void Pipeline::render_loop() {
     r.trace_s = report.trace_s;
     r.encode_s = report.encode_s;
     r.history_samples = report.history_samples;
+    r.reprojected_samples = report.reprojected_samples;
     // What the frame cost for the rays it traced, a mean (adaptive and
     // accumulating frames share them unevenly; a full history traces none).
     budget.measured(report.traced_pixels > 0 ? double(report.camera_rays) / report.traced_pixels

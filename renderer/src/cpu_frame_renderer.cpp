@@ -2,10 +2,12 @@
 // compiled and the kernel bound once, the per-pixel buffers and the threads
 // made once, then per frame passes over the rows: the camera frame into the
 // linear plate, the samples (a pilot and a second pass when adaptive; each
-// pixel's share of the rays when accumulating, frame_history.h), the
-// reconstruction (accumulating frames, defocus_filter.h), and the resolve
-// with each output's encoding.
+// pixel's share of the rays when accumulating, frame_history.h; a new
+// history's first, the last frames' samples moved through the new lens,
+// sample_store.h), the reconstruction (accumulating frames,
+// defocus_filter.h), and the resolve with each output's encoding.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstring>
@@ -23,6 +25,7 @@
 #include "frame_checks.h"
 #include "pixel_span.h"
 #include "ray_shares.h"
+#include "sample_store.h"
 #include "video_codec.h"
 #include "worker_pool.h"
 
@@ -39,6 +42,13 @@ double seconds_since(Clock::time_point start) {
 // the noise (enough for a first estimate of it, ray_shares.h).
 constexpr std::uint32_t kPilotSamples = 4;
 
+// The samples kept for reprojection (sample_store.h), in frames of the
+// whole picture at one ray per pixel: 40 MB at 720x576, eight frames of 1
+// rpp where the influence region is a quarter of the frame.
+constexpr std::size_t kStoredFrames = 2;
+// The most threads that move the kept samples at once (bands of rows).
+constexpr int kMostBands = 8;
+
 class CpuFrameRenderer final : public FrameRenderer {
 public:
   CpuFrameRenderer(const Scene &scene, int threads)
@@ -46,9 +56,10 @@ public:
         pixels_(std::size_t(scene_.render.width) * std::size_t(scene_.render.height)),
         plate_(pixels_), composite_(pixels_), mixed_(pixels_, glm::vec4(0.0f)),
         real_(pixels_, glm::vec4(0.0f)), aux_(pixels_, glm::vec4(0.0f)),
-        history_counts_(pixels_, 0u), shares_(pixels_, 0u), sigma_(pixels_, 0.0f),
-        noise_(pixels_, 0.0f), filtered_mixed_(pixels_), filtered_real_(pixels_),
-        scratch_mixed_(pixels_), scratch_real_(pixels_), scratch_weight_(pixels_), blur_(pixels_) {
+        history_counts_(pixels_, 0u), own_counts_(pixels_, 0u), shares_(pixels_, 0u),
+        sigma_(pixels_, 0.0f), noise_(pixels_, 0.0f), filtered_mixed_(pixels_),
+        filtered_real_(pixels_), scratch_mixed_(pixels_), scratch_real_(pixels_),
+        scratch_weight_(pixels_), blur_(pixels_) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 2 != 0 || h % 2 != 0)
@@ -60,6 +71,7 @@ public:
     const std::size_t runs = (std::size_t(w) + 2 * CAMHEAD_TILE_X - 1) / (2 * CAMHEAD_TILE_X);
     for (std::vector<RowSpan> *spans : {&spans_, &blocks_, &traced_spans_})
       spans->reserve(runs * std::size_t(h));
+    span_firsts_.reserve(runs * std::size_t(h));
   }
 
   std::string executor() const override {
@@ -73,6 +85,8 @@ public:
     frame.image.z = plate ? 1u : 0u;
     if (request.influence_region)
       static_cast<void>(regions_.build(frame));
+    if (request.accumulation.enabled && request.accumulation.reproject && !store_.reserved())
+      store_.reserve(kStoredFrames * pixels_, frame.image.x, frame.image.y);
     history_valid_ = false; // the region it traced is no longer in regions_
   }
 
@@ -97,12 +111,29 @@ public:
     if (request.seed != 0)
       frame.sampling.w = request.seed;
     const bool continues = request.accumulation.enabled && continues_history(request, frame);
+    const bool reprojects = request.accumulation.enabled && request.accumulation.reproject;
+    if (!reprojects)
+      store_.clear();            // what it holds would be older than the frames between
+    else if (!store_.reserved()) // prepare() reserves it
+      store_.reserve(kStoredFrames * pixels_, frame.image.x, frame.image.y);
     if (request.accumulation.enabled) {
       if (continues) {
         frame = history_; // its camera and seed, so that the samples stay one pattern's
       } else {
         frame.tracing.z = SAMPLER_SOBOL; // progressive: sample i does not depend on the count
         frame.sampling.z = request.accumulation.max_samples; // the pattern's size
+        // After a change of the lens alone the pattern goes on where the
+        // last history's left off (its seed, the indices after those it
+        // traced): a sample moved within its pixel and the new ones are then
+        // one pattern's, stratified together, not independent.
+        const bool goes_on = reprojects && history_valid_ && history_all_uniform_ &&
+                             history_.sampling.z == frame.sampling.z &&
+                             cpu::same_view(history_, frame) &&
+                             pattern_base_ + history_uniform_ < frame.sampling.z / 2;
+        pattern_base_ = goes_on ? pattern_base_ + history_uniform_ : 0;
+        if (goes_on)
+          frame.sampling.w = history_.sampling.w;
+        history_all_uniform_ = true;
         history_ = frame;
         history_valid_ = true;
         history_by_noise_ = request.accumulation.share_by_noise;
@@ -160,10 +191,21 @@ public:
     start = Clock::now();
     if (!continues)
       clear_traced();
+    if (!continues && reprojects) {
+      report.reprojected_samples =
+          reproject_into_history(has_plate, request.accumulation.reproject_frames);
+      history_rays_ += report.reprojected_samples;
+    }
     const std::uint32_t total = frame.sampling.z;
     if (request.accumulation.enabled) {
       report.camera_rays = share_rays(request);
-      trace_shares(has_plate);
+      // A frame that traces every pixel alike is kept for the frames after
+      // a lens change; one shared by noise is not (its samples are not
+      // uniform over the region).
+      std::span<cpu::StoredSample> kept;
+      if (reprojects && uniform_share_ > 0)
+        kept = store_.add_frame(kernel_.frame, *region_, report.camera_rays);
+      trace_shares(has_plate, kept);
       history_rays_ += report.camera_rays;
       report.history_samples =
           std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_->pixels(), 1));
@@ -285,6 +327,7 @@ private:
       std::fill(&real_[row + span.x0], &real_[row + span.x1], glm::vec4(0.0f));
       std::fill(&aux_[row + span.x0], &aux_[row + span.x1], glm::vec4(0.0f));
       std::fill(&history_counts_[row + span.x0], &history_counts_[row + span.x1], 0u);
+      std::fill(&own_counts_[row + span.x0], &own_counts_[row + span.x1], 0u);
     };
     pool_.run(int(traced_spans_.size()), clear);
     traced_spans_ = spans_; // what this frame leaves in them
@@ -296,15 +339,24 @@ private:
   // from there, with share_by_noise, where the image still lacks them
   // (ray_shares.h).
   std::uint64_t share_rays(const FrameRequest &request) {
-    const std::uint32_t most = request.accumulation.max_samples;
+    // Pattern indices from pattern_base_ on, below the pattern's size.
+    const std::uint32_t most = request.accumulation.max_samples - pattern_base_;
     const std::uint32_t rpp = request.rays_per_pixel;
     const bool by_noise = request.accumulation.share_by_noise && history_uniform_ >= kPilotSamples;
+    uniform_share_ = 0;
+    history_all_uniform_ = history_all_uniform_ && !by_noise;
     if (!by_noise) {
       const std::uint32_t k = std::min(rpp, most - std::min(most, history_uniform_));
-      for (const RowSpan &span : spans_)
+      span_firsts_.clear();
+      std::size_t first = 0;
+      for (const RowSpan &span : spans_) {
         for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i)
           shares_[i] = k;
+        span_firsts_.push_back(first);
+        first += std::size_t(span.x1 - span.x0) * k;
+      }
       history_uniform_ += k;
+      uniform_share_ = k;
       return region_->pixels() * k;
     }
     return cpu::share_rays_by_noise(spans_, scene_.render.width, scene_.render.height, aux_,
@@ -316,22 +368,90 @@ private:
     return std::size_t(y) * std::size_t(scene_.render.width) + x;
   }
 
-  // Each pixel's share of the frame's rays, the samples after those it holds.
-  void trace_shares(bool has_plate) {
+  // Each pixel's share of the frame's rays, the samples of its pattern after
+  // those it traced; into `kept` too where it is not empty (a frame of
+  // uniform shares: span k's samples from span_firsts_[k] on).
+  void trace_shares(bool has_plate, std::span<cpu::StoredSample> kept) {
     auto row = [&](int k) {
       const RowSpan &span = spans_[std::size_t(k)];
       cpu::CpuKernel kernel = kernel_; // its own sample range per pixel
+      cpu::StoredSample *out = kept.empty() ? nullptr : kept.data() + span_firsts_[std::size_t(k)];
       for (std::uint32_t x = span.x0; x < span.x1; ++x) {
         const std::size_t i = index(span.y, x);
         if (shares_[i] == 0)
           continue;
-        kernel.frame.sampling.x = history_counts_[i];
-        kernel.frame.sampling.y = history_counts_[i] + shares_[i];
-        kernel.trace_pixel(x, span.y, plate_[i], has_plate, mixed_[i], real_[i], aux_[i]);
+        kernel.frame.sampling.x = pattern_base_ + own_counts_[i];
+        kernel.frame.sampling.y = pattern_base_ + own_counts_[i] + shares_[i];
+        if (out == nullptr)
+          kernel.trace_pixel(x, span.y, plate_[i], has_plate, mixed_[i], real_[i], aux_[i]);
+        else
+          out = trace_and_keep(kernel, x, span.y, has_plate, out);
+        own_counts_[i] += shares_[i];
         history_counts_[i] += shares_[i];
       }
     };
     pool_.run(int(spans_.size()), row);
+  }
+
+  // trace_pixel()'s samples (uniform, every one traced), each kept as
+  // sample_store.h keeps it: its ray in the camera's frame and its result.
+  cpu::StoredSample *trace_and_keep(cpu::CpuKernel &kernel, std::uint32_t x, std::uint32_t y,
+                                    bool has_plate, cpu::StoredSample *out) {
+    const std::size_t i = index(y, x);
+    const gpu::FrameParams &f = kernel.frame;
+    const glm::vec3 pupil(f.cam_position), right(f.cam_right), up(f.cam_up), forward(f.cam_forward);
+    const std::uint32_t pattern = kernel.pixel_pattern_for(x, y, f.image.x, f.sampling.w);
+    for (std::uint32_t s = f.sampling.x; s < f.sampling.y; ++s) {
+      const cpu::CpuKernel::Ray ray = kernel.camera_ray(x, y, s, f.sampling.z, pattern);
+      const cpu::CpuKernel::SampleResult r = kernel.trace_sample(ray, s, f.sampling.z, pattern);
+      kernel.accumulate_sample(r, 1.0f, plate_[i], has_plate, mixed_[i], real_[i], aux_[i]);
+      const float along = glm::dot(ray.dir, forward);
+      const glm::vec3 offset = ray.origin - pupil;
+      *out++ = {glm::vec4(glm::dot(ray.dir, right) / along, glm::dot(ray.dir, up) / along,
+                          glm::dot(offset, right), glm::dot(offset, up)),
+                glm::vec4(r.mixed, r.is_virtual ? 1.0f : 0.0f),
+                glm::vec4(r.real, r.hit ? r.depth : -1.0f)};
+    }
+    return out;
+  }
+
+  // The kept samples of the last frames, moved into this frame's camera
+  // (kernel_.frame) where they land in its region; returns how many. The
+  // threads take bands of rows holding alike shares of the region.
+  std::uint64_t reproject_into_history(bool has_plate, std::uint32_t frames) {
+    store_.begin_reprojection(kernel_.frame, *region_, frames);
+    auto add = [&](std::size_t i, const cpu::StoredSample &s) {
+      cpu::CpuKernel::SampleResult r;
+      r.mixed = glm::vec3(s.mixed);
+      r.real = glm::vec3(s.real);
+      r.is_virtual = s.mixed.w > 0.5f;
+      r.hit = s.real.w >= 0.0f;
+      r.depth = s.real.w;
+      kernel_.accumulate_sample(r, 1.0f, plate_[i], has_plate, mixed_[i], real_[i], aux_[i]);
+      ++history_counts_[i];
+    };
+    const int bands = std::min(pool_.threads(), kMostBands);
+    std::array<std::uint32_t, kMostBands + 1> rows{};
+    std::array<std::uint64_t, kMostBands> given{};
+    const std::uint64_t pixels = region_->pixels();
+    std::uint64_t seen = 0;
+    int band = 0;
+    for (const RowSpan &span : spans_) {
+      while (band < bands - 1 && seen >= pixels * std::uint64_t(band + 1) / std::uint64_t(bands))
+        rows[std::size_t(++band)] = span.y;
+      seen += span.x1 - span.x0;
+    }
+    while (band < bands)
+      rows[std::size_t(++band)] = std::uint32_t(scene_.render.height);
+    auto rows_of_band = [&](int b) {
+      given[std::size_t(b)] =
+          store_.reproject_rows(rows[std::size_t(b)], rows[std::size_t(b) + 1], add);
+    };
+    pool_.run(bands, rows_of_band);
+    std::uint64_t total = 0;
+    for (int b = 0; b < bands; ++b)
+      total += given[std::size_t(b)];
+    return total;
   }
 
   // Samples [first, end) of the region's pixels into the accumulators.
@@ -371,8 +491,18 @@ private:
   std::uint64_t history_rays_ = 0;
   std::uint32_t history_frames_ = 0;
   std::vector<std::uint32_t> history_counts_; // samples per pixel
-  std::vector<std::uint32_t> shares_;         // this frame's rays per pixel
-  std::vector<float> sigma_, noise_;          // each pixel's noise, for the shares
+  // ... of them traced for this history (its pattern's next index); the
+  // rest came from the frames before, moved (sample_store.h).
+  std::vector<std::uint32_t> own_counts_;
+  cpu::SampleStore store_;
+  // Where this history's pattern starts (a pull's go on: see render()), and
+  // whether all of its frames shared their rays alike.
+  std::uint32_t pattern_base_ = 0;
+  bool history_all_uniform_ = true;
+  std::uint32_t uniform_share_ = 0;      // this frame's rays per pixel, if alike
+  std::vector<std::size_t> span_firsts_; // ... and where each span's go in store_
+  std::vector<std::uint32_t> shares_;    // this frame's rays per pixel
+  std::vector<float> sigma_, noise_;     // each pixel's noise, for the shares
   // The reconstruction's means and passes (defocus_filter.h).
   std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_;
   std::vector<float> scratch_weight_, blur_;

@@ -33,8 +33,8 @@ namespace camhead::renderer::cpu {
 
 struct DefocusFilterSettings {
   double strength = 1.0;
-  double min_sigma_px = 0.5; // below it a pixel keeps its own samples
-  int max_radius_px = 16;    // the widest reach of a pass: 2 sigma, at most
+  double min_sigma_px = 0.25; // below it a pixel keeps its own samples
+  int max_radius_px = 16;     // the widest reach of a pass: 2 sigma, at most
 };
 
 // Sums in, means out: `mixed`, `real` are the accumulators (sums of

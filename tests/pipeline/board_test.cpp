@@ -201,7 +201,7 @@ TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
             "virtual objects");
 }
 
-// A live frame accumulates and reconstructs unless the board says otherwise,
+// A live frame accumulates, reconstructs and reprojects unless the board says otherwise,
 // and an adaptive one does neither (it keeps no history).
 TEST(BoardLive, AccumulationIsOnUnlessAdaptive) {
   const auto render = [](const std::string &fields) {
@@ -213,6 +213,8 @@ TEST(BoardLive, AccumulationIsOnUnlessAdaptive) {
   EXPECT_FALSE(render(R"({"adaptive": true})").accumulation.enabled);
   EXPECT_FALSE(render(R"({"accumulate": false})").accumulation.enabled);
   EXPECT_FALSE(render(R"({"reconstruct": false})").accumulation.reconstruct);
+  EXPECT_TRUE(render("{}").accumulation.reproject);
+  EXPECT_FALSE(render(R"({"reproject": false})").accumulation.reproject);
   EXPECT_EQ(render(R"({"accumulate_max_samples": 64})").accumulation.max_samples, 64u);
   EXPECT_EQ(render(R"({"accumulate_tolerance_px": 0.2})").accumulation.tolerance_px, 0.2);
 }

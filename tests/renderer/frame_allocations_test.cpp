@@ -3,7 +3,9 @@
 // first frame after prepare(), for a held shot (the history growing, its
 // rays shared by noise, the reconstruction on) and for a shot that moves
 // every frame (a focus pull with a pan: a new history and influence region
-// each frame). On the GPU, a pipeline built in a frame would count too.
+// each frame; without the pan, each frame's history starts with the frames
+// before it moved through the new focus). On the GPU, a pipeline built in a
+// frame would count too.
 //
 // Counted (tests/support/counting_new.h): C++ allocations, not the C
 // library's malloc. The CPU reference is counted on every thread (its
@@ -83,6 +85,7 @@ public:
       const VideoBuffer outputs[] = {{yuyv(), out_yuyv_}, {nv12(), out_nv12_}};
       const FrameReport report = renderer_->render(request, {yuyv(), plate_}, outputs);
       ASSERT_EQ(report.status, FrameStatus::ok) << report.detail;
+      reprojected += report.reprojected_samples;
     }
   }
   void frames(int n) {
@@ -102,6 +105,7 @@ public:
   }
 
   FrameRequest request;
+  std::uint64_t reprojected = 0; // samples, in all frames
 
 private:
   static base::VideoFormat yuyv() {
@@ -154,6 +158,20 @@ TEST_P(FrameAllocations, AFocusPullWithAPanAllocatesNothingFrameAfterFrame) {
     });
   }),
             0u);
+}
+
+TEST_P(FrameAllocations, AFocusPullAllocatesNothingFrameAfterFrame) {
+  LiveFrames live(GetParam());
+  if (!live.available())
+    GTEST_SKIP() << "no Vulkan device";
+  const auto pull = [&](int k) {
+    live.request.camera.focus_distance_m = 1.0f + 0.05f * float(k % 20);
+  };
+  live.prepare();
+  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull); }), 0u);
+  if (GetParam() == Executor::cpu) { // the frames were moved, not only kept
+    EXPECT_GT(live.reprojected, 0u);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Executors, FrameAllocations,

@@ -17,6 +17,7 @@
 #include "camhead/renderer/frame_history.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/influence_region.h"
+#include "history_support.h"
 #include "test_scenes.h"
 #include "test_support.h"
 
@@ -25,125 +26,7 @@
 namespace camhead::renderer {
 namespace {
 
-constexpr int kWidth = 64;
-constexpr int kHeight = 48;
-
-// A virtual ball defocused in front of a real crate on a real floor, lit by
-// a point light: blur, a shadow on the proxy, and a depth edge.
-Scene ball_scene() {
-  Scene scene = test::empty_scene("history", 2.0f, 2.0f, kWidth, kHeight);
-  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
-  scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
-  scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
-  scene.objects.push_back(test::box("crate", {0.3f, -0.3f, -3.0f}, glm::vec3(0.4f), 0, true));
-  scene.objects.push_back(test::sphere("ball", {-0.2f, -0.25f, -1.2f}, 0.2f, 1, false));
-  Light light;
-  light.type = LightType::point;
-  light.position = {-1.0f, 2.0f, -1.0f};
-  light.power_W = 200.0f;
-  scene.lights.push_back(light);
-  return scene;
-}
-
-// The same focused at 0.3 m at f/1: everything else blurred by 5 to 7
-// pixels (radius), as the rig's near focus blurs its scene at 720x576.
-Scene defocused_ball_scene() {
-  Scene scene = ball_scene();
-  scene.camera.focus_distance_m = 0.3f;
-  scene.camera.f_number = 1.0f;
-  return scene;
-}
-
-base::VideoFormat rgb24() {
-  base::VideoFormat f;
-  f.pixel = base::PixelFormat::rgb24;
-  f.width = kWidth;
-  f.height = kHeight;
-  f.range = base::ColorRange::full;
-  return f;
-}
-
-std::vector<std::uint8_t> camera_frame() {
-  std::vector<std::uint8_t> bytes(base::frame_bytes(rgb24()));
-  std::mt19937 rng(11);
-  for (std::uint8_t &b : bytes)
-    b = std::uint8_t(64 + rng() % 128);
-  return bytes;
-}
-
-enum class Executor { cpu, gpu };
-
-// Renders frames with one renderer and keeps what the last one gave: RGB,
-// the camera's format, and with `and_yuyv` a YUYV output too, which makes
-// the renderer resolve every pixel rather than copy the camera's bytes
-// outside the influence region. The GPU executor's needs Vulkan (its tests
-// skip without; available() says).
-class Frames {
-public:
-  explicit Frames(const Scene &scene, bool and_yuyv = false, Executor executor = Executor::cpu)
-      : renderer_(executor == Executor::cpu ? make_cpu_frame_renderer(scene, 2)
-                  : test::have_vulkan()     ? make_gpu_frame_renderer(scene)
-                                            : nullptr),
-        and_yuyv_(and_yuyv) {}
-  [[nodiscard]] bool available() const { return renderer_ != nullptr; }
-
-  FrameReport render(const FrameRequest &request) {
-    out_.assign(base::frame_bytes(rgb24()), 0);
-    base::VideoFormat yuyv = rgb24();
-    yuyv.pixel = base::PixelFormat::yuyv;
-    yuyv.range = base::ColorRange::limited;
-    yuyv_.assign(base::frame_bytes(yuyv), 0);
-    const VideoBuffer targets[] = {{rgb24(), out_}, {yuyv, yuyv_}};
-    const FrameReport report =
-        renderer_->render(request, {rgb24(), plate_}, std::span(targets, and_yuyv_ ? 2 : 1));
-    EXPECT_EQ(report.status, FrameStatus::ok) << report.detail;
-    return report;
-  }
-  [[nodiscard]] const std::vector<std::uint8_t> &out() const { return out_; }
-
-private:
-  std::unique_ptr<FrameRenderer> renderer_;
-  bool and_yuyv_;
-  std::vector<std::uint8_t> plate_ = camera_frame();
-  std::vector<std::uint8_t> out_, yuyv_;
-};
-
-FrameRequest still(const Scene &scene, std::uint32_t rpp, std::uint32_t seed = 5) {
-  FrameRequest request;
-  request.camera = scene_camera(scene);
-  request.rays_per_pixel = rpp;
-  request.seed = seed;
-  request.accumulation.enabled = true;
-  return request;
-}
-
-// Every pixel alike, frame after frame.
-FrameRequest still_uniform(const Scene &scene, std::uint32_t rpp, std::uint32_t seed = 5) {
-  FrameRequest request = still(scene, rpp, seed);
-  request.accumulation.share_by_noise = false;
-  return request;
-}
-
-std::size_t bytes_differing(const std::vector<std::uint8_t> &a,
-                            const std::vector<std::uint8_t> &b) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    n += a[i] != b[i];
-  return n;
-}
-
-// The relative RMSE of `frames`' last output against `reference`'s, over
-// every byte (outside the influence region both are the camera's: the
-// errors are diluted alike).
-double virtual_error(const Frames &frames, const Frames &reference) {
-  double diff = 0.0, ref = 0.0;
-  for (std::size_t i = 0; i < reference.out().size(); ++i) {
-    const double a = reference.out()[i], b = frames.out()[i];
-    diff += (a - b) * (a - b);
-    ref += a * a;
-  }
-  return std::sqrt(diff / ref);
-}
+using namespace history;
 
 // Both executors (the GPU's where Vulkan is).
 class FrameHistoryOn : public ::testing::TestWithParam<Executor> {};
@@ -211,19 +94,32 @@ INSTANTIATE_TEST_SUITE_P(Executors, FrameHistoryOn, ::testing::Values(Executor::
 struct Change {
   const char *name;
   void (*apply)(FrameCamera &);
+  // A change of the lens alone, after which the frames before can be moved
+  // into the new camera (accumulation.h, reproject; reprojection_test.cpp).
+  bool lens_only;
 };
 
 // Eight frames of a held shot, then one after `change`: it starts afresh,
-// and has a fresh renderer's bytes.
-void expect_the_change_starts_afresh(Executor executor, const Change &change) {
+// and has a fresh renderer's bytes. With `reproject`, a change of the lens
+// alone starts with the samples before it, moved.
+void expect_the_change_starts_afresh(Executor executor, const Change &change, bool reproject) {
   const Scene scene = ball_scene();
   Frames held(scene, false, executor);
-  for (int n = 0; n < 8; ++n)
-    (void)held.render(still(scene, 1, 200 + n));
+  for (int n = 0; n < 8; ++n) {
+    FrameRequest request = still(scene, 1, 200 + n);
+    request.accumulation.reproject = reproject;
+    (void)held.render(request);
+  }
   FrameRequest moved = still(scene, 2, 300);
+  moved.accumulation.reproject = reproject;
   change.apply(moved.camera);
   const FrameReport report = held.render(moved);
   EXPECT_TRUE(report.history_restarted) << change.name;
+  if (reproject && change.lens_only && executor == Executor::cpu) {
+    EXPECT_GT(report.reprojected_samples, 0u) << change.name;
+    return;
+  }
+  EXPECT_EQ(report.reprojected_samples, 0u) << change.name;
   EXPECT_EQ(report.history_samples, 2u) << change.name;
 
   Frames fresh(scene, false, executor);
@@ -234,20 +130,25 @@ void expect_the_change_starts_afresh(Executor executor, const Change &change) {
 class FrameHistoryChange : public ::testing::TestWithParam<Change> {};
 
 TEST_P(FrameHistoryChange, TheFirstFrameAfterItCarriesNothingOfTheFramesBefore) {
-  expect_the_change_starts_afresh(Executor::cpu, GetParam());
+  expect_the_change_starts_afresh(Executor::cpu, GetParam(), false);
+}
+
+TEST_P(FrameHistoryChange, WithReprojectionAMoveOfTheCameraStillCarriesNothing) {
+  expect_the_change_starts_afresh(Executor::cpu, GetParam(), true);
 }
 
 const Change kChanges[] = {
-    {"focus", [](FrameCamera &c) { c.focus_distance_m = 1.2f; }},
-    {"aperture", [](FrameCamera &c) { c.f_number = 2.8f; }},
-    {"breathing", [](FrameCamera &c) { c.projection_focal_length_mm = 50.5f; }},
-    {"pupil", [](FrameCamera &c) { c.entrance_pupil_offset_m = 0.01f; }},
+    {"focus", [](FrameCamera &c) { c.focus_distance_m = 1.2f; }, true},
+    {"aperture", [](FrameCamera &c) { c.f_number = 2.8f; }, true},
+    {"breathing", [](FrameCamera &c) { c.projection_focal_length_mm = 50.5f; }, true},
+    {"pupil", [](FrameCamera &c) { c.entrance_pupil_offset_m = 0.01f; }, false},
     {"position",
      [](FrameCamera &c) {
        c.position.x += 0.01f;
        c.look_at.x += 0.01f;
-     }},
-    {"direction", [](FrameCamera &c) { c.look_at.x += 0.01f; }},
+     },
+     false},
+    {"direction", [](FrameCamera &c) { c.look_at.x += 0.01f; }, false},
 };
 
 INSTANTIATE_TEST_SUITE_P(Changes, FrameHistoryChange, ::testing::ValuesIn(kChanges),
@@ -314,7 +215,7 @@ TEST(GpuFrameHistory, TheFirstFrameAfterAChangeCarriesNothingOfTheFramesBefore) 
   if (!Frames(ball_scene(), false, Executor::gpu).available())
     GTEST_SKIP() << "no Vulkan device";
   for (const Change &change : kChanges)
-    expect_the_change_starts_afresh(Executor::gpu, change);
+    expect_the_change_starts_afresh(Executor::gpu, change, true); // it does not reproject
 }
 
 // The GPU's history converges to the picture: 8 frames of 2 rpp come as
@@ -392,15 +293,6 @@ TEST(FrameHistory, PixelsOutsideTheRegionPassThrough) {
         differ += !inside[p] && frames.out()[p * 3 + c] != plate[p * 3 + c];
     EXPECT_EQ(differ, 0u) << "frame " << n;
   }
-}
-
-// A converged render of `scene` (1024 samples), to measure against.
-Frames converged(const Scene &scene, std::uint32_t seed) {
-  Frames reference(scene);
-  FrameRequest request = still_uniform(scene, 1024, seed);
-  request.accumulation.max_samples = 1024;
-  (void)reference.render(request);
-  return reference;
 }
 
 TEST(FrameHistory, OneReconstructedRayPerPixelOfADefocusedShotIsNearlyNineFreshOnes) {

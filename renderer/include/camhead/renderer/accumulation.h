@@ -33,6 +33,15 @@ struct AccumulationSettings {
   // outside the region stays exact.
   bool reconstruct = true;
   double reconstruct_strength = 1.0;
+  // A frame that starts a new history (the lens moved: a focus pull) starts
+  // with the samples of the last frames that traced every pixel alike, each
+  // moved to the pixel whose ray it is through the new focus, image scale
+  // and aperture (renderer/src/sample_store.h: exact while the pose holds;
+  // frames with a smaller aperture, another pose, or rays the old frame did
+  // not trace are left out). Off, the first frame after a change carries
+  // nothing of the frames before it. The CPU reference's only, so far.
+  bool reproject = true;
+  std::uint32_t reproject_frames = 8; // at most this many frames' samples
 };
 
 } // namespace camhead::renderer

@@ -11,9 +11,12 @@
 // (tests/renderer/frame_history_test.cpp). A frame whose camera differs
 // from the history's by more than the tolerance, measured in pixels of blur
 // circle or position (frame_change_px), starts a new history: the first frame
-// after a focus jump carries nothing of the frames before it. Within the
-// tolerance the history's own camera is traced on, so the image shown lags
-// the lens by at most that much.
+// after a focus jump carries nothing of the frames before it, or, where the
+// pose held and the live settings ask (accumulation.h, reproject; the CPU
+// reference), their samples moved to the pixels that see their rays through
+// the new lens, which carry nothing of the old focus either
+// (renderer/src/sample_store.h). Within the tolerance the history's own
+// camera is traced on, so the image shown lags the lens by at most that much.
 #pragma once
 
 #include "camhead/renderer/accumulation.h"

@@ -77,6 +77,9 @@ struct FrameReport {
   // camera moved, or the one before did not accumulate).
   std::uint32_t history_samples = 0;
   bool history_restarted = false;
+  // Samples a new history took from the frames before, moved through the
+  // new lens (accumulation.h, reproject); counted in history_samples.
+  std::uint64_t reprojected_samples = 0;
   // Where the frame's time went, seconds: converting the plate in, tracing
   // (and the reconstruction; on the GPU the compositing too), compositing
   // and converting the composite out.

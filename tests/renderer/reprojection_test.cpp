@@ -1,0 +1,191 @@
+// A new history's first samples, moved from the frames before through the new
+// lens (accumulation.h, reproject; renderer/src/sample_store.h). The frame
+// after a focus jump must have a fresh render's expected value, nothing of
+// the old focus (no ghost), and less noise than a fresh frame; a pull frame
+// must come closer to the reference than one that starts afresh.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <span>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "camhead/renderer/frame_renderer.h"
+#include "history_support.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::renderer {
+namespace {
+
+using namespace history;
+
+// Relative RMSE of `image` against `reference`, linear RGB, every pixel.
+double error(std::span<const glm::vec4> image, std::span<const glm::vec4> reference) {
+  double diff = 0.0, ref = 0.0;
+  for (std::size_t i = 0; i < reference.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double a = reference[i][c], b = image[i][c];
+      diff += (a - b) * (a - b);
+      ref += a * a;
+    }
+  return std::sqrt(diff / ref);
+}
+
+// The mean of many frames' composites.
+class Mean {
+public:
+  void add(std::span<const glm::vec4> image) {
+    sum_.resize(image.size(), glm::vec4(0.0f));
+    for (std::size_t i = 0; i < image.size(); ++i)
+      sum_[i] += image[i];
+    ++n_;
+  }
+  [[nodiscard]] std::vector<glm::vec4> mean() const {
+    std::vector<glm::vec4> m = sum_;
+    for (glm::vec4 &v : m)
+      v /= float(n_);
+    return m;
+  }
+
+private:
+  std::vector<glm::vec4> sum_;
+  int n_ = 0;
+};
+
+// Before the jump: the ball scene's own focus (2 m, f/2). After: focused
+// at 0.6 m, stopped down to f/2.8, the image scale breathing by 3 %: every
+// pixel's blur changes by pixels, and the aperture and scale change too.
+FrameCamera after_the_jump(const Scene &scene) {
+  FrameCamera camera = scene_camera(scene);
+  camera.focus_distance_m = 0.6f;
+  camera.f_number = 2.8f;
+  camera.projection_focal_length_mm = 1.03f * camera.focal_length_mm;
+  return camera;
+}
+
+FrameRequest frame(const Scene &scene, const FrameCamera &camera, std::uint32_t seed) {
+  FrameRequest request = still_uniform(scene, 1, seed);
+  request.camera = camera;
+  request.accumulation.reconstruct = false; // the samples alone
+  return request;
+}
+
+TEST(Reprojection, TheFrameAfterAFocusJumpHasAFreshFramesExpectedValue) {
+  const Scene scene = ball_scene();
+  const FrameCamera jumped = after_the_jump(scene);
+  Frames reference(scene);
+  {
+    FrameRequest request = still_uniform(scene, 1024, 9);
+    request.camera = jumped;
+    request.accumulation.max_samples = 1024;
+    (void)reference.render(request);
+  }
+  const std::vector<glm::vec4> truth(reference.composite().begin(), reference.composite().end());
+
+  // Many trials: eight frames held at the first focus, then the jump, with
+  // the frames before moved and without (afresh). If the moved samples are
+  // unbiased, the mean of the frames after the jump converges to the new
+  // focus's picture as noise does, its error halving for four times the
+  // trials; a ghost of the old focus (a history kept across the jump, the
+  // negative control) stays.
+  constexpr int kTrials = 64;
+  Mean jump, jump_quarter, ghost, ghost_quarter;
+  double e_one = 0.0, e_afresh = 0.0; // single frames, mean over the trials
+  std::uint64_t samples = 0;
+  for (int t = 0; t < kTrials; ++t) {
+    Frames moved(scene), afresh(scene), kept(scene);
+    for (int n = 0; n < 8; ++n) {
+      FrameRequest request = frame(scene, scene_camera(scene), 1000u * t + n);
+      (void)moved.render(request);
+      (void)kept.render(request);
+      request.accumulation.reproject = false;
+      (void)afresh.render(request);
+    }
+    FrameRequest after = frame(scene, jumped, 1000u * t + 500);
+    const FrameReport report = moved.render(after);
+    EXPECT_TRUE(report.history_restarted);
+    EXPECT_GT(report.reprojected_samples, 0u);
+    samples += report.history_samples;
+    jump.add(moved.composite());
+    e_one += error(moved.composite(), truth) / kTrials;
+    after.accumulation.tolerance_px = 1e9; // keeps the history of the old focus
+    (void)kept.render(after);
+    ghost.add(kept.composite());
+    after.accumulation.tolerance_px = AccumulationSettings{}.tolerance_px;
+    after.accumulation.reproject = false;
+    (void)afresh.render(after);
+    e_afresh += error(afresh.composite(), truth) / kTrials;
+    if (t < kTrials / 4) {
+      jump_quarter.add(moved.composite());
+      ghost_quarter.add(kept.composite());
+    }
+  }
+  const double e_jump = error(jump.mean(), truth);
+  const double e_jump_quarter = error(jump_quarter.mean(), truth);
+  const double e_ghost = error(ghost.mean(), truth);
+  const double e_ghost_quarter = error(ghost_quarter.mean(), truth);
+  std::printf("[ reproject ] focus jump: a frame's error %.4f (%.1f samples a pixel held), "
+              "%.4f afresh; the mean of %d / %d frames %.4f / %.4f (%.2fx), of the old focus "
+              "kept %.4f / %.4f (%.2fx)\n",
+              e_one, double(samples) / kTrials, e_afresh, kTrials / 4, kTrials, e_jump_quarter,
+              e_jump, e_jump_quarter / e_jump, e_ghost_quarter, e_ghost, e_ghost_quarter / e_ghost);
+  EXPECT_GE(samples / kTrials, 2u) << "the jump's frames hold more than their own ray";
+  EXPECT_LT(e_one, 0.8 * e_afresh);
+  // Unbiased: the mean converges as noise does (2x; a bias would hold it).
+  EXPECT_GT(e_jump_quarter / e_jump, 1.6);
+  // The measure can tell a ghost.
+  EXPECT_LT(e_ghost_quarter / e_ghost, 1.2);
+  EXPECT_GT(e_ghost, 4.0 * e_jump);
+}
+
+TEST(Reprojection, APullFrameComesCloserToItsPictureThanOneStartedAfresh) {
+  // Twelve frames of a pull from the scene's focus (2 m) to 0.6 m, even in
+  // diopters, one ray per pixel each, as camhead run renders them; the last
+  // against a converged render of its own lens.
+  const Scene scene = ball_scene();
+  const FrameCamera end = after_the_jump(scene);
+  const FrameCamera start = scene_camera(scene);
+  const auto at = [&](int k) {
+    FrameCamera camera = end;
+    const float w0 = 1.0f / start.focus_distance_m, w1 = 1.0f / end.focus_distance_m;
+    camera.focus_distance_m = 1.0f / (w0 + (w1 - w0) * float(k) / 11.0f);
+    camera.f_number = end.f_number;
+    return camera;
+  };
+  Frames reference(scene);
+  FrameRequest request = still_uniform(scene, 1024, 9);
+  request.camera = at(11);
+  request.accumulation.max_samples = 1024;
+  (void)reference.render(request);
+  const std::vector<glm::vec4> truth(reference.composite().begin(), reference.composite().end());
+
+  // [reconstructed][reprojected], the mean over a few trials.
+  double e[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
+  constexpr int kTrials = 4;
+  for (int t = 0; t < kTrials; ++t)
+    for (const bool reconstruct : {false, true})
+      for (const bool reproject : {false, true}) {
+        Frames frames(scene);
+        for (int k = 0; k < 12; ++k) {
+          FrameRequest pull = still(scene, 1, 100u * t + k);
+          pull.camera = at(k);
+          pull.accumulation.reconstruct = reconstruct;
+          pull.accumulation.reproject = reproject;
+          (void)frames.render(pull);
+        }
+        e[reconstruct][reproject] += error(frames.composite(), truth) / kTrials;
+      }
+  std::printf("[ reproject ] pull frame: error %.4f afresh, %.4f with the frames before moved; "
+              "reconstructed %.4f, %.4f\n",
+              e[0][0], e[0][1], e[1][0], e[1][1]);
+  // The samples alone: six frames' more (the store holds six of this
+  // region), independent rather than one pattern's, so less than 7 rpp's gain.
+  EXPECT_LT(e[0][1], 0.6 * e[0][0]);
+  // With the reconstruction, which does most of the work at this blur.
+  EXPECT_LT(e[1][1], e[1][0]);
+}
+
+} // namespace
+} // namespace camhead::renderer
