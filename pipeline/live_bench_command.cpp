@@ -493,7 +493,7 @@ void add_bench_live_command(CLI::App &bench) {
   cmd->add_option("--threads", args->threads, "CPU threads (0 = all cores)")->capture_default_str();
   cmd->add_option("--reconstruct", args->reconstruct,
                   "Strength of the reconstruction from neighbours' samples (renderer\n"
-                  "defocus_filter.h: sigma = strength sqrt(blur radius / samples)); 0 = off")
+                  "defocus_filter.h: sigma = strength sqrt(blur radius) / samples^(1/3)); 0 = off")
       ->check(CLI::Range(0.0, 4.0))
       ->capture_default_str();
   cmd->callback([args] { set_exit_code(run_live(*args)); });

@@ -33,8 +33,8 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   // hit at depth 0, an infinite blur, is bounded); NaN, which no comparison
   // passes, leaves the pixel its own samples.
   const auto sigma_of = [&](std::size_t i) {
-    return std::min(float(settings.strength) *
-                        std::sqrt(std::abs(buffers.blur[i]) / float(std::max(counts[i], 1u))),
+    return std::min(float(settings.strength) * std::sqrt(std::abs(buffers.blur[i])) /
+                        std::cbrt(float(std::max(counts[i], 1u))),
                     0.5f * float(settings.max_radius_px));
   };
   // Neighbours whose blur circles are alike: differing by no more than the

@@ -7,13 +7,15 @@
 // blur circles are alike (defocus_filter.cpp), in two passes, rows then
 // columns.
 //
-// The Gaussian's sigma is strength sqrt(|c| / n) pixels (n the pixel's
-// samples). Widening a blur disk of radius c by a Gaussian of sigma widens
-// it by about 2 sigma^2 / c pixels, so this sigma adds the same 2
-// strength^2 / n pixels of blur whatever c is: a sigma proportional to c
-// (tried first) over-blurred the most defocused parts or left the others
-// noisy (bench/RESULTS.md). It fades as the history grows, and below
-// min_sigma_px a pixel keeps its own samples.
+// The Gaussian's sigma is strength sqrt(|c|) / n^(1/3) pixels (n the
+// pixel's samples). Widening a blur disk of radius c by a Gaussian of sigma
+// widens it by about 2 sigma^2 / c pixels, so this sigma adds the same 2
+// strength^2 / n^(2/3) pixels of blur whatever c is: a sigma proportional to
+// c (tried first) over-blurred the most defocused parts or left the others
+// noisy. It fades as the history grows: as n^(-1/2) it faded too fast for
+// samples moved from the frames before (sample_store.h), which are not one
+// pattern's; n^(-1/4) too slowly for a held shot's (bench/RESULTS.md).
+// Below min_sigma_px a pixel keeps its own samples.
 //
 // Only traced pixels take part and only the layers are filtered, never the
 // camera image: a pixel whose neighbourhood saw nothing virtual (I_m == I_r,

@@ -23,14 +23,14 @@ struct AccumulationSettings {
   // pixel holds its own count of samples of its own pattern.
   bool share_by_noise = true;
   // Let each pixel borrow its neighbours' samples within a Gaussian of
-  // sigma = strength sqrt(blur radius / samples) pixels, among neighbours of
-  // alike blur (renderer/src/defocus_filter.h): at the simulated rig's near
-  // focus a 1-rpp frame has less error than 9 rpp (bench/RESULTS.md), at the
-  // price of about 2 strength^2 / samples pixels of extra blur. Only the
-  // traced pixels take part,
-  // so with it (or share_by_noise) on the influence region and the whole
-  // frame give different (equally valid) estimates; the camera image
-  // outside the region stays exact.
+  // sigma = strength sqrt(blur radius) / samples^(1/3) pixels, among
+  // neighbours of alike blur (renderer/src/defocus_filter.h): at the
+  // simulated rig's near focus a 1-rpp frame has less error than 9 rpp
+  // (bench/RESULTS.md), at the price of about 2 strength^2 / samples^(2/3)
+  // pixels of extra blur. Only the traced pixels take part, so with it (or
+  // share_by_noise) on the influence region and the whole frame give
+  // different (equally valid) estimates; the camera image outside the region
+  // stays exact.
   bool reconstruct = true;
   double reconstruct_strength = 1.0;
   // A frame that starts a new history (the lens moved: a focus pull) starts
