@@ -56,7 +56,8 @@ public:
         pixels_(std::size_t(scene_.render.width) * std::size_t(scene_.render.height)),
         plate_(pixels_), composite_(pixels_), mixed_(pixels_, glm::vec4(0.0f)),
         real_(pixels_, glm::vec4(0.0f)), aux_(pixels_, glm::vec4(0.0f)),
-        history_counts_(pixels_, 0u), own_counts_(pixels_, 0u), shares_(pixels_, 0u),
+        history_counts_(pixels_, 0u), own_counts_(pixels_, 0u),
+        row_pixels_(std::size_t(std::max(scene_.render.height, 0))), shares_(pixels_, 0u),
         sigma_(pixels_, 0.0f), noise_(pixels_, 0.0f), filtered_mixed_(pixels_),
         filtered_real_(pixels_), scratch_mixed_(pixels_), scratch_real_(pixels_),
         scratch_weight_(pixels_), blur_(pixels_) {
@@ -433,13 +434,19 @@ private:
     const int bands = std::min(pool_.threads(), kMostBands);
     std::array<std::uint32_t, kMostBands + 1> rows{};
     std::array<std::uint64_t, kMostBands> given{};
+    // The region's pixels row by row (its spans come rectangle by
+    // rectangle), then cut where each band's share is reached: the bands
+    // are disjoint and in order.
+    std::fill(row_pixels_.begin(), row_pixels_.end(), 0u);
+    for (const RowSpan &span : spans_)
+      row_pixels_[span.y] += span.x1 - span.x0;
     const std::uint64_t pixels = region_->pixels();
     std::uint64_t seen = 0;
     int band = 0;
-    for (const RowSpan &span : spans_) {
+    for (std::uint32_t y = 0; y < row_pixels_.size(); ++y) {
       while (band < bands - 1 && seen >= pixels * std::uint64_t(band + 1) / std::uint64_t(bands))
-        rows[std::size_t(++band)] = span.y;
-      seen += span.x1 - span.x0;
+        rows[std::size_t(++band)] = y;
+      seen += row_pixels_[y];
     }
     while (band < bands)
       rows[std::size_t(++band)] = std::uint32_t(scene_.render.height);
@@ -499,10 +506,11 @@ private:
   // whether all of its frames shared their rays alike.
   std::uint32_t pattern_base_ = 0;
   bool history_all_uniform_ = true;
-  std::uint32_t uniform_share_ = 0;      // this frame's rays per pixel, if alike
-  std::vector<std::size_t> span_firsts_; // ... and where each span's go in store_
-  std::vector<std::uint32_t> shares_;    // this frame's rays per pixel
-  std::vector<float> sigma_, noise_;     // each pixel's noise, for the shares
+  std::vector<std::uint32_t> row_pixels_; // the region's pixels in each row
+  std::uint32_t uniform_share_ = 0;       // this frame's rays per pixel, if alike
+  std::vector<std::size_t> span_firsts_;  // ... and where each span's go in store_
+  std::vector<std::uint32_t> shares_;     // this frame's rays per pixel
+  std::vector<float> sigma_, noise_;      // each pixel's noise, for the shares
   // The reconstruction's means and passes (defocus_filter.h).
   std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_;
   std::vector<float> scratch_weight_, blur_;

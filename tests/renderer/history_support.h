@@ -76,8 +76,9 @@ enum class Executor { cpu, gpu };
 // skip without; available() says).
 class Frames {
 public:
-  explicit Frames(const Scene &scene, bool and_yuyv = false, Executor executor = Executor::cpu)
-      : renderer_(executor == Executor::cpu ? make_cpu_frame_renderer(scene, 2)
+  explicit Frames(const Scene &scene, bool and_yuyv = false, Executor executor = Executor::cpu,
+                  int cpu_threads = 2)
+      : renderer_(executor == Executor::cpu ? make_cpu_frame_renderer(scene, cpu_threads)
                   : test::have_vulkan()     ? make_gpu_frame_renderer(scene)
                                             : nullptr),
         and_yuyv_(and_yuyv) {}
