@@ -316,7 +316,7 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
   const int y0 = std::clamp(cy - crop_h / 2, 0, h - crop_h);
 
   const std::string titles[] = {"1 RPP, FRESH (BEFORE)",
-                                "LIVE: " + std::to_string(args.rpp) + " RPP" +
+                                "LIVE IN A PULL: " + std::to_string(args.rpp) + " RPP" +
                                     (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : ""),
                                 "9 RPP", std::to_string(args.ref_rpp) + " RPP (REFERENCE)"};
   const int gap = 6, left = 120, top = 24;
