@@ -369,7 +369,8 @@ int run_live(const LiveArgs &args) {
     const auto approach = [&](const LensPoint &lens) {
       std::vector<float> focus;
       const float w = 1.0f / lens.focus_m;
-      const float step = w <= kFarW ? pull_speed : -pull_speed;
+      const bool far_end = &lens == &pulling.front();
+      const float step = far_end ? pull_speed : -pull_speed;
       for (int j = kPullFrames; j >= 1; --j)
         focus.push_back(1.0f / std::clamp(w + step * float(j), kFarW, kNearW));
       return focus;
