@@ -55,8 +55,9 @@ private:
 };
 
 // Before the jump: the ball scene's own focus (2 m, f/2). After: focused
-// at 0.6 m, stopped down to f/2.8, the image scale breathing by 3 %: every
-// pixel's blur changes by pixels, and the aperture and scale change too.
+// at 0.6 m, stopped down to f/2.8, the image scale breathing by 3 %: at
+// this size a blur circle grows or shrinks by up to a pixel, and the frame's
+// edges move by one.
 FrameCamera after_the_jump(const Scene &scene) {
   FrameCamera camera = scene_camera(scene);
   camera.focus_distance_m = 0.6f;
