@@ -44,11 +44,7 @@ Scene ball_scene() {
   scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
   scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
   scene.objects.push_back(test::sphere("ball", {-0.2f, -0.25f, -1.5f}, 0.25f, 0, false));
-  Light light;
-  light.type = LightType::point;
-  light.position = {-1.0f, 2.0f, -1.0f};
-  light.power_W = 200.0f;
-  scene.lights.push_back(light);
+  scene.lights.push_back(test::point_light({-1.0f, 2.0f, -1.0f}, 200.0f));
   return scene;
 }
 

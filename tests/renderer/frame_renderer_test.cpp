@@ -55,11 +55,7 @@ Scene real_only(int w, int h) {
   scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
   scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
   scene.objects.push_back(test::box("crate", {0.3f, -0.3f, -2.0f}, glm::vec3(0.3f), 0, true));
-  Light light;
-  light.type = LightType::point;
-  light.position = {-1.0f, 2.0f, -1.0f};
-  light.power_W = 200.0f;
-  scene.lights.push_back(light);
+  scene.lights.push_back(test::point_light({-1.0f, 2.0f, -1.0f}, 200.0f));
   return scene;
 }
 

@@ -33,11 +33,7 @@ inline Scene ball_scene() {
   scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
   scene.objects.push_back(test::box("crate", {0.3f, -0.3f, -3.0f}, glm::vec3(0.4f), 0, true));
   scene.objects.push_back(test::sphere("ball", {-0.2f, -0.25f, -1.2f}, 0.2f, 1, false));
-  Light light;
-  light.type = LightType::point;
-  light.position = {-1.0f, 2.0f, -1.0f};
-  light.power_W = 200.0f;
-  scene.lights.push_back(light);
+  scene.lights.push_back(test::point_light({-1.0f, 2.0f, -1.0f}, 200.0f));
   return scene;
 }
 

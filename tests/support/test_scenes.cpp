@@ -63,6 +63,14 @@ renderer::Object plane(const char *name, glm::vec3 center, float size_m, int mat
   return o;
 }
 
+renderer::Light point_light(glm::vec3 position, float power_W) {
+  renderer::Light light;
+  light.type = renderer::LightType::point;
+  light.position = position;
+  light.power_W = power_W;
+  return light;
+}
+
 renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int width, int height) {
   using namespace renderer;
   Scene scene = empty_scene("edge_scene", f_number, focus_m, width, height);

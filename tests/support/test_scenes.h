@@ -26,6 +26,8 @@ namespace camhead::test {
 // A plane through `center`, normal +Y, of `size_m` x `size_m`.
 [[nodiscard]] renderer::Object plane(const char *name, glm::vec3 center, float size_m, int material,
                                      bool real);
+// A white point light of `power_W` at `position`.
+[[nodiscard]] renderer::Light point_light(glm::vec3 position, float power_W);
 
 // empty_scene() with a radiance-1 emitter that fills the half-plane x > 0 at depth `depth_m`,
 // against a black world: a vertical edge on the image's centre column.
