@@ -151,14 +151,14 @@ std::uint64_t SampleStore::reproject_rows(std::uint32_t y0, std::uint32_t y1, Ad
     const Source &source = sources_[k];
     const Frame &frame = *source.frame;
     // Only the rows whose samples can land in [y0, y1) are read.
-    const std::uint32_t from = y0 > source.reach ? y0 - source.reach : 0;
-    const std::uint32_t to = y1 + source.reach;
+    const std::uint32_t first_row = y0 > source.reach ? y0 - source.reach : 0;
+    const std::uint32_t end_row = y1 + source.reach;
     std::size_t rect_first = frame.first;
     for (const PixelRect &rect : frame.rects) {
       const std::size_t row_samples = std::size_t(rect.x1 - rect.x0) * frame.per_pixel;
       const std::size_t first_of_rect = rect_first;
       rect_first += row_samples * (rect.y1 - rect.y0);
-      const std::uint32_t row0 = std::max(rect.y0, from), row1 = std::min(rect.y1, to);
+      const std::uint32_t row0 = std::max(rect.y0, first_row), row1 = std::min(rect.y1, end_row);
       if (row0 >= row1)
         continue;
       const std::size_t end = first_of_rect + row_samples * (row1 - rect.y0);

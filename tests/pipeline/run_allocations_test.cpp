@@ -50,6 +50,7 @@ class RunAllocations : public RunLoop {
 protected:
   struct Counts {
     std::uint64_t render = 0, output = 0, frames_out = 0;
+    std::uint64_t reprojected = 0; // samples moved, in all the records
   };
 
   // A run of a take played in real time, looped, through a floor with a
@@ -81,8 +82,11 @@ protected:
     test::counting_new::start(thread_bucket);
     const RunSummary summary = run_pipeline(options);
     test::counting_new::stop();
+    std::uint64_t reprojected = 0;
+    for (const CompositeRecord &record : recorded_composites(dir_ / "stats.jsonl"))
+      reprojected += record.reprojected_samples;
     return {test::counting_new::count(kRender), test::counting_new::count(kOutput),
-            summary.frames_out};
+            summary.frames_out, reprojected};
   }
 };
 
@@ -91,6 +95,9 @@ TEST_F(RunAllocations, TheRenderAndOutputThreadsAllocateNothingOnTheCpuReference
   EXPECT_EQ(counts.frames_out, 40u);
   EXPECT_EQ(counts.render, 0u);
   EXPECT_EQ(counts.output, 0u);
+  // The pull's frames started with the frames before them moved
+  // (render.reproject), and the record says so.
+  EXPECT_GT(counts.reprojected, 0u);
 }
 
 // The driver's own threads are not camhead's, and not counted (lavapipe's

@@ -106,6 +106,7 @@ struct CompositeRecord {
   double delivered_ns = 0.0;
   double focus_m = 0.0;
   bool lens_fresh = false;
+  std::uint64_t reprojected_samples = 0;
 };
 
 inline double json_number(const std::string &line, const std::string &field) {
@@ -138,7 +139,8 @@ inline std::vector<CompositeRecord> recorded_composites(const fs::path &stats) {
                        std::uint64_t(json_number(line, "sequence")),
                        json_number(line, "exposure_mid_ns"), json_number(line, "delivered_ns"),
                        json_number(line, "focus_m"),
-                       line.find("\"lens_fresh\":true") != std::string::npos});
+                       line.find("\"lens_fresh\":true") != std::string::npos,
+                       std::uint64_t(json_number(line, "reprojected_samples"))});
   }
   return records;
 }
