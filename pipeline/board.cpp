@@ -84,7 +84,7 @@ public:
     if (root.has("scene"))
       board.scene = root.at("scene").path();
     if (root.has("pose"))
-      board.pose = read_pose(root.at("pose"));
+      board.pose = read_pose(root.at("pose"), board.lens);
     if (root.has("outputs"))
       for (const JsonValue &output :
            root.at("outputs").elements("output URIs (v4l2:/dev/videoN, file:PATH.y4m, ...)"))
@@ -211,8 +211,13 @@ private:
     return camera;
   }
 
-  static PoseConfig read_pose(const JsonValue &d) {
-    d.object({"position", "look_at"}, {"up"});
+  static PoseConfig read_pose(const JsonValue &d, const LensConfig &lens) {
+    const std::string type = d.has("type") ? d.at("type").string() : "static";
+    if (type == "freed" || type == "opentrackio")
+      return read_tracked_pose(d, lens, type);
+    if (type != "static")
+      d.at("type").fail("unknown pose type \"" + type + "\" (static, freed or opentrackio)");
+    d.object({"position", "look_at"}, {"type", "up"});
     PoseConfig pose;
     pose.position = vec3(d.at("position"));
     pose.look_at = vec3(d.at("look_at"));
@@ -237,6 +242,46 @@ private:
                           "position to look_at (straight down or up): give the direction the "
                           "top of the picture points to, e.g. [0, 0, -1]");
     }
+    return pose;
+  }
+
+  // A tracker's pose: it comes in the datagrams of a lens source of the same
+  // type, named by `source` or the board's only one of that type.
+  static PoseConfig read_tracked_pose(const JsonValue &d, const LensConfig &lens,
+                                      const std::string &type) {
+    for (const char *key : {"position", "look_at", "up"})
+      if (d.has(key))
+        d.fail_member(key, "only a static pose has one: a " + type +
+                               " pose is where its tracker says the camera is");
+    d.object({"type"}, {"source", "delay_ms"});
+    PoseConfig pose;
+    pose.type = type == "freed" ? PoseType::freed : PoseType::opentrackio;
+    const auto of_type = [&](const LensSourceConfig &s) { return source_type(s) == type; };
+    if (d.has("source")) {
+      pose.source = d.at("source").string();
+      const auto named =
+          std::find_if(lens.sources.begin(), lens.sources.end(),
+                       [&](const LensSourceConfig &s) { return s.name == pose.source; });
+      if (named == lens.sources.end())
+        d.at("source").fail("no lens source is named \"" + pose.source +
+                            "\": name one of lens.sources, of type " + type);
+      if (!of_type(*named))
+        d.at("source").fail("lens source \"" + pose.source + "\" is of type " +
+                            std::string(source_type(*named)) + ", not " + type + ": only a " +
+                            type + " source carries a " + type + " pose");
+    } else {
+      const auto count = std::count_if(lens.sources.begin(), lens.sources.end(), of_type);
+      if (count == 0)
+        d.fail_member("source", "missing, and lens.sources has no " + type +
+                                    " source: add one (its socket carries the pose) and, "
+                                    "if it is not the lens of the frames, list it after that one");
+      if (count > 1)
+        d.fail_member("source", "missing, and lens.sources has " + std::to_string(count) + " " +
+                                    type + " sources: name the one that carries the pose");
+      pose.source = std::find_if(lens.sources.begin(), lens.sources.end(), of_type)->name;
+    }
+    if (d.has("delay_ms"))
+      pose.delay_ms = d.at("delay_ms").number(Range::within(-1000.0, 1000.0));
     return pose;
   }
 
@@ -411,6 +456,18 @@ private:
 };
 
 } // namespace
+
+std::string_view pose_type_name(PoseType type) {
+  switch (type) {
+  case PoseType::fixed:
+    return "static";
+  case PoseType::freed:
+    return "freed";
+  case PoseType::opentrackio:
+    return "opentrackio";
+  }
+  return "static";
+}
 
 PoseVectors pose_vectors(const PoseConfig &pose) {
   const auto f = [](const std::array<double, 3> &a) {

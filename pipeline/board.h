@@ -160,13 +160,27 @@ struct CameraConfig {
   double sensor_width_mm = 36.0; // the width the lens projects onto
 };
 
-// Where the camera is; the scene file's camera when the board gives none
-// (tracking is to come).
+// Where the camera is. `fixed` ("static" in the file): the position, look-at
+// point and up direction given, or the scene file's camera when the board
+// has no pose. `freed` and `opentrackio`: the pose a tracker sends in the
+// datagrams of one of the board's lens sources of that type (one socket
+// carries both), moved back by `delay_ms`; the scene's camera until the
+// first pose arrives (pipeline/tracking/tracker_axes.h: the axes).
+enum class PoseType { fixed, freed, opentrackio };
+
 struct PoseConfig {
+  PoseType type = PoseType::fixed;
   std::array<double, 3> position{0.0, 0.0, 0.0};
   std::array<double, 3> look_at{0.0, 0.0, -1.0};
   std::array<double, 3> up{0.0, 1.0, 0.0};
+  // A tracker's: the name of the lens source whose datagrams carry the pose,
+  // and how much later than the physical instant its poses are stamped.
+  std::string source;
+  double delay_ms = 0.0;
 };
+
+// "static", "freed", "opentrackio", as board files spell the type.
+[[nodiscard]] std::string_view pose_type_name(PoseType type);
 
 // The pose as the renderer takes it: float32, `up` made of unit length
 // first (in double, so that a tiny one keeps its direction). The board

@@ -28,6 +28,7 @@
 #include "commands.h"
 #include "lens_sources.h"
 #include "run/run_paths.h"
+#include "tracking/tracker_axes.h"
 
 namespace camhead::cli {
 namespace {
@@ -99,6 +100,12 @@ void print_channel(std::FILE *out, const LensChannel &channel, std::int64_t now_
                  raw->focus_distance_m ? std::to_string(*raw->focus_distance_m).c_str() : "-",
                  raw->f_stop ? std::to_string(*raw->f_stop).c_str() : "-",
                  raw->focal_length_mm ? std::to_string(*raw->focal_length_mm).c_str() : "-");
+  if (raw->pose)
+    std::fprintf(out,
+                 "  pose    X %.3f  Y %.3f  Z %.3f m  pan %.2f  tilt %.2f  roll %.2f deg "
+                 "(the tracker's axes)\n",
+                 raw->pose->x_m, raw->pose->y_m, raw->pose->z_m, raw->pose->pan_deg,
+                 raw->pose->tilt_deg, raw->pose->roll_deg);
   if (!raw->focus && !raw->iris && !raw->zoom) {
     std::fprintf(out, "  lens    (no encoder counts to map through the profile)\n\n");
     return;
@@ -122,13 +129,35 @@ struct LensArgs {
 
 // The lens state as OpenTrackIO carries it. Infinity has no OpenTrackIO
 // spelling (focusDistance is a finite distance), so it is left out.
-hal::lens::OpenTrackIoLensState opentrackio_state(const lens_control::LensState &s) {
-  hal::lens::OpenTrackIoLensState out;
+hal::lens::OpenTrackIoState opentrackio_state(const lens_control::LensState &s) {
+  hal::lens::OpenTrackIoState out;
   if (std::isfinite(s.focus_distance_m.value))
     out.focus_distance_m = s.focus_distance_m.value;
   out.f_stop = s.f_number.value;
   out.focal_length_mm = s.projection_focal_length_mm.value;
   return out;
+}
+
+// The board's camera pose in OpenTrackIO's axes: a static pose as given, a
+// tracker's as it is now (none before its first pose); none for a board
+// without a pose (the scene's camera is not loaded here).
+std::optional<hal::lens::TrackedPose> sent_pose(const pipeline::Board &board,
+                                                const std::vector<LensChannel> &channels,
+                                                std::int64_t now_ns) {
+  if (!board.pose)
+    return std::nullopt;
+  if (board.pose->type == pipeline::PoseType::fixed) {
+    const pipeline::PoseVectors v = pipeline::pose_vectors(*board.pose);
+    renderer::FrameCamera camera;
+    camera.position = v.position;
+    camera.look_at = v.look_at;
+    camera.up = v.up;
+    return pipeline::to_opentrackio(pipeline::pose_of(camera));
+  }
+  for (const LensChannel &channel : channels)
+    if (const std::optional<pipeline::PoseAt> at = channel.pose_at(now_ns))
+      return pipeline::to_opentrackio(at->pose);
+  return std::nullopt;
 }
 
 std::unique_ptr<hal::lens::OpenTrackIoSender> open_sender(const std::string &destination) {
@@ -171,6 +200,10 @@ void monitor(const LensArgs &args) {
     const lens_control::LensProfile loaded = pipeline::load_board_profile(*board);
     profile = loaded.name();
     channels = pipeline::open_lens_channels(*board, loaded);
+    if (board->pose && board->pose->type != pipeline::PoseType::fixed)
+      for (LensChannel &channel : channels)
+        if (channel.config().name == board->pose->source)
+          channel.track_pose(board->pose->type, board->pose->delay_ms);
     if (!args.send_opentrackio.empty())
       sender = open_sender(args.send_opentrackio);
   } catch (const std::exception &e) {
@@ -189,8 +222,10 @@ void monitor(const LensArgs &args) {
       channel.pump(channels.size() > 1 ? 2ms : 10ms);
     if (sender && std::chrono::steady_clock::now() >= next_send) {
       next_send += 10ms; // 100 Hz, a common lens-data rate
-      static_cast<void>(
-          sender->send(opentrackio_state(channels.front().state_at(hal::lens::monotonic_ns()))));
+      const std::int64_t now = hal::lens::monotonic_ns();
+      hal::lens::OpenTrackIoState state = opentrackio_state(channels.front().state_at(now));
+      state.camera = sent_pose(*board, channels, now);
+      static_cast<void>(sender->send(state));
     }
     if (std::chrono::steady_clock::now() < next_draw)
       return;
@@ -300,7 +335,9 @@ void add_lens_command(CLI::App &app) {
       ->check(CLI::Range(10, 60000));
   mon->add_option("--send-opentrackio", args->send_opentrackio,
                   "Send the first source's lens state on as OpenTrackIO (100 Hz) to\n"
-                  "HOST[:PORT] (IPv4, unicast or multicast; port 55555 by default)");
+                  "HOST[:PORT] (IPv4, unicast or multicast; port 55555 by default),\n"
+                  "with the board's camera pose (static, or its tracker's) as the\n"
+                  "transform \"Camera\"");
   mon->callback([args] { monitor(*args); });
 
   CLI::App *rec = lens->add_subcommand(

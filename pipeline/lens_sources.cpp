@@ -14,6 +14,7 @@
 #include "camhead/hal/lens/usb/simulated_usb_lens.h"
 #include "camhead/hal/lens/usb/usb_lens.h"
 #include "trace_curve.h"
+#include "tracking/tracker_axes.h"
 
 namespace camhead::pipeline {
 
@@ -226,9 +227,18 @@ std::size_t LensChannel::poll(std::chrono::milliseconds timeout) {
   return batch_.size();
 }
 
+void LensChannel::track_pose(PoseType type, double delay_ms) {
+  pose_type_ = type;
+  poses_.emplace(PoseTimelineParams{.delay_ns = std::llround(delay_ms * 1e6)});
+}
+
 void LensChannel::feed() {
-  for (const hal::lens::EncoderReading &r : batch_)
+  for (const hal::lens::EncoderReading &r : batch_) {
     tracker_.push(to_encoder_sample(r));
+    if (poses_ && r.pose)
+      (void)poses_->push(r.t_ns, pose_type_ == PoseType::freed ? from_freed(*r.pose)
+                                                               : from_opentrackio(*r.pose));
+  }
   if (!batch_.empty())
     last_ = batch_.back();
   batch_.clear();

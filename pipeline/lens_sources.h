@@ -16,6 +16,7 @@
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/lens_control/lens_state.h"
 #include "camhead/lens_control/lens_tracker.h"
+#include "tracking/pose_timeline.h"
 
 namespace camhead::pipeline {
 
@@ -61,10 +62,22 @@ public:
     return tracker_.state_at(t_ns);
   }
 
+  // Keeps the camera poses the source sends from now on (a FreeD or
+  // OpenTrackIO tracker's, in that protocol's axes: `type`), moved back by
+  // `delay_ms`, in camhead's world.
+  void track_pose(PoseType type, double delay_ms);
+  // The pose at physical instant t_ns; empty before the first one, or when
+  // the channel does not track poses.
+  [[nodiscard]] std::optional<PoseAt> pose_at(std::int64_t t_ns) const {
+    return poses_ ? poses_->at(t_ns) : std::nullopt;
+  }
+
 private:
   LensSourceConfig config_;
   std::unique_ptr<hal::lens::LensEncoder> encoder_;
   lens_control::LensTracker tracker_;
+  PoseType pose_type_ = PoseType::fixed;
+  std::optional<PoseTimeline> poses_;
   std::optional<hal::lens::EncoderReading> last_;
   std::vector<hal::lens::EncoderReading> batch_;
 };

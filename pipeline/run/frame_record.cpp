@@ -11,8 +11,25 @@ void write_filler_record(std::FILE *out, std::uint64_t output_frame, const char 
                output_frame, kind, output_ns);
 }
 
+std::string json_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\u%04x", unsigned(c));
+      out += code;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
 void write_composite_record(std::FILE *out, std::uint64_t output_frame, const FrameRecord &r,
-                            std::int64_t output_ns, const std::string &executor) {
+                            std::int64_t output_ns, const RunRecordFields &run) {
   std::fprintf(
       out,
       "{\"output_frame\":%" PRIu64 ",\"kind\":\"composite\",\"sequence\":%" PRIu64
@@ -22,13 +39,17 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
       ",\"camera_rays\":%" PRIu64 ",\"history_samples\":%u,\"reprojected_samples\":%" PRIu64
       ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
-      ",\"encode_ms\":%.3f,\"executor\":\"%s\"}\n",
+      ",\"encode_ms\":%.3f,\"executor\":%s,\"pose_source\":%s,\"pose_fresh\":%s"
+      ",\"pose\":{\"position\":[%.7g,%.7g,%.7g],\"forward\":[%.6g,%.6g,%.6g]"
+      ",\"up\":[%.6g,%.6g,%.6g]}}\n",
       output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns, r.render_start_ns,
       r.render_end_ns, output_ns,
       std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
       r.focal_length_mm, r.lens_fresh ? "true" : "false", 1e3 * r.lens_wait_s, r.rpp, r.camera_rays,
       r.history_samples, r.reprojected_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
-      1e3 * r.trace_s, 1e3 * r.encode_s, executor.c_str());
+      1e3 * r.trace_s, 1e3 * r.encode_s, run.executor.c_str(), run.pose_source.c_str(),
+      r.pose_fresh ? "true" : "false", r.position.x, r.position.y, r.position.z, r.forward.x,
+      r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z);
 }
 
 } // namespace camhead::pipeline

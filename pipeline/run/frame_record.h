@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <string_view>
+
+#include <glm/vec3.hpp>
 
 namespace camhead::pipeline {
 
@@ -19,6 +22,10 @@ struct FrameRecord {
   double focus_m = 0.0, f_number = 0.0, focal_length_mm = 0.0;
   bool lens_fresh = false;  // the lens state covers the mid-exposure (else held or extrapolated)
   double lens_wait_s = 0.0; // how long the frame waited for it (bounded; run_loop.h)
+  // The camera's pose at the mid-exposure, world metres: where the lens is,
+  // its view direction and the picture's up, as the frame was rendered.
+  glm::vec3 position{0.0f}, forward{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
+  bool pose_fresh = false; // a tracker's pose current at that instant; a static one always
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;
   std::uint32_t history_samples = 0;     // samples per pixel the image holds (accumulating; else 0)
@@ -28,11 +35,22 @@ struct FrameRecord {
   double decode_s = 0.0, trace_s = 0.0, encode_s = 0.0;
 };
 
+// What every composite's line of a run says alike, as JSON string values
+// (json_string()): the executor and where the pose comes from ("static",
+// "freed:NAME", "opentrackio:NAME" with the lens source's name).
+struct RunRecordFields {
+  std::string executor;
+  std::string pose_source;
+};
+
+// `text` as a JSON string, quotes included.
+[[nodiscard]] std::string json_string(std::string_view text);
+
 // One line per frame sent, in the outputs' order: `output_frame` is its index
 // in every output (a Y4M file's frame number). A composite's line has every
 // field; a repeat or a placeholder only its kind and time.
 void write_composite_record(std::FILE *out, std::uint64_t output_frame, const FrameRecord &r,
-                            std::int64_t output_ns, const std::string &executor);
+                            std::int64_t output_ns, const RunRecordFields &run);
 void write_filler_record(std::FILE *out, std::uint64_t output_frame, const char *kind,
                          std::int64_t output_ns);
 

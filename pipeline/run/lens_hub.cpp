@@ -9,7 +9,17 @@
 namespace camhead::pipeline {
 
 LensHub::LensHub(const Board &board)
-    : channels_(open_lens_channels(board)), connected_(channels_.size(), false) {}
+    : channels_(open_lens_channels(board)), connected_(channels_.size(), false),
+      pose_source_("static") {
+  if (!board.pose || board.pose->type == PoseType::fixed)
+    return;
+  for (std::size_t i = 0; i < channels_.size(); ++i)
+    if (channels_[i].config().name == board.pose->source) {
+      channels_[i].track_pose(board.pose->type, board.pose->delay_ms);
+      pose_channel_ = i;
+    }
+  pose_source_ = std::string(pose_type_name(board.pose->type)) + ":" + board.pose->source;
+}
 
 void LensHub::start() {
   if (!thread_.joinable())
@@ -55,6 +65,16 @@ LensSnapshot LensHub::state_at(std::int64_t t_ns) const {
   const auto delay_ns = std::llround(lens.config().delay_ms * 1e6);
   snapshot.awaited = (snapshot.connected || !polled_) && (!last || last->t_ns - delay_ns < t_ns);
   return snapshot;
+}
+
+PoseSnapshot LensHub::pose_at(std::int64_t t_ns, const CameraPose &rest) const {
+  if (!pose_channel_)
+    return {rest, true};
+  std::lock_guard lock(mutex_);
+  const std::optional<PoseAt> at = channels_[*pose_channel_].pose_at(t_ns);
+  if (!at)
+    return {rest, false};
+  return {at->pose, at->fresh && connected_[*pose_channel_]};
 }
 
 std::string LensHub::source_name() const {

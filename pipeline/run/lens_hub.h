@@ -1,7 +1,9 @@
 // The board's lens chain on its own thread: every source polled into its
 // tracker, and the lens state at any instant for the frames that ask. The
 // first source of the board is the lens of the frames (a rig has one lens;
-// more sources are for monitoring and fallback, which is to come).
+// more sources are for monitoring and fallback, which is to come). Where the
+// board's pose comes from a tracker (a FreeD or OpenTrackIO source), its
+// poses are kept too, and the pose at any instant asked for alike.
 //
 // Thread safety: state_at() from any thread, while the hub runs.
 #pragma once
@@ -9,6 +11,7 @@
 #include <atomic>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -28,6 +31,13 @@ struct LensSnapshot {
   bool awaited = false;
 };
 
+struct PoseSnapshot {
+  CameraPose pose;
+  // The tracker is there and its pose current at that instant; a static
+  // pose always is.
+  bool fresh = false;
+};
+
 class LensHub {
 public:
   // Opens the board's sources (throws as open_lens_channels does).
@@ -42,6 +52,15 @@ public:
   // The lens at CLOCK_MONOTONIC instant t_ns: a lost source holds its last
   // state, flagged not fresh.
   [[nodiscard]] LensSnapshot state_at(std::int64_t t_ns) const;
+  // Whether the board's pose comes from a tracker.
+  [[nodiscard]] bool tracks_pose() const { return pose_channel_.has_value(); }
+  // The tracker's pose at CLOCK_MONOTONIC instant t_ns; `rest` (not fresh)
+  // before its first pose, or `rest` (fresh) for a board that tracks none.
+  [[nodiscard]] PoseSnapshot pose_at(std::int64_t t_ns, const CameraPose &rest) const;
+  // "static", or the tracker's type and lens source ("freed:tracker"), for
+  // the record and the status line.
+  [[nodiscard]] const std::string &pose_source() const { return pose_source_; }
+
   // "focus pull [trace ...]" for the status line.
   [[nodiscard]] std::string source_name() const;
 
@@ -52,7 +71,9 @@ private:
   // sources themselves are polled by the lens thread alone.
   mutable std::mutex mutex_;
   std::vector<LensChannel> channels_;
-  std::vector<bool> connected_; // each source's status().connected after its last poll
+  std::vector<bool> connected_;             // each source's status().connected after its last poll
+  std::optional<std::size_t> pose_channel_; // the channel whose poses are the camera's
+  std::string pose_source_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> polled_{false}; // every source polled once
   std::thread thread_;

@@ -27,6 +27,7 @@
 #include "camhead/renderer/scene_loader.h"
 #include "lens_camera.h"
 #include "trace_lens.h"
+#include "tracking/camera_pose.h"
 
 namespace camhead::pipeline {
 
@@ -168,7 +169,8 @@ void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &fo
 // at each exposure's middle, rendered by its own frame renderer, with a new
 // noise pattern every frame as a sensor has. The lens is the physical truth
 // where the board's trace gives it (trace_lens.h), else what the lens chain
-// says.
+// says. It films from the board's pose: a tracker's moves it (the simulated
+// world is where the tracker says the camera is).
 std::unique_ptr<CameraSource>
 open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
                 const renderer::Scene &scene, const renderer::FrameCamera &pose,
@@ -183,12 +185,14 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
   const std::uint32_t samples = sim.samples;
   auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
   explain_world_cache(sim, format, truth, *cache);
-  auto generator = [world, cache, format, pose, samples, &lens,
+  auto generator = [world, cache, format, pose, rest = pose_of(pose), samples, &lens,
                     truth = std::move(truth)](std::int64_t start_ns, std::int64_t exposure_ns,
                                               std::span<std::uint8_t> out) {
     const std::int64_t mid = start_ns + exposure_ns / 2;
+    const renderer::FrameCamera posed =
+        lens.tracks_pose() ? placed(pose, lens.pose_at(mid, rest).pose) : pose;
     renderer::FrameRequest request;
-    request.camera = lens_camera(pose, truth ? truth->state_at(mid) : lens.state_at(mid).state);
+    request.camera = lens_camera(posed, truth ? truth->state_at(mid) : lens.state_at(mid).state);
     if (cache->copy(request.camera, out))
       return;
     request.rays_per_pixel = samples;

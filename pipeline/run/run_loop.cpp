@@ -13,6 +13,8 @@
 #include <utility>
 #include <variant>
 
+#include <glm/geometric.hpp>
+
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
 #include "camhead/base/thread_name.h"
@@ -29,6 +31,7 @@
 #include "rig_setup.h"
 #include "run_paths.h"
 #include "run_status.h"
+#include "tracking/camera_pose.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -89,7 +92,10 @@ private:
   const RunOptions &options_;
   const Board &board_;
   const renderer::Scene scene_;
-  const renderer::FrameCamera pose_;
+  // The scene's camera at the board's static pose, on the camera's sensor;
+  // a tracker's pose replaces its place frame by frame.
+  const renderer::FrameCamera base_camera_;
+  const CameraPose rest_pose_;
   LensHub lens_;
   std::unique_ptr<CameraSource> camera_;
   double fps_ = 25.0;
@@ -99,6 +105,7 @@ private:
   std::vector<std::uint64_t> sink_failed_; // output thread: frames each sink did not take
   std::FILE *stats_ = nullptr;
   std::string executor_name_;
+  RunRecordFields record_fields_; // the record's fields that every frame shares
 
   std::vector<Slot> slots_{kSlots};
   std::vector<std::vector<std::uint8_t>> last_frames_;  // what each sink showed last
@@ -142,12 +149,13 @@ const Board &checked_board(const RunOptions &options) {
 // board before anything of that size is allocated.
 Pipeline::Pipeline(const RunOptions &options)
     : options_(options), board_(checked_board(options)), scene_(load_run_scene(board_)),
-      pose_(base_camera(board_, scene_)), lens_(board_),
-      camera_(open_camera(board_, scene_, pose_, lens_, options.threads)),
+      base_camera_(base_camera(board_, scene_)), rest_pose_(pose_of(base_camera_)), lens_(board_),
+      camera_(open_camera(board_, scene_, base_camera_, lens_, options.threads)),
       fps_(camera_fps(*camera_)),
       renderer_(make_renderer(board_, options.executor.value_or(board_.render.executor), scene_,
                               options.threads)),
-      executor_name_(renderer_->executor()) {
+      executor_name_(renderer_->executor()), record_fields_{json_string(executor_name_),
+                                                            json_string(lens_.pose_source())} {
   const std::vector<OutputSpec> specs = output_specs(options);
   std::vector<RunPath> paths = run_inputs(board_, scene_);
   for (RunPath &output : run_outputs(specs))
@@ -200,7 +208,7 @@ Pipeline::~Pipeline() {
 
 renderer::FrameRequest Pipeline::board_request() const {
   renderer::FrameRequest request;
-  request.camera = pose_;
+  request.camera = base_camera_;
   request.adaptive = board_.render.adaptive;
   request.influence_region = options_.influence_region;
   request.accumulation = board_.render.accumulation;
@@ -294,8 +302,15 @@ void Pipeline::render_loop() {
     r.f_number = lens.state.f_number.value;
     r.focal_length_mm = lens.state.focal_length_mm.value;
     r.lens_fresh = lens.fresh;
+    const PoseSnapshot pose = lens_.pose_at(r.exposure_mid_ns, rest_pose_);
+    const renderer::FrameCamera posed =
+        lens_.tracks_pose() ? placed(base_camera_, pose.pose) : base_camera_;
+    r.pose_fresh = pose.fresh;
+    r.position = posed.position;
+    r.forward = glm::normalize(posed.look_at - posed.position);
+    r.up = posed.up;
     renderer::FrameRequest request = board_request();
-    request.camera = lens_camera(pose_, lens.state);
+    request.camera = lens_camera(posed, lens.state);
     request.rays_per_pixel = board_.render.rays_per_pixel.value_or(budget.rpp());
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     r.rpp = request.rays_per_pixel;
@@ -408,7 +423,7 @@ void Pipeline::output_loop() {
     send([&](std::size_t i) { return std::span(slot.images[i]); }, slot.record.capture_ns);
     counters_.latency_ns = last_output_ns_ - slot.record.capture_ns;
     if (stats_ != nullptr)
-      write_composite_record(stats_, output_frame, slot.record, last_output_ns_, executor_name_);
+      write_composite_record(stats_, output_frame, slot.record, last_output_ns_, record_fields_);
     ++output_frame;
     for (std::size_t i = 0; i < sinks_.size(); ++i)
       last_frames_[i].swap(slot.images[i]); // the slot takes the older buffer

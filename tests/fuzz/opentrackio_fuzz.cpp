@@ -19,18 +19,18 @@ void check(bool ok) {
 }
 
 void check_result(const OpenTrackIoParseResult &r) {
-  check(r.lens.has_value() == (r.error == OpenTrackIoError::none));
-  check(r.lens.has_value() == r.detail.empty());
+  check(r.sample.has_value() == (r.error == OpenTrackIoError::none));
+  check(r.sample.has_value() == r.detail.empty());
   if (!r) {
     return;
   }
   // Strings came from valid JSON and doubles print in round-trip form, so the
   // re-encoded sample must parse back equal. Empty: the re-encoded JSON (with
   // its protocol object) no longer fits one datagram, which is legitimate.
-  const auto again = encode_opentrackio(*r.lens);
+  const auto again = encode_opentrackio(*r.sample);
   if (!again.empty()) {
     const OpenTrackIoParseResult back = parse_opentrackio(again);
-    check(back.lens.has_value() && *back.lens == *r.lens);
+    check(back.sample.has_value() && *back.sample == *r.sample);
   }
 }
 

@@ -1,6 +1,7 @@
 // OpenTrackIO JSON payload: a realistic sample, absent fields, and every
 // rejection naming the field that caused it. The header is always valid here
 // (encode_opentrackio_datagram), so only the payload is under test.
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -18,8 +19,8 @@ OpenTrackIoParseResult parse_payload(std::string_view json) {
   return parse_opentrackio(encode_opentrackio_datagram(payload, 3));
 }
 
-// Shaped like the OpenTrackIO example samples: tracker and transform data we
-// do not read sit next to the lens object and must not disturb it.
+// Shaped like the OpenTrackIO example samples: tracker data we do not read
+// sits next to the lens object and the transforms and must not disturb them.
 constexpr std::string_view kFullSample = R"({
   "protocol": {"name": "OpenTrackIO", "version": [1, 0, 0]},
   "sampleId": "urn:uuid:0b6c0a3e-2f7e-4b7a-9a4e-6f1d2c3b4a59",
@@ -51,7 +52,7 @@ constexpr std::string_view kFullSample = R"({
 TEST(OpenTrackIoFields, ExtractsLensFromFullSample) {
   const OpenTrackIoParseResult r = parse_payload(kFullSample);
   ASSERT_TRUE(r) << r.detail;
-  const OpenTrackIoLens &l = *r.lens;
+  const OpenTrackIoSample &l = *r.sample;
   EXPECT_EQ(l.header_sequence, 3);
   EXPECT_EQ(l.focus_distance_m, 10.0);
   EXPECT_EQ(l.f_stop, 4.0);
@@ -64,35 +65,78 @@ TEST(OpenTrackIoFields, ExtractsLensFromFullSample) {
   EXPECT_EQ(l.sample_timestamp->seconds, 1718000000u);
   EXPECT_EQ(l.sample_timestamp->nanoseconds, 41666667u);
   EXPECT_EQ(l.sample_id, "urn:uuid:0b6c0a3e-2f7e-4b7a-9a4e-6f1d2c3b4a59");
+  ASSERT_EQ(l.transforms.size(), 1u);
+  EXPECT_EQ(l.transforms[0].id, "Camera");
+  EXPECT_EQ(l.transforms[0].pose, (TrackedPose{.x_m = 1.0,
+                                               .y_m = 2.0,
+                                               .z_m = 3.0,
+                                               .pan_deg = 180.0,
+                                               .tilt_deg = 90.0,
+                                               .roll_deg = 45.0}));
+  EXPECT_EQ(opentrackio_camera_pose(l.transforms), l.transforms[0].pose)
+      << "one transform is the camera's pose as sent";
+}
+
+TEST(OpenTrackIoFields, TransformsComposeInOrder) {
+  // A tracking origin 1 m to the right turned 90 degrees to the left, then
+  // the camera 2 m ahead of it, tilted and rolled: 2 m along the origin's
+  // forward, which points along -X.
+  const OpenTrackIoParseResult r = parse_payload(R"({"transforms": [
+      {"translation": {"x": 1, "y": 0, "z": 0}, "rotation": {"pan": 90, "tilt": 0, "roll": 0},
+       "scale": {"x": 1, "y": 1, "z": 1}},
+      {"translation": {"x": 0, "y": 2, "z": 0.5}, "rotation": {"pan": -60, "tilt": 20, "roll": 15}}
+    ]})");
+  ASSERT_TRUE(r) << r.detail;
+  ASSERT_EQ(r.sample->transforms.size(), 2u);
+  EXPECT_FALSE(r.sample->transforms[0].id);
+  const std::optional<TrackedPose> camera = opentrackio_camera_pose(r.sample->transforms);
+  ASSERT_TRUE(camera);
+  EXPECT_NEAR(camera->x_m, -1.0, 1e-12);
+  EXPECT_NEAR(camera->y_m, 0.0, 1e-12);
+  EXPECT_NEAR(camera->z_m, 0.5, 1e-12);
+  EXPECT_NEAR(camera->pan_deg, 30.0, 1e-9) << "pans about the same vertical add";
+  EXPECT_NEAR(camera->tilt_deg, 20.0, 1e-9);
+  EXPECT_NEAR(camera->roll_deg, 15.0, 1e-9);
+  EXPECT_FALSE(opentrackio_camera_pose({})) << "no transforms, no pose";
+}
+
+TEST(OpenTrackIoFields, TransformsSurviveEncodeAndParse) {
+  OpenTrackIoSample sample;
+  sample.header_sequence = 9;
+  sample.transforms.push_back({.pose = {.x_m = 0.25, .pan_deg = -170.5}, .id = "Stage"});
+  sample.transforms.push_back({.pose = {.y_m = -3.0, .z_m = 1.5, .tilt_deg = -5, .roll_deg = 2}});
+  const OpenTrackIoParseResult r = parse_opentrackio(encode_opentrackio(sample));
+  ASSERT_TRUE(r) << r.detail;
+  EXPECT_EQ(*r.sample, sample);
 }
 
 TEST(OpenTrackIoFields, AbsentFieldsStayEmpty) {
   const OpenTrackIoParseResult r = parse_payload(R"({"lens":{"encoders":{"zoom":0.5}}})");
   ASSERT_TRUE(r) << r.detail;
-  EXPECT_EQ(r.lens->encoder_zoom, 0.5);
-  EXPECT_FALSE(r.lens->encoder_focus);
-  EXPECT_FALSE(r.lens->encoder_iris);
-  EXPECT_FALSE(r.lens->focus_distance_m);
-  EXPECT_FALSE(r.lens->sample_timestamp);
-  EXPECT_FALSE(r.lens->sample_id);
+  EXPECT_EQ(r.sample->encoder_zoom, 0.5);
+  EXPECT_FALSE(r.sample->encoder_focus);
+  EXPECT_FALSE(r.sample->encoder_iris);
+  EXPECT_FALSE(r.sample->focus_distance_m);
+  EXPECT_FALSE(r.sample->sample_timestamp);
+  EXPECT_FALSE(r.sample->sample_id);
 }
 
 TEST(OpenTrackIoFields, TrackerOnlySampleHasNoLensFields) {
   const OpenTrackIoParseResult r = parse_payload(R"({"tracker":{"status":"ok"}})");
   ASSERT_TRUE(r) << r.detail;
-  OpenTrackIoLens expected;
+  OpenTrackIoSample expected;
   expected.header_sequence = 3;
-  EXPECT_EQ(*r.lens, expected);
+  EXPECT_EQ(*r.sample, expected);
 }
 
 TEST(OpenTrackIoFields, EncoderBoundsAndIntegerNumbersAreAccepted) {
   const OpenTrackIoParseResult r =
       parse_payload(R"({"lens":{"encoders":{"focus":0,"iris":1,"zoom":1.0},"fStop":2}})");
   ASSERT_TRUE(r) << r.detail;
-  EXPECT_EQ(r.lens->encoder_focus, 0.0);
-  EXPECT_EQ(r.lens->encoder_iris, 1.0);
-  EXPECT_EQ(r.lens->encoder_zoom, 1.0);
-  EXPECT_EQ(r.lens->f_stop, 2.0);
+  EXPECT_EQ(r.sample->encoder_focus, 0.0);
+  EXPECT_EQ(r.sample->encoder_iris, 1.0);
+  EXPECT_EQ(r.sample->encoder_zoom, 1.0);
+  EXPECT_EQ(r.sample->f_stop, 2.0);
 }
 
 struct BadPayload {
@@ -151,6 +195,29 @@ const BadPayload kBadPayloads[] = {
     {"TimestampNoNanoseconds", R"({"timing":{"sampleTimestamp":{"seconds":1}}})", E::wrong_type,
      "timing.sampleTimestamp.nanoseconds"},
     {"SampleIdNumber", R"({"sampleId":5})", E::wrong_type, "sampleId"},
+    {"TransformsNotArray", R"({"transforms":{"translation":{}}})", E::wrong_type, "transforms"},
+    {"TransformNotObject", R"({"transforms":[1]})", E::wrong_type, "transforms[0]"},
+    {"TransformNoRotation",
+     R"({"transforms":[{"translation":{"x":0,"y":0,"z":0},"rotation":{"pan":0,"tilt":0,"roll":0}},
+                       {"translation":{"x":0,"y":0,"z":0}}]})",
+     E::wrong_type, "transforms[1].rotation: missing"},
+    {"TransformNoTranslation", R"({"transforms":[{"rotation":{"pan":0,"tilt":0,"roll":0}}]})",
+     E::wrong_type, "transforms[0].translation: missing"},
+    {"TranslationNoZ",
+     R"({"transforms":[{"translation":{"x":0,"y":0},"rotation":{"pan":0,"tilt":0,"roll":0}}]})",
+     E::wrong_type, "transforms[0].translation.z: missing"},
+    {"PanString",
+     R"({"transforms":[{"translation":{"x":0,"y":0,"z":0},"rotation":{"pan":"0","tilt":0,"roll":0}}]})",
+     E::wrong_type, "transforms[0].rotation.pan"},
+    {"RotationArray", R"({"transforms":[{"translation":{"x":0,"y":0,"z":0},"rotation":[0,0,0]}]})",
+     E::wrong_type, "transforms[0].rotation"},
+    {"TransformIdNumber",
+     R"({"transforms":[{"id":7,"translation":{"x":0,"y":0,"z":0},"rotation":{"pan":0,"tilt":0,"roll":0}}]})",
+     E::wrong_type, "transforms[0].id"},
+    {"OverflowTilt",
+     R"({"transforms":[{"translation":{"x":0,"y":0,"z":0},"rotation":{"pan":0,"tilt":1e999,"roll":0}}]})",
+     // Caught while parsing, before the elements are counted.
+     E::non_finite, "transforms[].rotation.tilt"},
     // Out of range.
     {"EncoderFocusAboveOne", R"({"lens":{"encoders":{"focus":1.0000001}}})", E::out_of_range,
      "lens.encoders.focus"},

@@ -57,14 +57,14 @@ TEST(OpenTrackIoHeader, ParsesHandAssembledDatagram) {
   d.insert(d.end(), payload.begin(), payload.end());
   const OpenTrackIoParseResult r = parse_opentrackio(d);
   ASSERT_TRUE(r) << r.detail;
-  EXPECT_EQ(r.lens->header_sequence, 42);
-  EXPECT_EQ(r.lens->focus_distance_m, 2.5);
-  EXPECT_FALSE(r.lens->f_stop);
+  EXPECT_EQ(r.sample->header_sequence, 42);
+  EXPECT_EQ(r.sample->focus_distance_m, 2.5);
+  EXPECT_FALSE(r.sample->f_stop);
   EXPECT_EQ(encode_opentrackio_datagram(bytes_of(payload), 42), d);
 }
 
 TEST(OpenTrackIoHeader, RoundTripsEveryField) {
-  OpenTrackIoLens lens;
+  OpenTrackIoSample lens;
   lens.header_sequence = 0xFFFF;
   lens.focus_distance_m = 3.25;
   lens.f_stop = 2.8;
@@ -79,13 +79,13 @@ TEST(OpenTrackIoHeader, RoundTripsEveryField) {
   ASSERT_FALSE(d.empty());
   const OpenTrackIoParseResult r = parse_opentrackio(d);
   ASSERT_TRUE(r) << r.detail;
-  EXPECT_EQ(*r.lens, lens);
+  EXPECT_EQ(*r.sample, lens);
 }
 
 TEST(OpenTrackIoHeader, RoundTripsEmptySample) {
-  const OpenTrackIoParseResult r = parse_opentrackio(encode_opentrackio(OpenTrackIoLens{}));
+  const OpenTrackIoParseResult r = parse_opentrackio(encode_opentrackio(OpenTrackIoSample{}));
   ASSERT_TRUE(r) << r.detail;
-  EXPECT_EQ(*r.lens, OpenTrackIoLens{});
+  EXPECT_EQ(*r.sample, OpenTrackIoSample{});
 }
 
 TEST(OpenTrackIoHeader, RejectsEveryTruncation) {
@@ -158,7 +158,7 @@ TEST(OpenTrackIoHeader, IgnoresReservedByte) {
   reseal(d);
   const OpenTrackIoParseResult r = parse_opentrackio(d);
   ASSERT_TRUE(r) << r.detail;
-  EXPECT_EQ(r.lens->f_stop, 4.0);
+  EXPECT_EQ(r.sample->f_stop, 4.0);
 }
 
 TEST(OpenTrackIoHeader, EncoderRefusesOversizedPayload) {

@@ -75,6 +75,28 @@ TEST(FreedReceiver, DeliversCountsStampedAtReceipt) {
   EXPECT_NE(s.detail.find("receiving from 127.0.0.1:"), std::string::npos) << s.detail;
 }
 
+TEST(FreedReceiver, DeliversThePoseInFreedsAxesAndMetres) {
+  FreedReceiver rx(loopback());
+  test::RawSender tx(rx.port());
+  FreedD1 m;
+  m.pan_deg = -45.5;
+  m.tilt_deg = 10.25;
+  m.roll_deg = -0.5;
+  m.x_mm = 1250.0;
+  m.y_mm = -3000.5;
+  m.z_mm = 1600.25;
+  ASSERT_TRUE(tx.send(encode_freed_d1(m)));
+  const std::vector<EncoderReading> got = test::collect(rx, 1);
+  ASSERT_EQ(got.size(), 1u);
+  ASSERT_TRUE(got[0].pose);
+  EXPECT_EQ(*got[0].pose, (TrackedPose{.x_m = 1.25,
+                                       .y_m = -3.0005,
+                                       .z_m = 1.60025,
+                                       .pan_deg = -45.5,
+                                       .tilt_deg = 10.25,
+                                       .roll_deg = -0.5}));
+}
+
 TEST(FreedReceiver, MalformedDatagramsAreCountedAndDropped) {
   FreedReceiver rx(loopback());
   test::RawSender tx(rx.port());

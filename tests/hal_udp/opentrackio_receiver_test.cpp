@@ -27,7 +27,7 @@ OpenTrackIoReceiverConfig loopback() {
 }
 
 std::vector<std::uint8_t> sample(std::uint16_t sequence, double focus = 0.25) {
-  OpenTrackIoLens l;
+  OpenTrackIoSample l;
   l.header_sequence = sequence;
   l.encoder_focus = focus;
   return encode_opentrackio(l);
@@ -47,7 +47,7 @@ void settle(OpenTrackIoReceiver &rx, std::uint64_t n, std::vector<EncoderReading
 }
 
 TEST(OpenTrackIoReading, EncodersScaleToNormalisedCounts) {
-  OpenTrackIoLens l;
+  OpenTrackIoSample l;
   l.encoder_focus = 0.0; // infinity, kept as 0
   l.encoder_iris = 1.0;
   l.encoder_zoom = 0.5;
@@ -61,7 +61,7 @@ TEST(OpenTrackIoReading, EncodersScaleToNormalisedCounts) {
 }
 
 TEST(OpenTrackIoReading, SampleWithoutLensFieldsGivesNoReading) {
-  OpenTrackIoLens l;
+  OpenTrackIoSample l;
   l.sample_sequence = 5;
   EXPECT_FALSE(reading_from_opentrackio(l, 0));
 }

@@ -29,8 +29,8 @@ OpenTrackIoSenderConfig unicast(std::string host, std::uint16_t port) {
   return c;
 }
 
-OpenTrackIoLensState state(int i) {
-  OpenTrackIoLensState s;
+OpenTrackIoState state(int i) {
+  OpenTrackIoState s;
   s.focus_distance_m = 0.5 + i;
   s.f_stop = 2.8;
   s.focal_length_mm = 35.0;
@@ -73,14 +73,52 @@ TEST(OpenTrackIoSender, RoundTripThroughRealSockets) {
   EXPECT_EQ(s.malformed, 0u);
 }
 
+TEST(OpenTrackIoSender, APoseSentIsReceivedUnchanged) {
+  OpenTrackIoReceiverConfig rc;
+  rc.bind_address = "127.0.0.1";
+  rc.port = 0;
+  OpenTrackIoReceiver rx(rc);
+  OpenTrackIoSender tx(unicast("127.0.0.1", rx.port()));
+  // Values no decimal shorter than 17 digits carries.
+  const TrackedPose camera{.x_m = 0.1 + 0.2,
+                           .y_m = -2.0 / 3.0,
+                           .z_m = 1.6e-7,
+                           .pan_deg = 179.99999999999997,
+                           .tilt_deg = -1.0 / 7.0,
+                           .roll_deg = 1e-300};
+  OpenTrackIoState pose_only;
+  pose_only.camera = camera;
+  ASSERT_EQ(tx.send(pose_only), 0) << tx.last_error();
+  OpenTrackIoState with_lens = state(3);
+  with_lens.camera = camera;
+  ASSERT_EQ(tx.send(with_lens), 0) << tx.last_error();
+
+  const std::vector<EncoderReading> got = test::collect(rx, 2);
+  ASSERT_EQ(got.size(), 2u) << "a sample with a pose and no lens field is still a reading";
+  for (const EncoderReading &r : got) {
+    ASSERT_TRUE(r.pose);
+    EXPECT_EQ(*r.pose, camera);
+  }
+  EXPECT_FALSE(got[0].focus || got[0].focus_distance_m);
+  EXPECT_EQ(got[1].focus_distance_m, 3.5);
+}
+
+TEST(OpenTrackIoSender, RejectsAPoseThatIsNotFinite) {
+  OpenTrackIoSender tx(unicast("127.0.0.1", 9));
+  OpenTrackIoState s;
+  s.camera = TrackedPose{.tilt_deg = std::numeric_limits<double>::infinity()};
+  EXPECT_EQ(tx.send(s), -EINVAL);
+  EXPECT_NE(tx.last_error().find("transforms[0]"), std::string::npos) << tx.last_error();
+}
+
 TEST(OpenTrackIoSender, RejectsValuesOpenTrackIoCannotCarry) {
   OpenTrackIoSender tx(unicast("127.0.0.1", 9));
-  OpenTrackIoLensState nan_focus;
+  OpenTrackIoState nan_focus;
   nan_focus.focus_distance_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(tx.send(nan_focus), -EINVAL);
   EXPECT_NE(tx.last_error().find("lens.focusDistance"), std::string::npos) << tx.last_error();
 
-  OpenTrackIoLensState past_end;
+  OpenTrackIoState past_end;
   past_end.encoder_iris = 1.5;
   EXPECT_EQ(tx.send(past_end), -EINVAL);
   EXPECT_NE(tx.last_error().find("lens.encoders.iris"), std::string::npos) << tx.last_error();

@@ -253,6 +253,59 @@ TEST(BoardLive, APoseWithoutAViewOrAnOrientationIsRefused) {
   EXPECT_EQ(pose(R"("position": [0, 1, 0], "look_at": [0, 1, -2])"), "(no error)");
 }
 
+// A tracker's pose comes in the datagrams of one of the board's lens
+// sources: the board names it, or has only one of that type.
+TEST(BoardLive, ATrackersPoseNamesTheSourceThatCarriesIt) {
+  const auto board = [](const std::string &sources, const std::string &pose) {
+    return R"({"format": "camhead-board", "version": 1, "name": "t",
+               "lens": {"sources": [)" +
+           sources + R"(]}, "pose": )" + pose + "}";
+  };
+  const std::string usb = R"({"type": "usb", "vendor_id": "1209", "product_id": "ca3e"})";
+  const std::string freed = R"({"name": "head", "type": "freed", "port": 40001})";
+  const std::string otio = R"({"name": "tracker", "type": "opentrackio"})";
+
+  const Board named = parse_board(
+      board(usb + ", " + freed, R"({"type": "freed", "source": "head", "delay_ms": 33.5})"),
+      "/rigs/test.json");
+  ASSERT_TRUE(named.pose);
+  EXPECT_EQ(named.pose->type, PoseType::freed);
+  EXPECT_EQ(named.pose->source, "head");
+  EXPECT_EQ(named.pose->delay_ms, 33.5);
+  const Board only = parse_board(board(otio + ", " + usb, R"({"type": "opentrackio"})"), "b");
+  EXPECT_EQ(only.pose->type, PoseType::opentrackio);
+  EXPECT_EQ(only.pose->source, "tracker") << "the board's only opentrackio source";
+  EXPECT_EQ(only.pose->delay_ms, 0.0);
+  EXPECT_EQ(parse_board(board(usb, R"({"type": "static", "position": [0, 1, 0],
+                                       "look_at": [0, 1, -1]})"),
+                        "b")
+                .pose->type,
+            PoseType::fixed);
+
+  const std::string file = "/rigs/test.json: ";
+  EXPECT_EQ(error_of(board(usb, R"({"type": "marker"})")),
+            file + "pose.type: unknown pose type \"marker\" (static, freed or opentrackio)");
+  EXPECT_EQ(error_of(board(usb + ", " + freed, R"({"type": "freed", "source": "lens"})")),
+            file + "pose.source: no lens source is named \"lens\": name one of lens.sources, "
+                   "of type freed");
+  EXPECT_EQ(error_of(board(usb + ", " + freed, R"({"type": "opentrackio", "source": "head"})")),
+            file + "pose.source: lens source \"head\" is of type freed, not opentrackio: only "
+                   "a opentrackio source carries a opentrackio pose");
+  EXPECT_EQ(error_of(board(usb, R"({"type": "freed"})")),
+            file + "pose.source: missing, and lens.sources has no freed source: add one (its "
+                   "socket carries the pose) and, if it is not the lens of the frames, list it "
+                   "after that one");
+  EXPECT_EQ(error_of(board(freed + R"(, {"name": "b", "type": "freed", "port": 40002})",
+                           R"({"type": "freed"})")),
+            file + "pose.source: missing, and lens.sources has 2 freed sources: name the one "
+                   "that carries the pose");
+  EXPECT_EQ(error_of(board(freed, R"({"type": "freed", "position": [0, 1, 0]})")),
+            file + "pose.position: only a static pose has one: a freed pose is where its "
+                   "tracker says the camera is");
+  EXPECT_EQ(error_of(board(freed, R"({"type": "freed", "delay_ms": 5000})")),
+            file + "pose.delay_ms: must be within -1000 .. 1000");
+}
+
 TEST(BoardLive, TheSimulatedRigHasACameraASceneAndAnOutput) {
   const Board board = load_board(resolve_board("sim"));
   ASSERT_TRUE(board.camera);

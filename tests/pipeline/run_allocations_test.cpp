@@ -11,6 +11,7 @@
 // library's malloc (stdio buffers its streams with it, once).
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "run/run_loop.h"
 #include "run_test_support.h"
 #include "test_support.h"
+#include "tracker_sender.h"
 
 #include <gtest/gtest.h>
 
@@ -50,12 +52,14 @@ class RunAllocations : public RunLoop {
 protected:
   struct Counts {
     std::uint64_t render = 0, output = 0, frames_out = 0;
-    std::uint64_t reprojected = 0; // samples moved, in all the records
+    std::uint64_t reprojected = 0;    // samples moved, in all the records
+    std::uint64_t tracked_frames = 0; // composites with a tracker's pose, fresh
   };
 
   // A run of a take played in real time, looped, through a floor with a
-  // virtual ball, with `render` as the board's render settings.
-  Counts run(const std::string &render) {
+  // virtual ball, with `render` as the board's render settings; `tracked`:
+  // the pose of a FreeD head on this host panning to and fro.
+  Counts run(const std::string &render, bool tracked = false) {
     const int w = 96, h = 64, n = 8;
     std::vector<std::vector<std::uint8_t>> frames;
     for (int k = 0; k < n; ++k)
@@ -70,23 +74,36 @@ protected:
         {"name": "floor", "type": "plane", "center": [0, 0, -3], "size": [10, 10], "material": "grey", "real": true},
         {"name": "ball", "type": "sphere", "center": [0.2, 0.25, -1.8], "radius": 0.25, "material": "grey", "real": false}],
       "lights": [{"name": "key", "type": "point", "position": [-1, 2, -1], "power_W": 200}]})");
+    const std::uint16_t port = free_udp_port();
+    // The FreeD source follows the trace in the board's list (the helper
+    // closes the last source's object).
+    const std::string freed = R"(}, {"name": "head", "type": "freed", "bind": "127.0.0.1",
+                                 "port": )" +
+                              std::to_string(port);
     RunOptions options;
-    options.board = board(R"({"type": "file", "path": ")" + input.string() +
-                              R"(", "loop": true, "realtime": true, "width": 96, "height": 64})",
-                          scene, R"(, "speed": 4)", R"(, "render": )" + render);
+    options.board =
+        board(R"({"type": "file", "path": ")" + input.string() +
+                  R"(", "loop": true, "realtime": true, "width": 96, "height": 64})",
+              scene, R"(, "speed": 4)" + (tracked ? freed : ""),
+              R"(, "render": )" + render + (tracked ? R"(, "pose": {"type": "freed"})" : ""));
     options.outputs = {"file:" + (dir_ / "out.y4m").string()};
     options.stats_file = dir_ / "stats.jsonl";
     options.frames = 40;
     options.threads = 2;
     options.status = nullptr;
+    std::optional<Tracker> head;
+    if (tracked)
+      head.emplace("freed", port, 2.0, 3.0); // +-2 degrees, to and fro every 3 s
     test::counting_new::start(thread_bucket);
     const RunSummary summary = run_pipeline(options);
     test::counting_new::stop();
-    std::uint64_t reprojected = 0;
-    for (const CompositeRecord &record : recorded_composites(dir_ / "stats.jsonl"))
+    std::uint64_t reprojected = 0, tracked_frames = 0;
+    for (const CompositeRecord &record : recorded_composites(dir_ / "stats.jsonl")) {
       reprojected += record.reprojected_samples;
+      tracked_frames += record.pose_fresh ? 1 : 0;
+    }
     return {test::counting_new::count(kRender), test::counting_new::count(kOutput),
-            summary.frames_out, reprojected};
+            summary.frames_out, reprojected, tracked_frames};
   }
 };
 
@@ -98,6 +115,16 @@ TEST_F(RunAllocations, TheRenderAndOutputThreadsAllocateNothingOnTheCpuReference
   // The pull's frames started with the frames before them moved
   // (render.reproject), and the record says so.
   EXPECT_GT(counts.reprojected, 0u);
+}
+
+// A tracker's pose, read for every frame from the lens thread's history,
+// adds nothing either.
+TEST_F(RunAllocations, ATrackedPoseAllocatesNothingFrameAfterFrame) {
+  const Counts counts = run(R"({"executor": "cpu"})", true);
+  EXPECT_EQ(counts.frames_out, 40u);
+  EXPECT_GT(counts.tracked_frames, 30u) << "the run had the head's pose";
+  EXPECT_EQ(counts.render, 0u);
+  EXPECT_EQ(counts.output, 0u);
 }
 
 // The driver's own threads are not camhead's, and not counted (lavapipe's

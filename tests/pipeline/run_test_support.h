@@ -107,6 +107,7 @@ struct CompositeRecord {
   double focus_m = 0.0;
   bool lens_fresh = false;
   std::uint64_t reprojected_samples = 0;
+  bool pose_fresh = false;
 };
 
 inline double json_number(const std::string &line, const std::string &field) {
@@ -140,7 +141,8 @@ inline std::vector<CompositeRecord> recorded_composites(const fs::path &stats) {
                        json_number(line, "exposure_mid_ns"), json_number(line, "delivered_ns"),
                        json_number(line, "focus_m"),
                        line.find("\"lens_fresh\":true") != std::string::npos,
-                       std::uint64_t(json_number(line, "reprojected_samples"))});
+                       std::uint64_t(json_number(line, "reprojected_samples")),
+                       line.find("\"pose_fresh\":true") != std::string::npos});
   }
   return records;
 }

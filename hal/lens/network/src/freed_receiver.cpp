@@ -38,6 +38,12 @@ void FreedReceiver::poll(std::chrono::milliseconds timeout, std::vector<EncoderR
     // 24-bit unsigned counts always fit an int32.
     r.focus = static_cast<std::int32_t>(m.focus);
     r.zoom = static_cast<std::int32_t>(m.zoom);
+    r.pose = TrackedPose{.x_m = m.x_mm / 1000.0,
+                         .y_m = m.y_mm / 1000.0,
+                         .z_m = m.z_mm / 1000.0,
+                         .pan_deg = m.pan_deg,
+                         .tilt_deg = m.tilt_deg,
+                         .roll_deg = m.roll_deg};
     out.push_back(r);
     return detail::Verdict::reading;
   });

@@ -3,8 +3,10 @@
 #include "camhead/hal/lens/network/opentrackio.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <utility>
 
@@ -50,7 +52,7 @@ OpenTrackIoParseResult reject(OpenTrackIoError error, std::string detail) {
   return OpenTrackIoParseResult{std::nullopt, error, std::move(detail)};
 }
 
-enum class Range { positive, unit };
+enum class Range { any, positive, unit };
 
 // Typed access to optional fields. The first failure sticks and every later
 // call is a no-op, so extraction reads as a straight list of fields.
@@ -82,7 +84,9 @@ public:
       fail(OpenTrackIoError::non_finite, path + ": not a finite number");
       return std::nullopt;
     }
-    const bool in_range = range == Range::positive ? v > 0.0 : (v >= 0.0 && v <= 1.0);
+    const bool in_range = range == Range::any        ? true
+                          : range == Range::positive ? v > 0.0
+                                                     : (v >= 0.0 && v <= 1.0);
     if (!in_range) {
       fail(OpenTrackIoError::out_of_range,
            path + ": " + child->dump() +
@@ -115,6 +119,25 @@ public:
       return std::nullopt;
     }
     return v;
+  }
+
+  // A number that must be there.
+  double required(const json &parent, const char *key, const std::string &path) {
+    const std::optional<double> v = number(parent, key, path, Range::any);
+    if (!v && ok()) {
+      fail(OpenTrackIoError::wrong_type, path + ": missing");
+    }
+    return v.value_or(0.0);
+  }
+
+  // The child array `key` of `parent`, or nullptr when absent or invalid.
+  const json *array(const json &parent, const char *key, const std::string &path) {
+    const json *child = find(parent, key);
+    if (child != nullptr && !child->is_array()) {
+      fail(OpenTrackIoError::wrong_type, path + ": expected an array, got " + child->type_name());
+      return nullptr;
+    }
+    return child;
   }
 
   std::optional<std::string> text(const json &parent, const char *key, const std::string &path) {
@@ -157,7 +180,7 @@ OpenTrackIoParseResult extract(const json &sample, std::uint16_t header_sequence
     return reject(OpenTrackIoError::wrong_type,
                   std::string{"sample: expected an object, got "} + sample.type_name());
   }
-  OpenTrackIoLens out;
+  OpenTrackIoSample out;
   out.header_sequence = header_sequence;
   Fields f;
   out.sample_id = f.text(sample, "sampleId", "sampleId");
@@ -187,13 +210,104 @@ OpenTrackIoParseResult extract(const json &sample, std::uint16_t header_sequence
       out.encoder_zoom = f.number(*enc, "zoom", "lens.encoders.zoom", Range::unit);
     }
   }
+  if (const json *transforms = f.array(sample, "transforms", "transforms")) {
+    out.transforms.reserve(transforms->size());
+    for (std::size_t i = 0; i < transforms->size() && f.ok(); ++i) {
+      const std::string path = "transforms[" + std::to_string(i) + "]";
+      const json &entry = (*transforms)[i];
+      if (!entry.is_object()) {
+        f.fail(OpenTrackIoError::wrong_type,
+               path + ": expected an object, got " + entry.type_name());
+        break;
+      }
+      OpenTrackIoTransform &t = out.transforms.emplace_back();
+      t.id = f.text(entry, "id", path + ".id");
+      const json *translation = f.object(entry, "translation", path + ".translation");
+      const json *rotation = f.object(entry, "rotation", path + ".rotation");
+      if (f.ok() && (translation == nullptr || rotation == nullptr)) {
+        f.fail(OpenTrackIoError::wrong_type,
+               path + (translation == nullptr ? ".translation" : ".rotation") + ": missing");
+        break;
+      }
+      if (!f.ok()) {
+        break;
+      }
+      t.pose.x_m = f.required(*translation, "x", path + ".translation.x");
+      t.pose.y_m = f.required(*translation, "y", path + ".translation.y");
+      t.pose.z_m = f.required(*translation, "z", path + ".translation.z");
+      t.pose.pan_deg = f.required(*rotation, "pan", path + ".rotation.pan");
+      t.pose.tilt_deg = f.required(*rotation, "tilt", path + ".rotation.tilt");
+      t.pose.roll_deg = f.required(*rotation, "roll", path + ".rotation.roll");
+    }
+  }
   if (!f.ok()) {
     return f.failure();
   }
   return OpenTrackIoParseResult{std::move(out), OpenTrackIoError::none, {}};
 }
 
+// Rotation matrices in OpenTrackIO's axes (X right, Y forward, Z up),
+// row-major; the columns are the camera's right, forward and up.
+using Matrix = std::array<double, 9>;
+constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
+
+Matrix multiply(const Matrix &a, const Matrix &b) {
+  Matrix m{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < 3; ++k) {
+        m[r * 3 + c] += a[r * 3 + k] * b[k * 3 + c];
+      }
+    }
+  }
+  return m;
+}
+
+// Rz(pan) Rx(tilt) Ry(roll): intrinsic Z, X, Y, right-handed.
+Matrix rotation(const TrackedPose &p) {
+  const double cp = std::cos(p.pan_deg * kRadiansPerDegree);
+  const double sp = std::sin(p.pan_deg * kRadiansPerDegree);
+  const double ct = std::cos(p.tilt_deg * kRadiansPerDegree);
+  const double st = std::sin(p.tilt_deg * kRadiansPerDegree);
+  const double cr = std::cos(p.roll_deg * kRadiansPerDegree);
+  const double sr = std::sin(p.roll_deg * kRadiansPerDegree);
+  const Matrix pan{cp, -sp, 0, sp, cp, 0, 0, 0, 1};
+  const Matrix tilt{1, 0, 0, 0, ct, -st, 0, st, ct};
+  const Matrix roll{cr, 0, sr, 0, 1, 0, -sr, 0, cr};
+  return multiply(multiply(pan, tilt), roll);
+}
+
 } // namespace
+
+std::optional<TrackedPose>
+opentrackio_camera_pose(std::span<const OpenTrackIoTransform> transforms) {
+  if (transforms.empty()) {
+    return std::nullopt;
+  }
+  if (transforms.size() == 1) {
+    return transforms.front().pose; // as sent, not through a matrix's rounding
+  }
+  Matrix r{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  double t[3] = {0.0, 0.0, 0.0};
+  for (const OpenTrackIoTransform &transform : transforms) {
+    const TrackedPose &p = transform.pose;
+    const double local[3] = {p.x_m, p.y_m, p.z_m};
+    for (int row = 0; row < 3; ++row) {
+      t[row] += r[row * 3] * local[0] + r[row * 3 + 1] * local[1] + r[row * 3 + 2] * local[2];
+    }
+    r = multiply(r, rotation(p));
+  }
+  // Back to angles: the forward column is (-sin pan cos tilt, cos pan cos tilt,
+  // sin tilt), the bottom row (-cos tilt sin roll, sin tilt, cos tilt cos roll).
+  TrackedPose out;
+  out.x_m = t[0];
+  out.y_m = t[1];
+  out.z_m = t[2];
+  out.tilt_deg = std::asin(std::clamp(r[7], -1.0, 1.0)) / kRadiansPerDegree;
+  out.pan_deg = std::atan2(-r[1], r[4]) / kRadiansPerDegree;
+  out.roll_deg = std::atan2(-r[6], r[8]) / kRadiansPerDegree;
+  return out;
+}
 
 std::uint16_t fletcher16(std::span<const std::uint8_t> first,
                          std::span<const std::uint8_t> second) {
@@ -274,34 +388,44 @@ std::vector<std::uint8_t> encode_opentrackio_datagram(std::span<const std::uint8
   return out;
 }
 
-std::vector<std::uint8_t> encode_opentrackio(const OpenTrackIoLens &lens) {
+std::vector<std::uint8_t> encode_opentrackio(const OpenTrackIoSample &in) {
   json sample = {{"protocol", {{"name", "OpenTrackIO"}, {"version", {1, 0, 0}}}}};
-  if (lens.sample_id) {
-    sample["sampleId"] = *lens.sample_id;
+  if (in.sample_id) {
+    sample["sampleId"] = *in.sample_id;
   }
-  if (lens.sample_sequence) {
-    sample["timing"]["sequenceNumber"] = *lens.sample_sequence;
+  if (in.sample_sequence) {
+    sample["timing"]["sequenceNumber"] = *in.sample_sequence;
   }
-  if (lens.sample_timestamp) {
-    sample["timing"]["sampleTimestamp"] = {{"seconds", lens.sample_timestamp->seconds},
-                                           {"nanoseconds", lens.sample_timestamp->nanoseconds}};
+  if (in.sample_timestamp) {
+    sample["timing"]["sampleTimestamp"] = {{"seconds", in.sample_timestamp->seconds},
+                                           {"nanoseconds", in.sample_timestamp->nanoseconds}};
   }
   const auto put = [&sample](const json::json_pointer &where, const std::optional<double> &v) {
     if (v) {
       sample[where] = *v;
     }
   };
-  put(json::json_pointer("/lens/focusDistance"), lens.focus_distance_m);
-  put(json::json_pointer("/lens/fStop"), lens.f_stop);
-  put(json::json_pointer("/lens/pinholeFocalLength"), lens.pinhole_focal_length_mm);
-  put(json::json_pointer("/lens/encoders/focus"), lens.encoder_focus);
-  put(json::json_pointer("/lens/encoders/iris"), lens.encoder_iris);
-  put(json::json_pointer("/lens/encoders/zoom"), lens.encoder_zoom);
+  put(json::json_pointer("/lens/focusDistance"), in.focus_distance_m);
+  put(json::json_pointer("/lens/fStop"), in.f_stop);
+  put(json::json_pointer("/lens/pinholeFocalLength"), in.pinhole_focal_length_mm);
+  put(json::json_pointer("/lens/encoders/focus"), in.encoder_focus);
+  put(json::json_pointer("/lens/encoders/iris"), in.encoder_iris);
+  put(json::json_pointer("/lens/encoders/zoom"), in.encoder_zoom);
+  for (const OpenTrackIoTransform &t : in.transforms) {
+    json entry = {
+        {"translation", {{"x", t.pose.x_m}, {"y", t.pose.y_m}, {"z", t.pose.z_m}}},
+        {"rotation",
+         {{"pan", t.pose.pan_deg}, {"tilt", t.pose.tilt_deg}, {"roll", t.pose.roll_deg}}}};
+    if (t.id) {
+      entry["id"] = *t.id;
+    }
+    sample["transforms"].push_back(std::move(entry));
+  }
 
   // `replace` keeps dump() from throwing on a sampleId that is not UTF-8.
   const std::string text = sample.dump(-1, ' ', false, json::error_handler_t::replace);
   const auto *bytes = reinterpret_cast<const std::uint8_t *>(text.data());
-  return encode_opentrackio_datagram(std::span(bytes, text.size()), lens.header_sequence);
+  return encode_opentrackio_datagram(std::span(bytes, text.size()), in.header_sequence);
 }
 
 const char *to_string(OpenTrackIoError error) {

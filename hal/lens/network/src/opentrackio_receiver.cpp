@@ -19,17 +19,19 @@ std::optional<std::int32_t> to_counts(const std::optional<double> &normalised) {
 
 } // namespace
 
-std::optional<EncoderReading> reading_from_opentrackio(const OpenTrackIoLens &lens,
+std::optional<EncoderReading> reading_from_opentrackio(const OpenTrackIoSample &sample,
                                                        std::int64_t t_ns) {
   EncoderReading r;
   r.t_ns = t_ns;
-  r.focus = to_counts(lens.encoder_focus);
-  r.iris = to_counts(lens.encoder_iris);
-  r.zoom = to_counts(lens.encoder_zoom);
-  r.focus_distance_m = lens.focus_distance_m;
-  r.f_stop = lens.f_stop;
-  r.focal_length_mm = lens.pinhole_focal_length_mm;
-  if (!r.focus && !r.iris && !r.zoom && !r.focus_distance_m && !r.f_stop && !r.focal_length_mm) {
+  r.focus = to_counts(sample.encoder_focus);
+  r.iris = to_counts(sample.encoder_iris);
+  r.zoom = to_counts(sample.encoder_zoom);
+  r.focus_distance_m = sample.focus_distance_m;
+  r.f_stop = sample.f_stop;
+  r.focal_length_mm = sample.pinhole_focal_length_mm;
+  r.pose = opentrackio_camera_pose(sample.transforms);
+  if (!r.focus && !r.iris && !r.zoom && !r.focus_distance_m && !r.f_stop && !r.focal_length_mm &&
+      !r.pose) {
     return std::nullopt;
   }
   return r;
@@ -72,8 +74,8 @@ void OpenTrackIoReceiver::poll(std::chrono::milliseconds timeout,
       why = std::string("OpenTrackIO: ") + to_string(parsed.error) + ": " + parsed.detail;
       return detail::Verdict::malformed;
     }
-    track_sequence(parsed.lens->header_sequence, d.t_ns);
-    std::optional<EncoderReading> reading = reading_from_opentrackio(*parsed.lens, d.t_ns);
+    track_sequence(parsed.sample->header_sequence, d.t_ns);
+    std::optional<EncoderReading> reading = reading_from_opentrackio(*parsed.sample, d.t_ns);
     if (!reading) {
       return detail::Verdict::ignored;
     }

@@ -17,7 +17,7 @@ namespace camhead::hal::lens {
 namespace {
 
 // The field name of the first value that OpenTrackIO cannot carry, or null.
-const char *invalid_field(const OpenTrackIoLensState &s) {
+const char *invalid_field(const OpenTrackIoState &s) {
   const auto positive = [](const std::optional<double> &v) {
     return !v || (std::isfinite(*v) && *v > 0.0);
   };
@@ -39,6 +39,14 @@ const char *invalid_field(const OpenTrackIoLensState &s) {
   }
   if (!unit(s.encoder_zoom)) {
     return "lens.encoders.zoom must be within [0, 1]";
+  }
+  if (s.camera) {
+    const TrackedPose &c = *s.camera;
+    for (const double v : {c.x_m, c.y_m, c.z_m, c.pan_deg, c.tilt_deg, c.roll_deg}) {
+      if (!std::isfinite(v)) {
+        return "transforms[0]: translation and rotation must be finite";
+      }
+    }
   }
   if (s.timestamp && s.timestamp->nanoseconds >= 1'000'000'000) {
     return "timing.sampleTimestamp.nanoseconds must be < 1e9";
@@ -85,23 +93,26 @@ OpenTrackIoSender::~OpenTrackIoSender() {
   }
 }
 
-int OpenTrackIoSender::send(const OpenTrackIoLensState &state) {
+int OpenTrackIoSender::send(const OpenTrackIoState &state) {
   if (const char *why = invalid_field(state)) {
     ++failed_;
     last_error_ = name_ + ": " + why;
     return -EINVAL;
   }
-  OpenTrackIoLens lens;
-  lens.header_sequence = static_cast<std::uint16_t>(sequence_);
-  lens.sample_sequence = sequence_;
-  lens.sample_timestamp = state.timestamp;
-  lens.focus_distance_m = state.focus_distance_m;
-  lens.f_stop = state.f_stop;
-  lens.pinhole_focal_length_mm = state.focal_length_mm;
-  lens.encoder_focus = state.encoder_focus;
-  lens.encoder_iris = state.encoder_iris;
-  lens.encoder_zoom = state.encoder_zoom;
-  const std::vector<std::uint8_t> datagram = encode_opentrackio(lens);
+  OpenTrackIoSample sample;
+  sample.header_sequence = static_cast<std::uint16_t>(sequence_);
+  sample.sample_sequence = sequence_;
+  sample.sample_timestamp = state.timestamp;
+  sample.focus_distance_m = state.focus_distance_m;
+  sample.f_stop = state.f_stop;
+  sample.pinhole_focal_length_mm = state.focal_length_mm;
+  sample.encoder_focus = state.encoder_focus;
+  sample.encoder_iris = state.encoder_iris;
+  sample.encoder_zoom = state.encoder_zoom;
+  if (state.camera) {
+    sample.transforms.push_back({.pose = *state.camera, .id = "Camera"});
+  }
+  const std::vector<std::uint8_t> datagram = encode_opentrackio(sample);
   if (datagram.empty()) {
     ++failed_;
     last_error_ = name_ + ": sample does not fit one datagram";

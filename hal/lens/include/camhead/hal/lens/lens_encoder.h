@@ -20,6 +20,17 @@
 
 namespace camhead::hal::lens {
 
+// The camera's pose as a tracking source sends it, in the protocol's own
+// axes and angles: X, Y, Z in metres and pan, tilt, roll in degrees, whose
+// directions and order each protocol defines (FreeD's and OpenTrackIO's
+// differ); pipeline/tracking turns them into camhead's world.
+struct TrackedPose {
+  double x_m = 0.0, y_m = 0.0, z_m = 0.0;
+  double pan_deg = 0.0, tilt_deg = 0.0, roll_deg = 0.0;
+
+  bool operator==(const TrackedPose &) const = default;
+};
+
 // One reading of whichever axes the source carries. Counts are the encoder's
 // raw units (a quadrature position, a USB board's 32-bit count, FreeD's
 // 24-bit value, OpenTrackIO's normalised encoder scaled by kNormalisedCounts).
@@ -33,6 +44,10 @@ struct EncoderReading {
   // Calibrated values, where the source already knows them (OpenTrackIO's
   // focusDistance / fStop / pinholeFocalLength, a recorded trace).
   std::optional<double> focus_distance_m, f_stop, focal_length_mm;
+
+  // The camera's pose, where the source tracks it (FreeD, OpenTrackIO's
+  // transforms).
+  std::optional<TrackedPose> pose;
 
   bool operator==(const EncoderReading &) const = default;
 };

@@ -3,9 +3,11 @@
 //
 // What a reading carries: focus and zoom as the message's raw 24-bit counts
 // (0 .. 0xFFFFFF, lens_control's profile says what they mean); FreeD D1 has no
-// iris field, so iris stays empty. t_ns is the CLOCK_MONOTONIC instant the
-// kernel received the datagram: D1 carries no timestamp of its own, and the
-// fixed delay of the sender is lens_control's per-source delay correction.
+// iris field, so iris stays empty. The pose is the message's pan, tilt, roll
+// and X, Y, Z (millimetres made metres) as FreeD defines them. t_ns is the
+// CLOCK_MONOTONIC instant the kernel received the datagram: D1 carries no
+// timestamp of its own, and the fixed delay of the sender is the board's
+// per-source delay correction.
 //
 // Status:
 //   connected   a valid D1 message from the selected camera arrived within the

@@ -30,6 +30,8 @@
 #include <string>
 #include <vector>
 
+#include "camhead/hal/lens/lens_encoder.h"
+
 namespace camhead::hal::lens {
 
 inline constexpr std::size_t kOpenTrackIoHeaderSize = 16;
@@ -46,10 +48,28 @@ struct OpenTrackIoTimestamp {
   bool operator==(const OpenTrackIoTimestamp &) const = default;
 };
 
-// The lens part of one sample. Every field the sender left out is empty; a
-// sample with no `lens` object at all parses to all-empty lens fields (a
-// tracker-only sample is valid OpenTrackIO, it just carries no lens data).
-struct OpenTrackIoLens {
+// One entry of a sample's `transforms`: translation (metres) and rotation
+// (pan, tilt, roll in degrees) of a frame relative to the one before it in
+// the list; the first is relative to the stage's origin. `scale` is read as
+// 1 (camhead tracks cameras, which do not scale).
+//
+// Axes, as camdkit describes OpenTrackIO 1.0 (not checked against the SMPTE
+// document itself): right-handed, Z up, Y forward and X right when pan, tilt
+// and roll are 0; rotations intrinsic about Z, X, Y in that order (pan, then
+// tilt, then roll), each positive by the right-hand rule: a positive pan turns
+// the camera to the left, a positive tilt up, a positive roll clockwise as
+// seen from behind the camera.
+struct OpenTrackIoTransform {
+  TrackedPose pose;
+  std::optional<std::string> id = std::nullopt;
+
+  bool operator==(const OpenTrackIoTransform &) const = default;
+};
+
+// What camhead reads of one sample: the lens, the transforms and the timing.
+// Every field the sender left out is empty; a sample with no `lens` object at
+// all parses to all-empty lens fields (a tracker-only sample is valid).
+struct OpenTrackIoSample {
   std::uint16_t header_sequence = 0; // from the binary header, for loss counting
 
   std::optional<double> focus_distance_m;        // lens.focusDistance, > 0
@@ -63,7 +83,9 @@ struct OpenTrackIoLens {
   std::optional<OpenTrackIoTimestamp> sample_timestamp; // timing.sampleTimestamp
   std::optional<std::string> sample_id;                 // sampleId, e.g. "urn:uuid:..."
 
-  bool operator==(const OpenTrackIoLens &) const = default;
+  std::vector<OpenTrackIoTransform> transforms; // in the sample's order
+
+  bool operator==(const OpenTrackIoSample &) const = default;
 };
 
 // Why a datagram was rejected; tests and a receiver's statistics key on this,
@@ -82,14 +104,14 @@ enum class OpenTrackIoError {
   non_finite,           // a number that overflowed to +-infinity
 };
 
-// GCC 12 has no std::expected: lens is set exactly when error is
+// GCC 12 has no std::expected: sample is set exactly when error is
 // OpenTrackIoError::none, and `detail` then is empty.
 struct [[nodiscard]] OpenTrackIoParseResult {
-  std::optional<OpenTrackIoLens> lens;
+  std::optional<OpenTrackIoSample> sample;
   OpenTrackIoError error = OpenTrackIoError::none;
   std::string detail;
 
-  explicit operator bool() const { return lens.has_value(); }
+  explicit operator bool() const { return sample.has_value(); }
 };
 
 // Fletcher-16 with modulus 255 over the concatenation of `first` and
@@ -97,7 +119,7 @@ struct [[nodiscard]] OpenTrackIoParseResult {
 [[nodiscard]] std::uint16_t fletcher16(std::span<const std::uint8_t> first,
                                        std::span<const std::uint8_t> second = {});
 
-// Validates the header and the JSON payload and extracts the lens fields.
+// Validates the header and the JSON payload and extracts the fields above.
 // Never throws and never reads outside `datagram`.
 [[nodiscard]] OpenTrackIoParseResult parse_opentrackio(std::span<const std::uint8_t> datagram);
 
@@ -108,11 +130,17 @@ struct [[nodiscard]] OpenTrackIoParseResult {
 encode_opentrackio_datagram(std::span<const std::uint8_t> payload, std::uint16_t sequence,
                             std::uint8_t encoding = kOpenTrackIoJson);
 
-// Builds a JSON sample with the fields of `lens` that are set (plus the
-// protocol name and version) and wraps it with lens.header_sequence. Fields
+// Builds a JSON sample with the fields of `sample` that are set (plus the
+// protocol name and version) and wraps it with sample.header_sequence. Fields
 // should be finite: the JSON writer turns NaN and infinity into null, which
 // the parser then rejects. Empty when the sample does not fit one datagram.
-[[nodiscard]] std::vector<std::uint8_t> encode_opentrackio(const OpenTrackIoLens &lens);
+[[nodiscard]] std::vector<std::uint8_t> encode_opentrackio(const OpenTrackIoSample &sample);
+
+// The camera's pose relative to the stage: the transforms composed in order
+// (each relative to the one before), in OpenTrackIO's axes and angles; empty
+// for a sample without transforms.
+[[nodiscard]] std::optional<TrackedPose>
+opentrackio_camera_pose(std::span<const OpenTrackIoTransform> transforms);
 
 [[nodiscard]] const char *to_string(OpenTrackIoError error);
 

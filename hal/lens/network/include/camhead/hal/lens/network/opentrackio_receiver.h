@@ -10,13 +10,14 @@
 //   focus_distance_m     lens.focusDistance, as sent
 //   f_stop               lens.fStop, as sent
 //   focal_length_mm      lens.pinholeFocalLength, as sent
+//   pose                 the camera's pose: the sample's transforms composed
+//                        (opentrackio_camera_pose), OpenTrackIO's axes
 //   t_ns                 the CLOCK_MONOTONIC instant the kernel received the
 //                        datagram. timing.sampleTimestamp is the sender's (PTP)
 //                        clock, which this host cannot map without knowing
 //                        the offset; the sender's fixed latency is
 //                        lens_control's per-source delay correction.
-// A sample without any of these fields (tracker data only) is valid but gives
-// no reading.
+// A sample without any of these fields is valid but gives no reading.
 //
 // Status:
 //   connected   a reading arrived within the last `connected_window` (1 s by
@@ -64,7 +65,7 @@ struct OpenTrackIoReceiverConfig {
 
 // The reading for one parsed sample (see the table above), at `t_ns`; empty
 // when the sample carries no lens field. Pure, for tests and tools.
-[[nodiscard]] std::optional<EncoderReading> reading_from_opentrackio(const OpenTrackIoLens &lens,
+[[nodiscard]] std::optional<EncoderReading> reading_from_opentrackio(const OpenTrackIoSample &lens,
                                                                      std::int64_t t_ns);
 
 class OpenTrackIoReceiver final : public LensEncoder {

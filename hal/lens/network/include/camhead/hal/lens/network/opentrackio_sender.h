@@ -34,14 +34,17 @@ struct OpenTrackIoSenderConfig {
   bool multicast_loop = true;
 };
 
-// One lens state as OpenTrackIO describes it. Empty fields are left out of
-// the sample.
-struct OpenTrackIoLensState {
+// One lens state and camera pose as OpenTrackIO describes them. Empty fields
+// are left out of the sample.
+struct OpenTrackIoState {
   std::optional<double> focus_distance_m; // lens.focusDistance, > 0
   std::optional<double> f_stop;           // lens.fStop, > 0
   std::optional<double> focal_length_mm;  // lens.pinholeFocalLength, > 0
   // lens.encoders, normalised [0, 1]; focus 0 is infinity.
   std::optional<double> encoder_focus, encoder_iris, encoder_zoom;
+  // The camera's pose relative to the stage, in OpenTrackIO's axes: sent as
+  // the one transform "Camera".
+  std::optional<TrackedPose> camera;
   // timing.sampleTimestamp on the sender's clock (PTP time on a studio
   // network); left out when empty.
   std::optional<OpenTrackIoTimestamp> timestamp;
@@ -62,7 +65,7 @@ public:
   // the sample does not fit one datagram, or sendto's -errno (-EAGAIN when
   // the socket buffer is full: the sample is dropped, not queued). The reason
   // of the last failure is in last_error().
-  [[nodiscard]] int send(const OpenTrackIoLensState &state);
+  [[nodiscard]] int send(const OpenTrackIoState &state);
 
   // The header sequence number the next sample will carry.
   [[nodiscard]] std::uint16_t next_sequence() const {
