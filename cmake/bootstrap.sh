@@ -16,6 +16,9 @@ packages=(
   libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev libpng-dev
   libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
   libgpiod-dev libusb-1.0-0-dev
+  # The marker pose source's module (pipeline/tracking/opencv): OpenCV 4.6
+  # with contrib's aruco; camhead itself opens the module at run time.
+  libopencv-dev libopencv-contrib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # bench/embree_peer: Embree 3 as the CPU ceiling for ray throughput.
   libembree-dev

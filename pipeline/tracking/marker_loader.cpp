@@ -1,0 +1,99 @@
+// Finds and opens libcamhead_markers.so (marker_tracker.h), as the libcamera
+// camera's loader does: $CAMHEAD_MARKERS_MODULE, beside the executable, the
+// install's lib folder, then the library path. No OpenCV header here.
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <system_error>
+#include <vector>
+
+#include "camhead/hal/shared_library.h"
+#include "marker_module_abi.h"
+#include "marker_tracker.h"
+
+namespace camhead::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char *kModuleName = CAMHEAD_MARKERS_MODULE_NAME;
+// The Debian package whose library the module needs at run time.
+constexpr const char *kOpenCvPackage = "libopencv-contrib406";
+
+std::vector<std::string> candidates(std::string &searched) {
+  if (const char *path = std::getenv("CAMHEAD_MARKERS_MODULE"); path != nullptr && *path) {
+    searched = std::string("$CAMHEAD_MARKERS_MODULE (") + path + ")";
+    return {path};
+  }
+  std::vector<std::string> paths;
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const fs::path dir = exe.parent_path();
+    for (const fs::path &place : {dir, dir / CAMHEAD_MARKERS_MODULE_RELDIR}) {
+      const fs::path file = (place / kModuleName).lexically_normal();
+      if (fs::exists(file, error))
+        paths.push_back(file);
+      searched += (searched.empty() ? "" : ", ") + file.parent_path().string();
+    }
+  }
+  paths.emplace_back(kModuleName);
+  searched += (searched.empty() ? "" : ", ") + std::string("the library path");
+  return paths;
+}
+
+// Opened once and never closed: its trackers run its code until the end.
+marker_module::Module &module() {
+  static std::mutex mutex;
+  static marker_module::Module *opened = nullptr;
+  const std::lock_guard lock(mutex);
+  if (opened != nullptr)
+    return *opened;
+  std::string searched, last_error;
+  for (const std::string &path : candidates(searched)) {
+    auto library = std::make_unique<hal::SharedLibrary>(path, kOpenCvPackage);
+    marker_module::Factory factory = nullptr;
+    library->resolve(marker_module::kFactorySymbol, factory);
+    if (!library->ok()) {
+      last_error = library->error();
+      if (path == kModuleName &&
+          last_error.find(std::string(kModuleName) + ": cannot open shared object file") !=
+              std::string::npos)
+        last_error.clear();
+      if (!last_error.empty())
+        break;
+      continue;
+    }
+    marker_module::Module *instance = factory(marker_module::kAbiVersion);
+    if (instance == nullptr)
+      throw MarkerModuleError(path + ": built for another camhead (module ABI " +
+                              std::to_string(marker_module::kAbiVersion) +
+                              " wanted); rebuild camhead and its markers module together");
+    (void)library.release(); // never closed: see above
+    opened = instance;
+    return *instance;
+  }
+  if (!last_error.empty())
+    throw MarkerModuleError("marker tracking: " + last_error);
+  throw MarkerModuleError(std::string("marker tracking: ") + kModuleName + " is not in " +
+                          searched +
+                          ": camhead builds it where libopencv-contrib-dev is installed, and it "
+                          "needs the Debian package " +
+                          kOpenCvPackage + " to run");
+}
+
+} // namespace
+
+const char *marker_module_name() {
+  return kModuleName;
+}
+
+std::unique_ptr<MarkerTracker> open_marker_tracker(const MarkerBoard &board) {
+  std::string error;
+  std::unique_ptr<MarkerTracker> tracker = module().open(board, error);
+  if (!tracker)
+    throw MarkerModuleError(board.file.string() + ": " + error);
+  return tracker;
+}
+
+} // namespace camhead::pipeline

@@ -1,0 +1,75 @@
+// The camera's pose from the markers in its own picture (issue 25): a
+// ChArUco board or a marker field (marker_board.h) found in the luma plane
+// of the frame that is rendered, with that frame's lens.
+//
+// The detection and the pose solve are OpenCV's (aruco, calib3d), in a
+// module opened at run time (libcamhead_markers.so, built where Debian's
+// libopencv-contrib-dev is installed), so that camhead starts without
+// OpenCV where a board does not ask for markers, as it does without
+// libcamera. Nothing here includes an OpenCV header.
+//
+// Thread safety: a tracker is used by one thread at a time.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "camera_pose.h"
+#include "marker_board.h"
+
+namespace camhead::pipeline {
+
+// A module that cannot be opened, or a board it cannot track.
+class MarkerModuleError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// A frame's luma plane, as captured: 8-bit, rows `stride` bytes apart.
+struct LumaImage {
+  const std::uint8_t *data = nullptr;
+  int width = 0, height = 0;
+  std::ptrdiff_t stride = 0;
+};
+
+// The lens at that frame, in pixels of the luma plane: OpenCV's camera
+// matrix and Brown-Conrady coefficients in its order (k1 k2 p1 p2 k3).
+struct CameraModel {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  std::array<double, 5> distortion{};
+};
+
+struct MarkerPose {
+  bool found = false;           // enough of the board seen for a pose
+  CameraPose pose;              // the camera in the scene's world, when found
+  double reprojection_px = 0.0; // RMS distance of the points used from where the pose puts them
+  int markers_seen = 0;         // the board's markers detected
+  int points_used = 0;          // corners the pose was solved from
+  // A planar target seen nearly head on has two poses that fit almost
+  // equally well (the mirror flip): the one nearer the previous pose was
+  // kept, and the frame is flagged.
+  bool ambiguous = false;
+};
+
+class MarkerTracker {
+public:
+  virtual ~MarkerTracker() = default;
+  // The camera's pose in one picture. `previous`, where there is one, picks
+  // between the two poses of an ambiguous planar view. Never throws.
+  virtual MarkerPose track(const LumaImage &luma, const CameraModel &camera,
+                           const CameraPose *previous) = 0;
+};
+
+// Opens the module (once per process) and makes a tracker for `board`.
+// Throws MarkerModuleError saying what is missing: the module, OpenCV's
+// packages, or a build for another camhead.
+[[nodiscard]] std::unique_ptr<MarkerTracker> open_marker_tracker(const MarkerBoard &board);
+
+// "libcamhead_markers.so".
+[[nodiscard]] const char *marker_module_name();
+
+} // namespace camhead::pipeline

@@ -1,0 +1,225 @@
+// libcamhead_markers.so (tracking/marker_tracker.h): the marker pose source
+// on OpenCV 4.6's aruco and calib3d. Its one exported symbol is the factory
+// (marker_module_abi.h); everything else is hidden.
+//
+// Per picture: the board's markers are detected on the luma plane as it is
+// (no copy, no colour conversion); a ChArUco board's chessboard corners are
+// interpolated from them with the frame's lens (so that a distorting lens
+// does not bend the homography, opencv issue 23873) and refined to
+// sub-pixel; a field gives its markers' four corners. The pose is solved
+// from the corners: IPPE for a planar target (which gives both poses of the
+// planar ambiguity, opencv issue 8813), SQPnP for a field that is not flat,
+// then refined by Levenberg-Marquardt on all points.
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
+#include <opencv2/aruco.hpp>
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "../marker_module_abi.h"
+
+namespace camhead::pipeline {
+namespace {
+
+// Two planar poses whose reprojection errors are this close are both
+// plausible: the frame is ambiguous.
+constexpr double kAmbiguousRatio = 0.7;
+// Half the side of the window a chessboard corner is refined in, pixels.
+constexpr int kMinRefineHalfWindow = 2, kMaxRefineHalfWindow = 8;
+
+cv::Matx33d camera_matrix(const CameraModel &c) {
+  return {c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0};
+}
+
+// The camera pose in the world from OpenCV's (rvec, tvec) of the target's
+// points, and the target's frame in the world (`to_world`, a rotation).
+CameraPose world_pose(const cv::Vec3d &rvec, const cv::Vec3d &tvec, const glm::dmat3 &to_world) {
+  cv::Matx33d r;
+  cv::Rodrigues(rvec, r);
+  const cv::Matx33d rt = r.t();
+  const cv::Vec3d centre = -(rt * tvec);
+  // OpenCV's camera: x right, y down, z ahead; camhead's: x right, y up,
+  // looking along -z. Columns of R^T are the camera's axes in the target's
+  // frame.
+  const glm::dvec3 x(rt(0, 0), rt(1, 0), rt(2, 0));
+  const glm::dvec3 y(rt(0, 1), rt(1, 1), rt(2, 1));
+  const glm::dvec3 z(rt(0, 2), rt(1, 2), rt(2, 2));
+  const glm::dmat3 axes(to_world * x, to_world * -y, to_world * -z);
+  return {to_world * glm::dvec3(centre[0], centre[1], centre[2]),
+          glm::normalize(glm::quat_cast(axes))};
+}
+
+// How far apart two orientations are, radians.
+double angle_between(const glm::dquat &a, const glm::dquat &b) {
+  return 2.0 * std::acos(std::min(1.0, std::abs(glm::dot(a, b))));
+}
+
+bool coplanar(const std::vector<cv::Point3f> &points) {
+  cv::Mat data(int(points.size()), 3, CV_32F, const_cast<cv::Point3f *>(points.data()));
+  cv::PCA pca(data, cv::Mat(), cv::PCA::DATA_AS_ROW);
+  return pca.eigenvalues.at<float>(2) <= 1e-8f * std::max(1.0f, pca.eigenvalues.at<float>(0));
+}
+
+class OpenCvTracker final : public MarkerTracker {
+public:
+  explicit OpenCvTracker(const MarkerBoard &board)
+      : board_(board), dictionary_(cv::aruco::getPredefinedDictionary(board.dictionary)),
+        parameters_(cv::aruco::DetectorParameters::create()) {
+    if (board.type == MarkerBoardType::charuco) {
+      charuco_ =
+          cv::aruco::CharucoBoard::create(board.squares_x, board.squares_y, float(board.square_m),
+                                          float(board.marker_m), dictionary_);
+      // Board coordinates (x right, y down the page, z into it) in the
+      // world: marker_board.h.
+      to_world_ = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, -1, 0));
+    } else {
+      parameters_->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+    }
+  }
+
+  MarkerPose track(const LumaImage &luma, const CameraModel &camera,
+                   const CameraPose *previous) override {
+    try {
+      return track_or_throw(luma, camera, previous);
+    } catch (const std::exception &) {
+      return {}; // OpenCV refused the picture: no pose from it
+    }
+  }
+
+private:
+  MarkerPose track_or_throw(const LumaImage &luma, const CameraModel &camera,
+                            const CameraPose *previous) {
+    const cv::Mat image(luma.height, luma.width, CV_8UC1, const_cast<std::uint8_t *>(luma.data),
+                        std::size_t(luma.stride));
+    const cv::Matx33d k = camera_matrix(camera);
+    const cv::Mat distortion(camera.distortion, false);
+    corners_.clear();
+    ids_.clear();
+    cv::aruco::detectMarkers(image, dictionary_, corners_, ids_, parameters_);
+    MarkerPose out;
+    object_.clear();
+    image_points_.clear();
+    if (charuco_) {
+      out.markers_seen = int(ids_.size());
+      if (ids_.empty())
+        return out;
+      cv::aruco::interpolateCornersCharuco(corners_, ids_, image, charuco_, charuco_corners_,
+                                           charuco_ids_, k, distortion);
+      refine_chessboard_corners(image);
+      for (std::size_t i = 0; i < charuco_ids_.size(); ++i) {
+        object_.push_back(charuco_->chessboardCorners[std::size_t(charuco_ids_[i])]);
+        image_points_.push_back(charuco_corners_[i]);
+      }
+    } else {
+      for (std::size_t i = 0; i < ids_.size(); ++i) {
+        const auto placed = std::find_if(board_.markers.begin(), board_.markers.end(),
+                                         [&](const PlacedMarker &m) { return m.id == ids_[i]; });
+        if (placed == board_.markers.end())
+          continue; // a marker of the dictionary that is not the field's
+        ++out.markers_seen;
+        for (int c = 0; c < 4; ++c) {
+          const glm::dvec3 &p = placed->corners[std::size_t(c)];
+          object_.emplace_back(float(p.x), float(p.y), float(p.z));
+          image_points_.push_back(corners_[i][std::size_t(c)]);
+        }
+      }
+    }
+    out.points_used = int(object_.size());
+    if (object_.size() < 6) // four determine a plane's pose; six give it some redundancy
+      return out;
+
+    std::vector<cv::Vec3d> rvecs, tvecs;
+    std::vector<double> errors;
+    const bool planar = charuco_ || coplanar(object_);
+    cv::solvePnPGeneric(object_, image_points_, k, distortion, rvecs, tvecs, false,
+                        planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_SQPNP, cv::noArray(),
+                        cv::noArray(), errors);
+    if (rvecs.empty())
+      return out;
+    std::size_t chosen = 0;
+    if (rvecs.size() > 1 && errors.size() > 1 && errors[1] > 0.0 &&
+        errors[0] / errors[1] > kAmbiguousRatio) {
+      out.ambiguous = true;
+      if (previous != nullptr) {
+        const auto distance = [&](std::size_t i) {
+          return angle_between(world_pose(rvecs[i], tvecs[i], to_world_).orientation,
+                               previous->orientation);
+        };
+        chosen = distance(1) < distance(0) ? 1 : 0;
+      }
+    }
+    cv::Vec3d rvec = rvecs[chosen], tvec = tvecs[chosen];
+    cv::solvePnPRefineLM(object_, image_points_, k, distortion, rvec, tvec);
+    cv::projectPoints(object_, rvec, tvec, k, distortion, projected_);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < projected_.size(); ++i) {
+      const cv::Point2f d = projected_[i] - image_points_[i];
+      sum += double(d.dot(d));
+    }
+    out.reprojection_px = std::sqrt(sum / double(projected_.size()));
+    out.pose = world_pose(rvec, tvec, to_world_);
+    out.found = true;
+    return out;
+  }
+
+  // interpolateCornersCharuco refines each corner in one fixed window and
+  // stops at 0.1 px. A chessboard corner is an unbiased saddle only while
+  // its window holds nothing else: the markers sit a margin away, which a
+  // board seen at a slant squeezes to a few pixels across the slant. Each
+  // corner is refined again in the largest window that stays clear of the
+  // detected markers' corners, to a thousandth of a pixel.
+  void refine_chessboard_corners(const cv::Mat &image) {
+    for (cv::Point2f &corner : charuco_corners_) {
+      float clear = std::numeric_limits<float>::max();
+      for (const std::vector<cv::Point2f> &marker : corners_)
+        for (const cv::Point2f &m : marker)
+          clear = std::min(clear, std::max(std::abs(m.x - corner.x), std::abs(m.y - corner.y)));
+      const int half = std::clamp(int(clear) - 1, kMinRefineHalfWindow, kMaxRefineHalfWindow);
+      refined_.assign(1, corner);
+      cv::cornerSubPix(
+          image, refined_, cv::Size(half, half), cv::Size(-1, -1),
+          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 0.001));
+      corner = refined_.front();
+    }
+  }
+
+  MarkerBoard board_;
+  cv::Ptr<cv::aruco::Dictionary> dictionary_;
+  cv::Ptr<cv::aruco::DetectorParameters> parameters_;
+  cv::Ptr<cv::aruco::CharucoBoard> charuco_;
+  glm::dmat3 to_world_{1.0}; // a field's points are the world's
+  // Kept between pictures, so that their storage is reused.
+  std::vector<std::vector<cv::Point2f>> corners_;
+  std::vector<int> ids_, charuco_ids_;
+  std::vector<cv::Point2f> charuco_corners_, refined_, image_points_, projected_;
+  std::vector<cv::Point3f> object_;
+};
+
+class OpenCvModule final : public marker_module::Module {
+public:
+  std::unique_ptr<MarkerTracker> open(const MarkerBoard &board, std::string &error) override {
+    try {
+      return std::make_unique<OpenCvTracker>(board);
+    } catch (const std::exception &e) {
+      error = std::string("OpenCV: ") + e.what();
+      return nullptr;
+    }
+  }
+};
+
+} // namespace
+} // namespace camhead::pipeline
+
+extern "C" __attribute__((visibility("default"))) camhead::pipeline::marker_module::Module *
+camhead_markers_module(int abi_version) {
+  static camhead::pipeline::OpenCvModule module;
+  return abi_version == camhead::pipeline::marker_module::kAbiVersion ? &module : nullptr;
+}

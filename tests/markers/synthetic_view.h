@@ -1,0 +1,152 @@
+// Pictures of marker boards as a camera at a known pose sees them, made with
+// OpenCV's own drawing of the board and a perspective warp, supersampled
+// 8x8 (a sensor integrates over its pixels), on a grey floor, in video
+// range, with the sensor's noise: the truth the marker tracker is measured
+// against. Independent of camhead's renderer on purpose.
+//
+// The supersampling sets how finely an edge can sit: the warp samples the
+// page at points, so a sharp edge lands on the supersampled grid, and 4x4
+// moved the board's corners by up to 1/8 px with their phase in the pixel
+// (seen: rows of corners off by +0.15 and -0.06 px). At 8x8 the page's own
+// pixels (1/240 of a square) are wider than the samples, and the warp's
+// linear interpolation makes every edge a ramp the box filter integrates.
+#pragma once
+
+#include <random>
+
+#include <glm/mat3x3.hpp>
+#include <opencv2/aruco.hpp>
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "tracking/marker_board.h"
+#include "tracking/marker_tracker.h"
+
+namespace camhead::pipeline::test {
+
+constexpr int kSupersample = 8;
+
+// OpenCV's camera-from-world rotation and translation for a camhead pose.
+inline void extrinsics(const CameraPose &pose, cv::Matx33d &r, cv::Vec3d &t) {
+  const glm::dmat3 axes = glm::mat3_cast(pose.orientation); // columns: right, up, back
+  const glm::dvec3 x = axes[0], y = -axes[1], z = -axes[2]; // OpenCV: right, down, ahead
+  r = cv::Matx33d(x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z);
+  const cv::Vec3d p(pose.position.x, pose.position.y, pose.position.z);
+  t = -(r * p);
+}
+
+// The camera matrix of the supersampled picture whose pixel blocks average
+// to the picture of `camera`.
+inline cv::Matx33d supersampled(const CameraModel &camera) {
+  const double s = kSupersample, o = (s - 1.0) / 2.0;
+  return {s * camera.fx, 0.0, s * camera.cx + o, 0.0, s * camera.fy, s * camera.cy + o, 0.0,
+          0.0,           1.0};
+}
+
+// The light on the sensor at `size` (video-range luma, not yet quantized)
+// from a supersampled canvas of 0..255 values (128 where nothing was drawn).
+inline cv::Mat expose(const cv::Mat &canvas, cv::Size size) {
+  cv::Mat wide, small;
+  canvas.convertTo(wide, CV_32F, 190.0 / 255.0, 30.0);
+  cv::resize(wide, small, size, 0.0, 0.0, cv::INTER_AREA);
+  return small;
+}
+
+// One frame of that light: Gaussian sensor noise of `noise` digital
+// numbers, quantized to 8 bits.
+inline cv::Mat frame(const cv::Mat &light, double noise, std::mt19937 &random) {
+  cv::Mat out(light.size(), CV_8UC1);
+  std::normal_distribution<double> n(0.0, noise);
+  for (int y = 0; y < light.rows; ++y)
+    for (int x = 0; x < light.cols; ++x)
+      out.at<std::uint8_t>(y, x) =
+          cv::saturate_cast<std::uint8_t>(light.at<float>(y, x) + (noise > 0.0 ? n(random) : 0.0));
+  return out;
+}
+
+// A ChArUco board where marker_board.h puts it, seen from `pose`: the light.
+inline cv::Mat charuco_view(const MarkerBoard &board, const CameraModel &camera,
+                            const CameraPose &pose, cv::Size size) {
+  const auto dictionary = cv::aruco::getPredefinedDictionary(board.dictionary);
+  const auto charuco = cv::aruco::CharucoBoard::create(
+      board.squares_x, board.squares_y, float(board.square_m), float(board.marker_m), dictionary);
+  constexpr int kPixelsPerSquare = 240;
+  cv::Mat page;
+  charuco->draw(cv::Size(board.squares_x * kPixelsPerSquare, board.squares_y * kPixelsPerSquare),
+                page, 0, 1);
+  // The page's pixel (u, v), centres at integers, is board point
+  // ((u + 0.5) a, (v + 0.5) a): its edges are the board's.
+  const double a = board.square_m / kPixelsPerSquare;
+  const cv::Matx33d page_to_board(a, 0.0, 0.5 * a, 0.0, a, 0.5 * a, 0.0, 0.0, 1.0);
+  // Board point (x, y, 0) to world (marker_board.h), then to the camera.
+  cv::Matx33d r;
+  cv::Vec3d t;
+  extrinsics(pose, r, t);
+  const cv::Matx33d board_to_world(1, 0, 0, 0, 0, -1, 0, 1, 0);
+  const cv::Matx33d rb = r * board_to_world;
+  const cv::Matx33d plane(rb(0, 0), rb(0, 1), t[0], rb(1, 0), rb(1, 1), t[1], rb(2, 0), rb(2, 1),
+                          t[2]);
+  const cv::Matx33d h = supersampled(camera) * plane * page_to_board;
+  cv::Mat canvas;
+  cv::warpPerspective(page, canvas, cv::Mat(h),
+                      cv::Size(size.width * kSupersample, size.height * kSupersample),
+                      cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
+  return expose(canvas, size);
+}
+
+// A marker field's markers, each with a white quiet zone of one cell around
+// it, seen from `pose`: the light.
+inline cv::Mat field_view(const MarkerBoard &board, const CameraModel &camera,
+                          const CameraPose &pose, cv::Size size) {
+  const auto dictionary = cv::aruco::getPredefinedDictionary(board.dictionary);
+  const int cells = dictionary->markerSize + 2; // bits and the black border
+  constexpr int kPixelsPerCell = 40;
+  cv::Matx33d r;
+  cv::Vec3d t;
+  extrinsics(pose, r, t);
+  const cv::Matx33d k = supersampled(camera);
+  cv::Mat canvas(size.height * kSupersample, size.width * kSupersample, CV_8UC1, cv::Scalar(128));
+  for (const PlacedMarker &m : board.markers) {
+    cv::Mat marker;
+    cv::aruco::drawMarker(dictionary, m.id, cells * kPixelsPerCell, marker, 1);
+    cv::Mat padded;
+    cv::copyMakeBorder(marker, padded, kPixelsPerCell, kPixelsPerCell, kPixelsPerCell,
+                       kPixelsPerCell, cv::BORDER_CONSTANT, cv::Scalar(255));
+    // The padded square's corners in the world: the marker's, moved out by
+    // one cell of its side.
+    const glm::dvec3 centre = (m.corners[0] + m.corners[2]) / 2.0;
+    const double grow = double(cells + 2) / cells;
+    std::vector<cv::Point3d> world;
+    for (const glm::dvec3 &c : m.corners) {
+      const glm::dvec3 p = centre + grow * (c - centre);
+      world.emplace_back(p.x, p.y, p.z);
+    }
+    std::vector<cv::Point2d> projected;
+    cv::Mat rvec;
+    cv::Rodrigues(cv::Mat(r), rvec);
+    cv::projectPoints(world, rvec, cv::Mat(t), cv::Mat(k), cv::Mat(), projected);
+    const float e = float(padded.cols) - 0.5f, b = -0.5f; // the page's outer edges
+    const cv::Point2f from[4] = {{b, b}, {e, b}, {e, e}, {b, e}};
+    const cv::Point2f to[4] = {projected[0], projected[1], projected[2], projected[3]};
+    const cv::Mat h = cv::getPerspectiveTransform(from, to);
+    cv::Mat warped, mask;
+    cv::warpPerspective(padded, warped, h, canvas.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                        cv::Scalar(0));
+    cv::warpPerspective(cv::Mat(padded.size(), CV_8UC1, cv::Scalar(255)), mask, h, canvas.size(),
+                        cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+    // Blend by coverage, so that the pasted square's edges are antialiased.
+    for (int y = 0; y < canvas.rows; ++y)
+      for (int x = 0; x < canvas.cols; ++x) {
+        const int w = mask.at<std::uint8_t>(y, x);
+        if (w > 0)
+          canvas.at<std::uint8_t>(y, x) =
+              std::uint8_t((warped.at<std::uint8_t>(y, x) * 255 +
+                            canvas.at<std::uint8_t>(y, x) * (255 - w) + 127) /
+                           255);
+      }
+  }
+  return expose(canvas, size);
+}
+
+} // namespace camhead::pipeline::test
