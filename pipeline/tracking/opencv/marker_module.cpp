@@ -73,6 +73,14 @@ public:
   explicit OpenCvTracker(const MarkerBoard &board)
       : board_(board), dictionary_(cv::aruco::getPredefinedDictionary(board.dictionary)),
         parameters_(cv::aruco::DetectorParameters::create()) {
+    // One core: the tracker runs beside the renderer, which has the others.
+    // (A process-wide setting; this module is camhead's only OpenCV user.)
+    cv::setNumThreads(1);
+    // The detector thresholds the picture once per window size, 3, 13 and
+    // 23 px by default; the third pass cost a third of the time and changed
+    // no pose in tests/markers (bench/RESULTS.md: 4.5 -> 2.9 ms at 720x576,
+    // 12.8 -> 8.2 ms at 1920x1080).
+    parameters_->adaptiveThreshWinSizeMax = 13;
     if (board.type == MarkerBoardType::charuco) {
       charuco_ =
           cv::aruco::CharucoBoard::create(board.squares_x, board.squares_y, float(board.square_m),
