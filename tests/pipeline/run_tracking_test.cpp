@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <numbers>
 #include <string>
@@ -131,8 +132,11 @@ TEST_P(RunTracking, APanMovesTheVirtualObjectWhereTheLensPutsIt) {
   }
   for (const double x : still.ball_x)
     EXPECT_NEAR(x, kWidth / 2.0, 0.25) << "pan 0: the ball dead ahead";
-  for (const double x : panned.ball_x)
+  for (const double x : panned.ball_x) {
+    std::printf("%s pan %.0f: ball at %.3f px, the pinhole formula %.3f px\n", type.c_str(),
+                pan_deg, x, expected_x);
     EXPECT_NEAR(x, expected_x, 0.25) << type << " pan " << pan_deg;
+  }
   for (const double fx : panned.forward_x)
     EXPECT_NEAR(fx, std::sin(turn_right_deg * std::numbers::pi / 180.0), 1e-5)
         << "the recorded view";
