@@ -215,8 +215,17 @@ private:
     const std::string type = d.has("type") ? d.at("type").string() : "static";
     if (type == "freed" || type == "opentrackio")
       return read_tracked_pose(d, lens, type);
+    if (type == "marker") {
+      // Found in the frame itself: no delay to correct.
+      d.object({"type", "board"});
+      PoseConfig pose;
+      pose.type = PoseType::marker;
+      pose.marker_board = d.at("board").path();
+      return pose;
+    }
     if (type != "static")
-      d.at("type").fail("unknown pose type \"" + type + "\" (static, freed or opentrackio)");
+      d.at("type").fail("unknown pose type \"" + type +
+                        "\" (static, freed, opentrackio or marker)");
     d.object({"position", "look_at"}, {"type", "up"});
     PoseConfig pose;
     pose.position = vec3(d.at("position"));
@@ -465,6 +474,8 @@ std::string_view pose_type_name(PoseType type) {
     return "freed";
   case PoseType::opentrackio:
     return "opentrackio";
+  case PoseType::marker:
+    return "marker";
   }
   return "static";
 }

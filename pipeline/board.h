@@ -166,7 +166,9 @@ struct CameraConfig {
 // datagrams of one of the board's lens sources of that type (one socket
 // carries both), moved back by `delay_ms`; the scene's camera until the
 // first pose arrives (pipeline/tracking/tracker_axes.h: the axes).
-enum class PoseType { fixed, freed, opentrackio };
+// `marker`: found in each frame's own picture from a marker board
+// (pipeline/tracking/marker_board.h), with that frame's lens.
+enum class PoseType { fixed, freed, opentrackio, marker };
 
 struct PoseConfig {
   PoseType type = PoseType::fixed;
@@ -177,9 +179,16 @@ struct PoseConfig {
   // and how much later than the physical instant its poses are stamped.
   std::string source;
   double delay_ms = 0.0;
+  // A marker pose's board file.
+  std::filesystem::path marker_board;
 };
 
-// "static", "freed", "opentrackio", as board files spell the type.
+// Whether the pose comes in a lens source's datagrams (freed, opentrackio).
+[[nodiscard]] inline bool pose_from_lens_source(PoseType type) {
+  return type == PoseType::freed || type == PoseType::opentrackio;
+}
+
+// "static", "freed", "opentrackio", "marker", as board files spell the type.
 [[nodiscard]] std::string_view pose_type_name(PoseType type);
 
 // The pose as the renderer takes it: float32, `up` made of unit length

@@ -140,7 +140,8 @@ hal::lens::OpenTrackIoState opentrackio_state(const lens_control::LensState &s) 
 
 // The board's camera pose in OpenTrackIO's axes: a static pose as given, a
 // tracker's as it is now (none before its first pose); none for a board
-// without a pose (the scene's camera is not loaded here).
+// without a pose (the scene's camera is not loaded here) or with a marker
+// pose (found in `camhead run`'s frames, not here).
 std::optional<hal::lens::TrackedPose> sent_pose(const pipeline::Board &board,
                                                 const std::vector<LensChannel> &channels,
                                                 std::int64_t now_ns) {
@@ -200,7 +201,7 @@ void monitor(const LensArgs &args) {
     const lens_control::LensProfile loaded = pipeline::load_board_profile(*board);
     profile = loaded.name();
     channels = pipeline::open_lens_channels(*board, loaded);
-    if (board->pose && board->pose->type != pipeline::PoseType::fixed)
+    if (board->pose && pipeline::pose_from_lens_source(board->pose->type))
       for (LensChannel &channel : channels)
         if (channel.config().name == board->pose->source)
           channel.track_pose(board->pose->type, board->pose->delay_ms);

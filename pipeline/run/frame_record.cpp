@@ -30,6 +30,9 @@ std::string json_string(std::string_view text) {
 
 void write_composite_record(std::FILE *out, std::uint64_t output_frame, const FrameRecord &r,
                             std::int64_t output_ns, const RunRecordFields &run) {
+  char reprojection[32] = "null"; // JSON has no NaN: a pose not found in the frame
+  if (std::isfinite(r.reprojection_px))
+    std::snprintf(reprojection, sizeof reprojection, "%.4f", r.reprojection_px);
   std::fprintf(
       out,
       "{\"output_frame\":%" PRIu64 ",\"kind\":\"composite\",\"sequence\":%" PRIu64
@@ -41,7 +44,7 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
       ",\"encode_ms\":%.3f,\"executor\":%s,\"pose_source\":%s,\"pose_fresh\":%s"
       ",\"pose\":{\"position\":[%.7g,%.7g,%.7g],\"forward\":[%.6g,%.6g,%.6g]"
-      ",\"up\":[%.6g,%.6g,%.6g]}}\n",
+      ",\"up\":[%.6g,%.6g,%.6g]},\"markers_seen\":%d,\"reprojection_px\":%s}\n",
       output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns, r.render_start_ns,
       r.render_end_ns, output_ns,
       std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
@@ -49,7 +52,7 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       r.history_samples, r.reprojected_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
       1e3 * r.trace_s, 1e3 * r.encode_s, run.executor.c_str(), run.pose_source.c_str(),
       r.pose_fresh ? "true" : "false", r.position.x, r.position.y, r.position.z, r.forward.x,
-      r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z);
+      r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z, r.markers_seen, reprojection);
 }
 
 } // namespace camhead::pipeline

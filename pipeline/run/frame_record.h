@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -26,6 +27,10 @@ struct FrameRecord {
   // its view direction and the picture's up, as the frame was rendered.
   glm::vec3 position{0.0f}, forward{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
   bool pose_fresh = false; // a tracker's pose current at that instant; a static one always
+  // A marker pose's: the board's markers found in the frame, and the RMS
+  // distance of the corners used from where the pose puts them (NaN: none).
+  int markers_seen = 0;
+  double reprojection_px = std::numeric_limits<double>::quiet_NaN();
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;
   std::uint32_t history_samples = 0;     // samples per pixel the image holds (accumulating; else 0)
@@ -37,7 +42,8 @@ struct FrameRecord {
 
 // What every composite's line of a run says alike, as JSON string values
 // (json_string()): the executor and where the pose comes from ("static",
-// "freed:NAME", "opentrackio:NAME" with the lens source's name).
+// "freed:NAME", "opentrackio:NAME" with the lens source's name,
+// "marker:NAME" with the marker board's).
 struct RunRecordFields {
   std::string executor;
   std::string pose_source;

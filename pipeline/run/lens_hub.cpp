@@ -11,7 +11,7 @@ namespace camhead::pipeline {
 LensHub::LensHub(const Board &board)
     : channels_(open_lens_channels(board)), connected_(channels_.size(), false),
       pose_source_("static") {
-  if (!board.pose || board.pose->type == PoseType::fixed)
+  if (!board.pose || !pose_from_lens_source(board.pose->type))
     return;
   for (std::size_t i = 0; i < channels_.size(); ++i)
     if (channels_[i].config().name == board.pose->source) {

@@ -28,6 +28,7 @@
 #include "lens_camera.h"
 #include "trace_lens.h"
 #include "tracking/camera_pose.h"
+#include "tracking/marker_source.h"
 
 namespace camhead::pipeline {
 
@@ -329,6 +330,16 @@ std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int 
                                        .mode = spec.mode});
   }
   throw OutputError(spec.uri, "unknown output kind");
+}
+
+std::unique_ptr<MarkerPoseSource> open_marker_source(const Board &board,
+                                                     const base::VideoFormat &format,
+                                                     const renderer::FrameCamera &base,
+                                                     const LensHub &lens, bool every_frame) {
+  if (!board.pose || board.pose->type != PoseType::marker)
+    return nullptr;
+  return std::make_unique<MarkerPoseSource>(load_marker_board(board.pose->marker_board), format,
+                                            base, lens, every_frame);
 }
 
 double camera_fps(const CameraSource &camera) {

@@ -19,6 +19,8 @@
 
 namespace camhead::pipeline {
 
+class MarkerPoseSource;
+
 // The board's scene, rendered at the camera's size, without its plate.
 [[nodiscard]] renderer::Scene load_run_scene(const Board &board);
 
@@ -41,6 +43,14 @@ make_renderer(const Board &board, Executor wanted, const renderer::Scene &scene,
 [[nodiscard]] std::unique_ptr<hal::camera::CameraSource>
 open_camera(const Board &board, const renderer::Scene &scene, const renderer::FrameCamera &pose,
             const LensHub &lens, int threads);
+
+// A marker pose's tracker for frames of `format` (its board loaded, the
+// OpenCV module opened: throws MarkerBoardError, MarkerModuleError); null
+// for any other pose. `every_frame`: a take composited offline
+// (marker_source.h).
+[[nodiscard]] std::unique_ptr<MarkerPoseSource>
+open_marker_source(const Board &board, const base::VideoFormat &format,
+                   const renderer::FrameCamera &base, const LensHub &lens, bool every_frame);
 
 // Opens the sink at `width` x `height`, `fps` frames a second (for the
 // formats that carry a rate). Throws OutputError (or the backend's error,

@@ -32,6 +32,7 @@
 #include "run_paths.h"
 #include "run_status.h"
 #include "tracking/camera_pose.h"
+#include "tracking/marker_source.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -84,6 +85,10 @@ private:
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
   // are on their way, and says how long in the record.
   LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
+  // The camera's pose at the frame's mid-exposure: a marker pose found in
+  // the frame (waiting for the tracker as long as for the lens, at most),
+  // a tracker's, or the static one.
+  PoseSnapshot pose_at(std::uint64_t sequence, FrameRecord &record);
   RunSummary finish();
   // Sends one frame to every sink: `frame(i)` is sink i's, sent from where
   // it is (frame_sink.h).
@@ -98,6 +103,9 @@ private:
   const CameraPose rest_pose_;
   LensHub lens_;
   std::unique_ptr<CameraSource> camera_;
+  // A marker pose's tracker (null for any other pose): fed by the capture
+  // thread, asked by the render thread.
+  std::unique_ptr<MarkerPoseSource> markers_;
   double fps_ = 25.0;
   std::unique_ptr<renderer::FrameRenderer> renderer_;
   std::vector<std::unique_ptr<FrameSink>> sinks_;
@@ -136,6 +144,12 @@ std::vector<OutputSpec> output_specs(const RunOptions &options) {
   return specs;
 }
 
+// A take played as fast as it is composited: every frame is rendered.
+bool offline_take(const Board &board) {
+  const auto *file = std::get_if<FileCameraConfig>(&board.camera->kind);
+  return file != nullptr && !file->realtime;
+}
+
 const Board &checked_board(const RunOptions &options) {
   if (!options.board.camera)
     throw std::runtime_error(options.board.file.string() +
@@ -151,11 +165,14 @@ Pipeline::Pipeline(const RunOptions &options)
     : options_(options), board_(checked_board(options)), scene_(load_run_scene(board_)),
       base_camera_(base_camera(board_, scene_)), rest_pose_(pose_of(base_camera_)), lens_(board_),
       camera_(open_camera(board_, scene_, base_camera_, lens_, options.threads)),
+      markers_(
+          open_marker_source(board_, camera_->format(), base_camera_, lens_, offline_take(board_))),
       fps_(camera_fps(*camera_)),
       renderer_(make_renderer(board_, options.executor.value_or(board_.render.executor), scene_,
                               options.threads)),
-      executor_name_(renderer_->executor()), record_fields_{json_string(executor_name_),
-                                                            json_string(lens_.pose_source())} {
+      executor_name_(renderer_->executor()),
+      record_fields_{json_string(executor_name_),
+                     json_string(markers_ ? markers_->name() : lens_.pose_source())} {
   const std::vector<OutputSpec> specs = output_specs(options);
   std::vector<RunPath> paths = run_inputs(board_, scene_);
   for (RunPath &output : run_outputs(specs))
@@ -192,10 +209,12 @@ Pipeline::Pipeline(const RunOptions &options)
   sink_failed_.assign(sinks_.size(), 0);
   for (int i = 0; i < kSlots; ++i)
     (void)free_slots_.push(i);
-  if (const auto *file = std::get_if<FileCameraConfig>(&board_.camera->kind))
-    lossless_ = !file->realtime;
+  lossless_ = offline_take(board_);
   if (options.status != nullptr)
-    status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_);
+    status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_,
+                    markers_ ? markers_->name() : lens_.pose_source());
+  if (markers_)
+    markers_->start();
   // Last: a trace played from the rig's start starts with the run, not a
   // set-up's time (a renderer's kernel compiles) before its first frame.
   lens_.start();
@@ -250,6 +269,8 @@ void Pipeline::capture_loop() {
     if (result != CaptureResult::frame)
       continue;
     ++counters_.frames_in;
+    if (markers_)
+      markers_->submit(frame); // tracked while the frame before renders
     Delivered delivered{{*camera_, frame}, base::monotonic_ns()};
     if (lossless_) {
       // A file played as fast as it is taken: every frame is rendered (a
@@ -302,10 +323,11 @@ void Pipeline::render_loop() {
     r.f_number = lens.state.f_number.value;
     r.focal_length_mm = lens.state.focal_length_mm.value;
     r.lens_fresh = lens.fresh;
-    const PoseSnapshot pose = lens_.pose_at(r.exposure_mid_ns, rest_pose_);
+    const PoseSnapshot pose = pose_at(frame.sequence, r);
     const renderer::FrameCamera posed =
-        lens_.tracks_pose() ? placed(base_camera_, pose.pose) : base_camera_;
+        markers_ || lens_.tracks_pose() ? placed(base_camera_, pose.pose) : base_camera_;
     r.pose_fresh = pose.fresh;
+    counters_.pose_stale = !pose.fresh;
     r.position = posed.position;
     r.forward = glm::normalize(posed.look_at - posed.position);
     r.up = posed.up;
@@ -373,6 +395,18 @@ LensSnapshot Pipeline::lens_at(std::int64_t mid_exposure_ns, FrameRecord &record
   if (!lens.fresh)
     ++counters_.lens_late;
   return lens;
+}
+
+PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
+  if (!markers_)
+    return lens_.pose_at(record.exposure_mid_ns, rest_pose_);
+  const std::int64_t deadline =
+      record.delivered_ns + (lossless_ ? kOfflineLensWaitNs : std::llround(0.5e9 / fps_));
+  const FramePose found =
+      markers_->pose_for(sequence, record.exposure_mid_ns, deadline, rest_pose_);
+  record.markers_seen = found.markers_seen;
+  record.reprojection_px = found.reprojection_px;
+  return {found.pose, found.fresh};
 }
 
 template <typename Frame> void Pipeline::send(Frame frame, std::int64_t capture_ns) {

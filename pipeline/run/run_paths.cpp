@@ -127,6 +127,8 @@ std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene
     inputs.push_back(std::move(input));
   if (board.lens.profile)
     add("the lens profile", *board.lens.profile);
+  if (board.pose && board.pose->type == PoseType::marker)
+    add("the pose's marker board", board.pose->marker_board);
   for (const LensSourceConfig &source : board.lens.sources) {
     const std::string role = "lens source \"" + source.name + "\"'s trace";
     if (const auto *trace = std::get_if<TraceSourceConfig>(&source.kind))

@@ -11,9 +11,10 @@ namespace camhead::pipeline {
 
 RunStatus::RunStatus(std::FILE *out, const hal::camera::CameraSource &camera, const LensHub &lens,
                      const std::vector<std::unique_ptr<hal::output::FrameSink>> &sinks,
-                     const RunCounters &counters, std::string executor)
+                     const RunCounters &counters, std::string executor, std::string pose_source)
     : out_(out), tty_(isatty(fileno(out)) != 0), camera_(camera), lens_(lens), sinks_(sinks),
-      counters_(counters), executor_(std::move(executor)), sink_errors_seen_(sinks.size(), 0) {}
+      counters_(counters), executor_(std::move(executor)), pose_source_(std::move(pose_source)),
+      sink_errors_seen_(sinks.size(), 0) {}
 
 void RunStatus::start() {
   std::fprintf(out_, "camhead run: %s -> %zu output%s, %s, lens %s\n", camera_.name().c_str(),
@@ -37,11 +38,11 @@ void RunStatus::second(std::int64_t now_ns, double dt, std::uint64_t in, std::ui
   char output_errors[48] = "";
   if (const std::uint64_t errors = counters_.sink_errors; errors > 0)
     std::snprintf(output_errors, sizeof output_errors, "  OUTPUT ERRORS %" PRIu64, errors);
-  // A tracker's pose, and whether it is current.
+  // A tracked pose, and whether the last frame's was current.
   char pose[96] = "";
-  if (lens_.tracks_pose())
-    std::snprintf(pose, sizeof pose, "  pose %s%s", lens_.pose_source().c_str(),
-                  lens_.pose_at(now_ns, {}).fresh ? "" : " (stale)");
+  if (pose_source_ != "static")
+    std::snprintf(pose, sizeof pose, "  pose %s%s", pose_source_.c_str(),
+                  counters_.pose_stale ? " (stale)" : "");
   char lens_late[64] = "";
   if (const std::uint64_t late = counters_.lens_late; late > 0)
     std::snprintf(lens_late, sizeof lens_late, " (%" PRIu64 " frames without it)", late);

@@ -24,7 +24,7 @@ public:
   // as the run goes and must outlive this.
   RunStatus(std::FILE *out, const hal::camera::CameraSource &camera, const LensHub &lens,
             const std::vector<std::unique_ptr<hal::output::FrameSink>> &sinks,
-            const RunCounters &counters, std::string executor);
+            const RunCounters &counters, std::string executor, std::string pose_source);
 
   // What runs: the camera, the outputs, the executor, the lens.
   void start();
@@ -46,6 +46,7 @@ private:
   const std::vector<std::unique_ptr<hal::output::FrameSink>> &sinks_;
   const RunCounters &counters_;
   const std::string executor_;
+  const std::string pose_source_;               // "static" is not shown
   std::vector<std::uint64_t> sink_errors_seen_; // reported so far
   std::string camera_detail_seen_;              // reported last
   std::uint64_t camera_errors_seen_ = 0;        // reported so far

@@ -283,8 +283,14 @@ TEST(BoardLive, ATrackersPoseNamesTheSourceThatCarriesIt) {
             PoseType::fixed);
 
   const std::string file = "/rigs/test.json: ";
-  EXPECT_EQ(error_of(board(usb, R"({"type": "marker"})")),
-            file + "pose.type: unknown pose type \"marker\" (static, freed or opentrackio)");
+  EXPECT_EQ(error_of(board(usb, R"({"type": "markers"})")),
+            file + "pose.type: unknown pose type \"markers\" (static, freed, opentrackio or "
+                   "marker)");
+  EXPECT_EQ(error_of(board(usb, R"({"type": "marker"})")), file + "pose.board: missing");
+  EXPECT_EQ(parse_board(board(usb, R"({"type": "marker", "board": "floor.json"})"), "/rigs/b.json")
+                .pose->marker_board,
+            "/rigs/floor.json")
+      << "relative to the board file";
   EXPECT_EQ(error_of(board(usb + ", " + freed, R"({"type": "freed", "source": "lens"})")),
             file + "pose.source: no lens source is named \"lens\": name one of lens.sources, "
                    "of type freed");

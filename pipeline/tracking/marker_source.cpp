@@ -1,0 +1,164 @@
+#include "marker_source.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "camhead/base/thread_name.h"
+#include "luma.h"
+#include "run/lens_hub.h"
+
+namespace camhead::pipeline {
+namespace {
+
+constexpr std::size_t kSlots = 3;   // one tracking, two waiting
+constexpr std::size_t kResults = 8; // frames the renderer may still ask about
+
+} // namespace
+
+MarkerPoseSource::MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
+                                   const renderer::FrameCamera &base, const LensHub &lens,
+                                   bool every_frame)
+    : tracker_(open_marker_tracker(board)), format_(format), sensor_width_mm_(base.sensor_width_mm),
+      lens_(lens), every_frame_(every_frame), name_("marker:" + board.name), slots_(kSlots),
+      results_(kResults) {
+  for (Slot &slot : slots_)
+    slot.luma.resize(std::size_t(format.width) * std::size_t(format.height));
+}
+
+MarkerPoseSource::~MarkerPoseSource() {
+  {
+    const std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  work_.notify_all();
+  freed_.notify_all();
+  if (thread_.joinable())
+    thread_.join();
+}
+
+void MarkerPoseSource::start() {
+  if (!thread_.joinable())
+    thread_ = std::thread([this] {
+      base::name_this_thread("camhead-track");
+      track_loop();
+    });
+}
+
+void MarkerPoseSource::submit(const hal::camera::CapturedFrame &frame) {
+  if (frame.format.width != format_.width || frame.format.height != format_.height)
+    return;
+  Slot *slot = nullptr;
+  {
+    std::unique_lock lock(mutex_);
+    const auto find_free = [&] {
+      for (Slot &s : slots_)
+        if (s.state == SlotState::free)
+          return &s;
+      return static_cast<Slot *>(nullptr);
+    };
+    if (every_frame_)
+      freed_.wait(lock, [&] { return stop_ || find_free() != nullptr; });
+    slot = find_free();
+    if (slot == nullptr) // every slot waiting or tracking: the oldest waiting one gives way
+      for (Slot &s : slots_)
+        if (s.state == SlotState::waiting && (slot == nullptr || s.sequence < slot->sequence))
+          slot = &s;
+    if (slot == nullptr)
+      return;
+    slot->state = SlotState::filling;
+  }
+  copy_luma(frame.format, frame.bytes, slot->luma);
+  {
+    const std::lock_guard lock(mutex_);
+    slot->sequence = frame.sequence;
+    slot->mid_ns = hal::camera::mid_exposure_ns(frame);
+    slot->state = SlotState::waiting;
+  }
+  work_.notify_one();
+}
+
+CameraModel MarkerPoseSource::camera_of(const lens_control::LensState &lens) const {
+  CameraModel camera;
+  camera.fx = camera.fy =
+      lens.projection_focal_length_mm.value * double(format_.width) / sensor_width_mm_;
+  camera.cx = (format_.width - 1) / 2.0;
+  camera.cy = (format_.height - 1) / 2.0;
+  return camera;
+}
+
+void MarkerPoseSource::track_loop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    work_.wait(lock, [this] {
+      return stop_ || std::any_of(slots_.begin(), slots_.end(),
+                                  [](const Slot &s) { return s.state == SlotState::waiting; });
+    });
+    if (stop_)
+      return;
+    // Live, the newest frame, and the ones before it are not tracked (the
+    // renderer skips them too when it is behind); offline, the oldest.
+    Slot *slot = nullptr;
+    for (Slot &s : slots_)
+      if (s.state == SlotState::waiting &&
+          (slot == nullptr ||
+           (every_frame_ ? s.sequence < slot->sequence : s.sequence > slot->sequence)))
+        slot = &s;
+    if (!every_frame_)
+      for (Slot &s : slots_)
+        if (s.state == SlotState::waiting && &s != slot) {
+          results_[next_result_++ % kResults] = {s.sequence, false, {}};
+          s.state = SlotState::free;
+        }
+    slot->state = SlotState::tracking;
+    const std::optional<CameraPose> previous = last_found_;
+    lock.unlock();
+
+    const LumaImage luma{slot->luma.data(), format_.width, format_.height,
+                         std::ptrdiff_t(format_.width)};
+    const lens_control::LensState lens = lens_.state_at(slot->mid_ns).state;
+    MarkerPose found = tracker_->track(luma, camera_of(lens), previous ? &*previous : nullptr);
+    if (found.found) // from the entrance pupil back to the lens's reference plane
+      found.pose.position -= found.pose.forward() * (lens.entrance_pupil_offset_mm.value / 1000.0);
+
+    lock.lock();
+    results_[next_result_++ % kResults] = {slot->sequence, true, found};
+    if (found.found) {
+      (void)found_.push(slot->mid_ns, found.pose);
+      last_found_ = found.pose;
+    }
+    slot->state = SlotState::free;
+    done_.notify_all();
+    freed_.notify_all();
+  }
+}
+
+const MarkerPoseSource::Result *MarkerPoseSource::result_of(std::uint64_t sequence) const {
+  for (const Result &r : results_)
+    if (r.sequence == sequence)
+      return &r;
+  return nullptr;
+}
+
+FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_exposure_ns,
+                                     std::int64_t deadline_ns, const CameraPose &rest) {
+  std::unique_lock lock(mutex_);
+  const auto deadline =
+      std::chrono::steady_clock::time_point(std::chrono::nanoseconds(deadline_ns));
+  (void)done_.wait_until(lock, deadline, [&] { return result_of(sequence) != nullptr; });
+  FramePose out;
+  const Result *result = result_of(sequence);
+  if (result != nullptr && result->tracked) {
+    out.markers_seen = result->pose.markers_seen;
+    if (result->pose.found) {
+      out.pose = result->pose.pose;
+      out.fresh = true;
+      out.reprojection_px = result->pose.reprojection_px;
+      return out;
+    }
+  }
+  const std::optional<PoseAt> predicted = found_.at(mid_exposure_ns);
+  out.pose = predicted ? predicted->pose : rest;
+  return out;
+}
+
+} // namespace camhead::pipeline

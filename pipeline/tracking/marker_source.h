@@ -1,0 +1,120 @@
+// The marker pose source in the live pipeline: each camera frame's pose,
+// found in that frame's own picture (marker_tracker.h) on a thread of its
+// own while the frame before renders, so that there is no tracking delay to
+// calibrate, and never holding the output.
+//
+//   capture thread   submit(frame): the luma plane copied into a free slot
+//                    (the camera's buffer goes back at once); never waits
+//   camhead-track    tracks the newest frame handed over, with the lens at
+//                    its mid-exposure (focal length in pixels from the
+//                    profile's projection focal length: breathing and zoom
+//                    followed), and keeps the result
+//   render thread    pose_for(frame): that frame's result, waiting for it at
+//                    most until a deadline; when it is late or the board was
+//                    not seen, the pose predicted from the frames before
+//                    (PoseTimeline: 20 ms of extrapolation, then held),
+//                    flagged not fresh
+//
+// The found pose is the entrance pupil's (the pinhole of the model the
+// markers are solved with); the renderer's camera is the lens's reference
+// plane, the profile's entrance-pupil offset behind it.
+//
+// Storage is made at construction; submit() and pose_for() allocate
+// nothing. The tracking thread runs OpenCV, which allocates as it detects:
+// it holds no frame and no output waits on it.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "camhead/base/video_format.h"
+#include "camhead/hal/camera/camera_source.h"
+#include "camhead/lens_control/lens_state.h"
+#include "camhead/renderer/frame_camera.h"
+#include "marker_tracker.h"
+#include "pose_timeline.h"
+
+namespace camhead::pipeline {
+
+class LensHub;
+
+// What a frame's pose was, for the renderer and the record.
+struct FramePose {
+  CameraPose pose;
+  bool fresh = false; // found in this very frame
+  int markers_seen = 0;
+  double reprojection_px = std::numeric_limits<double>::quiet_NaN(); // NaN: not found
+};
+
+class MarkerPoseSource {
+public:
+  // Opens the tracking module for `board` (throws MarkerModuleError) and
+  // makes the slots for frames of `format`. `base`: the sensor the lens
+  // projects onto (its width in millimetres). `every_frame`: a take
+  // composited offline, where every frame is rendered: each is tracked, in
+  // order, and submit() waits for a free slot; live, a tracker that falls
+  // behind tracks the newest frame and leaves the ones before it.
+  MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
+                   const renderer::FrameCamera &base, const LensHub &lens, bool every_frame);
+  ~MarkerPoseSource();
+  MarkerPoseSource(const MarkerPoseSource &) = delete;
+  MarkerPoseSource &operator=(const MarkerPoseSource &) = delete;
+
+  void start(); // the tracking thread
+  // Capture thread: hands a frame over. A frame of another size than the
+  // one made for is not tracked (its pose will be predicted). Live, it
+  // never waits (the oldest frame not yet tracked gives way).
+  void submit(const hal::camera::CapturedFrame &frame);
+  // Render thread: frame `sequence`'s pose; waits for the tracker until
+  // `deadline_ns` (CLOCK_MONOTONIC) at most. `rest`: the pose before any was
+  // found.
+  [[nodiscard]] FramePose pose_for(std::uint64_t sequence, std::int64_t mid_exposure_ns,
+                                   std::int64_t deadline_ns, const CameraPose &rest);
+  // "marker:NAME".
+  [[nodiscard]] const std::string &name() const { return name_; }
+
+private:
+  enum class SlotState { free, filling, waiting, tracking };
+  struct Slot {
+    SlotState state = SlotState::free;
+    std::uint64_t sequence = 0;
+    std::int64_t mid_ns = 0;
+    std::vector<std::uint8_t> luma;
+  };
+  struct Result {
+    std::uint64_t sequence = std::numeric_limits<std::uint64_t>::max();
+    bool tracked = false; // false: skipped for a newer frame
+    MarkerPose pose;
+  };
+
+  void track_loop();
+  // The lens as the tracker models it, in pixels of the frame.
+  [[nodiscard]] CameraModel camera_of(const lens_control::LensState &lens) const;
+  [[nodiscard]] const Result *result_of(std::uint64_t sequence) const;
+
+  std::unique_ptr<MarkerTracker> tracker_;
+  const base::VideoFormat format_;
+  const double sensor_width_mm_;
+  const LensHub &lens_;
+  const bool every_frame_;
+  std::string name_;
+
+  std::mutex mutex_;
+  std::condition_variable work_, done_, freed_;
+  std::vector<Slot> slots_;
+  std::vector<Result> results_; // a ring, by sequence
+  std::size_t next_result_ = 0;
+  PoseTimeline found_; // the poses found, for frames without one
+  std::optional<CameraPose> last_found_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+} // namespace camhead::pipeline

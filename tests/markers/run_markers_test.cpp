@@ -1,0 +1,231 @@
+// The marker pose source in `camhead run` (issue 25): a take of a camera
+// dollying and panning over a ChArUco board on the floor, drawn with known
+// poses (synthetic_view.h), played lossless; each frame's recorded pose is
+// the one found in that very frame, within 2 mm and 0.1 degree of the
+// truth, and when the board leaves the picture the frames go out with the
+// pose predicted from the last two found (20 ms of their motion, then held),
+// flagged, with no markers seen.
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <pthread.h>
+
+#include "counting_new.h"
+#include "run/run_loop.h"
+#include "run_test_support.h"
+#include "synthetic_view.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::pipeline {
+namespace {
+
+// The bucket of the calling thread, by the names run_loop.cpp and
+// marker_source.cpp give them.
+int frame_loop_thread() {
+  char name[16] = {};
+  if (pthread_getname_np(pthread_self(), name, sizeof name) != 0)
+    return -1;
+  if (std::strcmp(name, "camhead-render") == 0 || std::strcmp(name, "camhead-worker") == 0)
+    return 0;
+  if (std::strcmp(name, "camhead-output") == 0)
+    return 1;
+  if (std::strcmp(name, "camhead-track") == 0)
+    return 2;
+  return -1;
+}
+
+const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_TEST_MARKERS_MODULE, 0) == 0;
+
+constexpr int kWidth = 640, kHeight = 360;
+constexpr int kBoardFrames = 16, kEmptyFrames = 3;
+const glm::dvec3 kBoardCentre(0.45, 0.0, 0.30);
+
+// Frame k of the move: 1.9 m from the board's centre, swinging from its
+// left to its right while rising, looking at a point that wanders about
+// the centre (a pan on top of the dolly).
+CameraPose truth_at(int k) {
+  const double u = double(k) / (kBoardFrames - 1);
+  const double a = (-35.0 + 70.0 * u) * std::numbers::pi / 180.0;
+  const glm::dvec3 from =
+      kBoardCentre + 1.9 * glm::normalize(glm::dvec3(std::sin(a), 1.0 + 0.3 * u, std::cos(a)));
+  const glm::dvec3 at = kBoardCentre + glm::dvec3(0.08 * std::sin(5.0 * u), 0.0, 0.05 * u);
+  renderer::FrameCamera c;
+  c.position = glm::vec3(from);
+  c.look_at = glm::vec3(at);
+  CameraPose p = pose_of(c);
+  p.position = from;
+  return p;
+}
+
+double degrees_between(const glm::dvec3 &a, const glm::dvec3 &b) {
+  return std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0, 1.0)) * 180.0 /
+         std::numbers::pi;
+}
+
+glm::dvec3 recorded(const std::string &line, const std::string &key) {
+  const std::size_t at = line.find("\"" + key + "\":[");
+  EXPECT_NE(at, std::string::npos) << key << " in " << line;
+  const char *p = line.c_str() + at + key.size() + 4;
+  char *end = nullptr;
+  glm::dvec3 v;
+  v.x = std::strtod(p, &end);
+  v.y = std::strtod(end + 1, &end);
+  v.z = std::strtod(end + 1, &end);
+  return v;
+}
+
+class RunMarkers : public RunLoop {
+protected:
+  // The take, its lens and scene, and a board that finds its pose in it;
+  // `realtime`: played at its 25 fps as a live camera delivers (else
+  // offline, every frame composited).
+  Board take_board(bool realtime) const {
+    const MarkerBoard board = parse_marker_board(
+        R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
+          "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
+        "floor.json");
+    write("floor.json", R"({"format": "camhead-markers", "version": 1, "name": "floor",
+      "type": "charuco", "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1,
+      "marker_m": 0.075})");
+    // The still lens the take was drawn with: 35 mm on 36 mm, from calibrated
+    // values (no profile, so no entrance-pupil offset either).
+    CameraModel camera;
+    camera.fx = camera.fy = 35.0 / 36.0 * kWidth;
+    camera.cx = (kWidth - 1) / 2.0;
+    camera.cy = (kHeight - 1) / 2.0;
+    std::mt19937 random(5);
+    std::vector<std::vector<std::uint8_t>> frames;
+    for (int k = 0; k < kBoardFrames + kEmptyFrames; ++k) {
+      const cv::Mat luma =
+          k < kBoardFrames
+              ? test::frame(test::charuco_view(board, camera, truth_at(k), {kWidth, kHeight}), 1.0,
+                            random)
+              : cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(120)); // the camera looks away
+      std::vector<std::uint8_t> planar(std::size_t(kWidth) * kHeight * 2, 128);
+      std::copy(luma.data, luma.data + std::size_t(kWidth) * kHeight, planar.begin());
+      frames.push_back(std::move(planar));
+    }
+    const fs::path take = write("take.y4m", y4m_422(kWidth, kHeight, frames));
+    const fs::path lens = write("lens.csv", "# camhead lens trace v1\nt_s,focus_m,f_stop,focal_mm\n"
+                                            "0,2,8,35\n1,2,8,35\n");
+    const fs::path scene =
+        write("scene.json", R"({"render": {"width": 640, "height": 360, "samples": 1},
+      "camera": {"position": [0.45, 1.5, 1.5], "look_at": [0.45, 0, 0.3], "up": [0, 1, 0],
+                 "focal_length_mm": 35, "sensor_width_mm": 36, "f_number": 8, "focus_distance_m": 2},
+      "materials": {"grey": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+      "objects": [
+        {"name": "floor", "type": "plane", "center": [0, 0, 0], "size": [10, 10], "material": "grey", "real": true},
+        {"name": "ball", "type": "sphere", "center": [0, 0.05, 0], "radius": 0.05, "material": "grey", "real": false}],
+      "lights": [{"name": "key", "type": "point", "position": [0, 2, 1], "power_W": 100}]})");
+    return load_board(write("board.json", R"({"format": "camhead-board", "version": 1,
+      "name": "markers", "lens": {"sources": [{"type": "trace", "file": ")" +
+                                              lens.string() + R"(", "loop": true}]},
+      "camera": {"type": "file", "path": ")" + take.string() +
+                                              R"(", "loop": false, "realtime": )" +
+                                              (realtime ? "true" : "false") + R"(,
+                 "width": 640, "height": 360},
+      "scene": ")" + scene.string() + R"(",
+      "pose": {"type": "marker", "board": "floor.json"},
+      "render": {"executor": "cpu", "rays_per_pixel": 1}})"));
+  }
+};
+
+TEST_F(RunMarkers, EachFramesPoseIsFoundInThatFrame) {
+  RunOptions options;
+  options.board = take_board(false);
+  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
+  options.stats_file = dir_ / "stats.jsonl";
+  options.frames = kBoardFrames + kEmptyFrames;
+  options.duration_s = 300.0;
+  options.status = nullptr;
+  const RunSummary summary = run_pipeline(options);
+  EXPECT_EQ(summary.frames_out, std::uint64_t(kBoardFrames + kEmptyFrames));
+
+  std::ifstream stats(dir_ / "stats.jsonl");
+  int checked = 0, empty = 0;
+  glm::dvec3 held(0.0);
+  double worst_mm = 0.0, worst_deg = 0.0;
+  for (std::string line; std::getline(stats, line);) {
+    if (line.find("\"kind\":\"composite\"") == std::string::npos)
+      continue;
+    EXPECT_NE(line.find("\"pose_source\":\"marker:floor\""), std::string::npos) << line;
+    const int k = int(json_number(line, "sequence"));
+    const glm::dvec3 position = recorded(line, "position");
+    const glm::dvec3 forward = recorded(line, "forward");
+    if (k < kBoardFrames) {
+      const CameraPose truth = truth_at(k);
+      const double mm = 1000.0 * glm::length(position - truth.position);
+      const double deg = degrees_between(forward, truth.forward());
+      worst_mm = std::max(worst_mm, mm);
+      worst_deg = std::max(worst_deg, deg);
+      EXPECT_NE(line.find("\"pose_fresh\":true"), std::string::npos) << "frame " << k;
+      EXPECT_GT(json_number(line, "markers_seen"), 15.0) << "frame " << k;
+      EXPECT_LT(mm, 2.0) << "frame " << k;
+      EXPECT_LT(deg, 0.1) << "frame " << k;
+      ++checked;
+    } else {
+      // Looking away: predicted from the last two poses found, 20 ms on
+      // (half a frame of this take's 25 fps), then held; flagged.
+      EXPECT_NE(line.find("\"pose_fresh\":false"), std::string::npos) << "frame " << k;
+      EXPECT_NE(line.find("\"markers_seen\":0"), std::string::npos) << "frame " << k;
+      EXPECT_NE(line.find("\"reprojection_px\":null"), std::string::npos) << "frame " << k;
+      const glm::dvec3 last = truth_at(kBoardFrames - 1).position;
+      const glm::dvec3 predicted = last + 0.5 * (last - truth_at(kBoardFrames - 2).position);
+      // Two measured poses extrapolated by half their step: their errors,
+      // 1.5 times over.
+      EXPECT_LT(1000.0 * glm::length(position - predicted), 3.0) << "frame " << k;
+      if (empty > 0) {
+        EXPECT_EQ(position, held) << "frame " << k << ": held";
+      }
+      held = position;
+      ++empty;
+    }
+  }
+  std::printf("%d frames with the board: worst %.3f mm, %.4f deg; %d without\n", checked, worst_mm,
+              worst_deg, empty);
+  EXPECT_EQ(checked, kBoardFrames);
+  EXPECT_EQ(empty, kEmptyFrames);
+}
+
+// Live (the take at its 25 fps), the render and output threads wait for
+// the tracker, never longer than half a frame, and allocate nothing for it
+// (tests/pipeline/run_allocations_test.cpp has the rest of the loop); most
+// frames get the pose found in them.
+TEST_F(RunMarkers, LiveTheRenderThreadWaitsForTheTrackerWithoutAllocating) {
+  RunOptions options;
+  options.board = take_board(true);
+  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
+  options.stats_file = dir_ / "stats.jsonl";
+  options.frames = kBoardFrames;
+  options.duration_s = 60.0;
+  options.threads = 2;
+  options.status = nullptr;
+  camhead::test::counting_new::start(frame_loop_thread);
+  const RunSummary summary = run_pipeline(options);
+  camhead::test::counting_new::stop();
+  EXPECT_EQ(camhead::test::counting_new::count(0), 0u) << "camhead-render and camhead-worker";
+  EXPECT_EQ(camhead::test::counting_new::count(1), 0u) << "camhead-output";
+  EXPECT_GT(camhead::test::counting_new::count(2), 0u)
+      << "camhead-track, OpenCV's: the count sees allocations";
+  int fresh = 0, composites = 0;
+  std::ifstream stats(dir_ / "stats.jsonl");
+  for (std::string line; std::getline(stats, line);)
+    if (line.find("\"kind\":\"composite\"") != std::string::npos) {
+      ++composites;
+      fresh += line.find("\"pose_fresh\":true") != std::string::npos ? 1 : 0;
+    }
+  std::printf("live: %d of %d composites with the pose found in their frame, %llu frames out\n",
+              fresh, composites, (unsigned long long)summary.frames_out);
+  EXPECT_GT(fresh, composites / 2);
+}
+
+} // namespace
+} // namespace camhead::pipeline
