@@ -12,6 +12,8 @@ namespace {
 
 constexpr std::size_t kSlots = 3;   // one tracking, two waiting
 constexpr std::size_t kResults = 8; // frames the renderer may still ask about
+// A pose found longer ago than this is no guide to where the board is now.
+constexpr std::int64_t kFollowWithinNs = 100'000'000;
 
 } // namespace
 
@@ -110,7 +112,11 @@ void MarkerPoseSource::track_loop() {
           s.state = SlotState::free;
         }
     slot->state = SlotState::tracking;
-    const std::optional<CameraPose> previous = last_found_;
+    // The pose predicted for this frame from the last ones found, while
+    // they are recent enough to follow the board from (marker_tracker.h).
+    std::optional<CameraPose> previous;
+    if (found_.size() > 0 && slot->mid_ns - found_.newest_ns() <= kFollowWithinNs)
+      previous = found_.at(slot->mid_ns)->pose;
     lock.unlock();
 
     const LumaImage luma{slot->luma.data(), format_.width, format_.height,
@@ -122,10 +128,8 @@ void MarkerPoseSource::track_loop() {
 
     lock.lock();
     results_[next_result_++ % kResults] = {slot->sequence, true, found};
-    if (found.found) {
+    if (found.found)
       (void)found_.push(slot->mid_ns, found.pose);
-      last_found_ = found.pose;
-    }
     slot->state = SlotState::free;
     done_.notify_all();
     freed_.notify_all();

@@ -53,13 +53,18 @@ struct MarkerPose {
   // equally well (the mirror flip): the one nearer the previous pose was
   // kept, and the frame is flagged.
   bool ambiguous = false;
+  // The board's markers were too blurred (defocus, motion) to read, and its
+  // chessboard corners were followed from where the previous pose put them.
+  bool followed = false;
 };
 
 class MarkerTracker {
 public:
   virtual ~MarkerTracker() = default;
-  // The camera's pose in one picture. `previous`, where there is one, picks
-  // between the two poses of an ambiguous planar view. Never throws.
+  // The camera's pose in one picture. `previous`, where there is one (the
+  // pose predicted for this picture from the last ones found), picks
+  // between the two poses of an ambiguous planar view, and lets a ChArUco
+  // board be followed where its markers cannot be read. Never throws.
   virtual MarkerPose track(const LumaImage &luma, const CameraModel &camera,
                            const CameraPose *previous) = 0;
 };

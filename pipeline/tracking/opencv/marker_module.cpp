@@ -32,6 +32,16 @@ namespace {
 // Two planar poses whose reprojection errors are this close are both
 // plausible: the frame is ambiguous.
 constexpr double kAmbiguousRatio = 0.7;
+// Four points determine a plane's pose; six give it some redundancy.
+constexpr std::size_t kMinPoints = 6;
+// A corner followed from the previous pose: found within this fraction of
+// the board's square (in pixels) of where that pose puts it, in a window
+// whose pixels spread by at least this much (standard deviation, digital
+// numbers).
+constexpr double kFollowReach = 0.3, kFollowContrast = 12.0;
+// At least this many followed corners, fitting one pose this well.
+constexpr std::size_t kMinFollowed = 10;
+constexpr double kMaxFollowedReprojectionPx = 1.0;
 // Half the side of the window a chessboard corner is refined in, pixels.
 constexpr int kMinRefineHalfWindow = 2, kMaxRefineHalfWindow = 8;
 
@@ -55,6 +65,20 @@ CameraPose world_pose(const cv::Vec3d &rvec, const cv::Vec3d &tvec, const glm::d
   const glm::dmat3 axes(to_world * x, to_world * -y, to_world * -z);
   return {to_world * glm::dvec3(centre[0], centre[1], centre[2]),
           glm::normalize(glm::quat_cast(axes))};
+}
+
+// OpenCV's (rvec, tvec) of the target's points for a camera at `pose` in
+// the world: world_pose() undone.
+void extrinsics(const CameraPose &pose, const glm::dmat3 &to_world, cv::Vec3d &rvec,
+                cv::Vec3d &tvec) {
+  const glm::dmat3 axes = glm::mat3_cast(pose.orientation); // right, up, back in the world
+  const glm::dmat3 from_world = glm::transpose(to_world);
+  const glm::dvec3 x = from_world * axes[0], y = from_world * -axes[1],
+                   z = from_world * -axes[2]; // OpenCV's camera axes in the target's frame
+  const cv::Matx33d r(x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z);
+  const glm::dvec3 c = from_world * pose.position;
+  tvec = -(r * cv::Vec3d(c.x, c.y, c.z));
+  cv::Rodrigues(r, rvec);
 }
 
 // How far apart two orientations are, radians.
@@ -113,15 +137,30 @@ private:
     ids_.clear();
     cv::aruco::detectMarkers(image, dictionary_, corners_, ids_, parameters_);
     MarkerPose out;
+    following_ = false;
     object_.clear();
     image_points_.clear();
     if (charuco_) {
       out.markers_seen = int(ids_.size());
-      if (ids_.empty())
-        return out;
-      cv::aruco::interpolateCornersCharuco(corners_, ids_, image, charuco_, charuco_corners_,
-                                           charuco_ids_, k, distortion);
-      refine_chessboard_corners(image);
+      charuco_corners_.clear();
+      charuco_ids_.clear();
+      if (!ids_.empty()) {
+        cv::aruco::interpolateCornersCharuco(corners_, ids_, image, charuco_, charuco_corners_,
+                                             charuco_ids_, k, distortion);
+        refine_chessboard_corners(image);
+      }
+      // Few corners read from the markers: follow the board from the
+      // previous pose instead, where that finds more.
+      if (charuco_ids_.size() < kMinFollowed && previous != nullptr) {
+        read_corners_.swap(charuco_corners_);
+        read_ids_.swap(charuco_ids_);
+        follow_corners(image, k, distortion, *previous);
+        if (charuco_ids_.size() < read_ids_.size()) {
+          read_corners_.swap(charuco_corners_);
+          read_ids_.swap(charuco_ids_);
+          following_ = false;
+        }
+      }
       for (std::size_t i = 0; i < charuco_ids_.size(); ++i) {
         object_.push_back(charuco_->chessboardCorners[std::size_t(charuco_ids_[i])]);
         image_points_.push_back(charuco_corners_[i]);
@@ -141,7 +180,8 @@ private:
       }
     }
     out.points_used = int(object_.size());
-    if (object_.size() < 6) // four determine a plane's pose; six give it some redundancy
+    out.followed = following_;
+    if (object_.size() < kMinPoints)
       return out;
 
     std::vector<cv::Vec3d> rvecs, tvecs;
@@ -173,6 +213,8 @@ private:
       sum += double(d.dot(d));
     }
     out.reprojection_px = std::sqrt(sum / double(projected_.size()));
+    if (following_ && out.reprojection_px > kMaxFollowedReprojectionPx)
+      return out; // the followed corners do not make one board: not it
     out.pose = world_pose(rvec, tvec, to_world_);
     out.found = true;
     return out;
@@ -199,6 +241,64 @@ private:
     }
   }
 
+  // A defocused or moving board keeps its chessboard corners (a blurred X
+  // stays an X, centred where it was) long after its markers' codes are
+  // unreadable (bench/RESULTS.md: from about 3 px of blur on a 5x5 marker
+  // of 26 px). With too few corners found from the markers, each corner is
+  // looked for where the previous pose puts it, refined in a window of a
+  // third of a square, and kept only if it stayed within kFollowReach of a
+  // square of there (so that it cannot jump to its neighbour) in a window
+  // with contrast; the corners kept must make one board (the reprojection
+  // check in track_or_throw). The camera must move less than that between
+  // frames; the pose is then flagged `followed`.
+  void follow_corners(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion,
+                      const CameraPose &previous) {
+    following_ = false;
+    cv::Vec3d rvec, tvec;
+    extrinsics(previous, to_world_, rvec, tvec);
+    cv::projectPoints(charuco_->chessboardCorners, rvec, tvec, k, distortion, predicted_);
+    charuco_corners_.clear();
+    charuco_ids_.clear();
+    const int cols = board_.squares_x - 1;
+    for (std::size_t i = 0; i < predicted_.size(); ++i) {
+      const cv::Point2f p = predicted_[i];
+      // The square's size here: the distance to a neighbouring corner.
+      const std::size_t neighbour = int(i) % cols + 1 < cols ? i + 1 : i - 1;
+      const float square = float(cv::norm(predicted_[neighbour] - p));
+      const int half = std::clamp(int(square / 3.0f), kMinRefineHalfWindow, 24);
+      if (p.x < half + 2 || p.y < half + 2 || p.x > image.cols - half - 3 ||
+          p.y > image.rows - half - 3)
+        continue;
+      refined_.assign(1, p);
+      cv::cornerSubPix(
+          image, refined_, cv::Size(half, half), cv::Size(-1, -1),
+          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 0.001));
+      const cv::Point2f c = refined_.front();
+      if (cv::norm(c - p) > kFollowReach * square || !has_contrast(image, c, half))
+        continue;
+      charuco_corners_.push_back(c);
+      charuco_ids_.push_back(int(i));
+    }
+    if (charuco_ids_.size() < kMinFollowed) {
+      charuco_corners_.clear();
+      charuco_ids_.clear();
+      return;
+    }
+    following_ = true;
+  }
+
+  // Something to refine on around `c`: the window's pixels spread by at
+  // least kFollowContrast (a board's dark and light squares, however
+  // blurred; not the grey of a floor where the board no longer is, on which
+  // cornerSubPix stays where it was put).
+  static bool has_contrast(const cv::Mat &image, cv::Point2f c, int half) {
+    const cv::Rect window(int(std::lround(c.x)) - half, int(std::lround(c.y)) - half, 2 * half + 1,
+                          2 * half + 1);
+    cv::Scalar mean, deviation;
+    cv::meanStdDev(image(window & cv::Rect(0, 0, image.cols, image.rows)), mean, deviation);
+    return deviation[0] >= kFollowContrast;
+  }
+
   MarkerBoard board_;
   cv::Ptr<cv::aruco::Dictionary> dictionary_;
   cv::Ptr<cv::aruco::DetectorParameters> parameters_;
@@ -207,7 +307,10 @@ private:
   // Kept between pictures, so that their storage is reused.
   std::vector<std::vector<cv::Point2f>> corners_;
   std::vector<int> ids_, charuco_ids_;
-  std::vector<cv::Point2f> charuco_corners_, refined_, image_points_, projected_;
+  std::vector<cv::Point2f> charuco_corners_, refined_, image_points_, projected_, predicted_;
+  std::vector<cv::Point2f> read_corners_; // the corners read from the markers, while following
+  std::vector<int> read_ids_;
+  bool following_ = false; // this picture's corners were followed from the previous pose
   std::vector<cv::Point3f> object_;
 };
 
