@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include <glm/geometric.hpp>
+
 #include "camhead/base/thread_name.h"
 #include "luma.h"
 #include "run/lens_hub.h"
@@ -15,6 +17,19 @@ constexpr std::size_t kResults = 8; // frames the renderer may still ask about
 // A pose found longer ago than this is no guide to where the board is now.
 constexpr std::int64_t kFollowWithinNs = 100'000'000;
 
+// The points whose movement in the picture the still filter measures: a
+// ChArUco board's four outer corners, a field's markers' corners.
+std::vector<glm::dvec3> extent_of(const MarkerBoard &board) {
+  if (board.type == MarkerBoardType::charuco) {
+    const double w = board.squares_x * board.square_m, h = board.squares_y * board.square_m;
+    return {board_to_world(0, 0), board_to_world(w, 0), board_to_world(w, h), board_to_world(0, h)};
+  }
+  std::vector<glm::dvec3> corners;
+  for (const PlacedMarker &m : board.markers)
+    corners.insert(corners.end(), m.corners.begin(), m.corners.end());
+  return corners;
+}
+
 } // namespace
 
 MarkerPoseSource::MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
@@ -22,7 +37,7 @@ MarkerPoseSource::MarkerPoseSource(const MarkerBoard &board, const base::VideoFo
                                    bool every_frame)
     : tracker_(open_marker_tracker(board)), format_(format), sensor_width_mm_(base.sensor_width_mm),
       lens_(lens), every_frame_(every_frame), name_("marker:" + board.name), slots_(kSlots),
-      results_(kResults) {
+      results_(kResults), board_extent_(extent_of(board)) {
   for (Slot &slot : slots_)
     slot.luma.resize(std::size_t(format.width) * std::size_t(format.height));
 }
@@ -122,9 +137,14 @@ void MarkerPoseSource::track_loop() {
     const LumaImage luma{slot->luma.data(), format_.width, format_.height,
                          std::ptrdiff_t(format_.width)};
     const lens_control::LensState lens = lens_.state_at(slot->mid_ns).state;
-    MarkerPose found = tracker_->track(luma, camera_of(lens), previous ? &*previous : nullptr);
-    if (found.found) // from the entrance pupil back to the lens's reference plane
+    const CameraModel camera = camera_of(lens);
+    MarkerPose found = tracker_->track(luma, camera, previous ? &*previous : nullptr);
+    if (found.found) {
+      // Held while the camera is still (still_pose.h), then from the
+      // entrance pupil back to the lens's reference plane.
+      found.pose = still_.filter(found.pose, camera.fx, board_extent_);
       found.pose.position -= found.pose.forward() * (lens.entrance_pupil_offset_mm.value / 1000.0);
+    }
 
     lock.lock();
     results_[next_result_++ % kResults] = {slot->sequence, true, found};

@@ -8,7 +8,8 @@
 //   camhead-track    tracks the newest frame handed over, with the lens at
 //                    its mid-exposure (focal length in pixels from the
 //                    profile's projection focal length: breathing and zoom
-//                    followed), and keeps the result
+//                    followed), holds it while the camera is still
+//                    (still_pose.h), and keeps the result
 //   render thread    pose_for(frame): that frame's result, waiting for it at
 //                    most until a deadline; when it is late or the board was
 //                    not seen, the pose predicted from the frames before
@@ -40,6 +41,7 @@
 #include "camhead/renderer/frame_camera.h"
 #include "marker_tracker.h"
 #include "pose_timeline.h"
+#include "still_pose.h"
 
 namespace camhead::pipeline {
 
@@ -111,8 +113,9 @@ private:
   std::vector<Slot> slots_;
   std::vector<Result> results_; // a ring, by sequence
   std::size_t next_result_ = 0;
-  PoseTimeline found_; // the poses found, for frames without one
-  std::optional<CameraPose> last_found_;
+  PoseTimeline found_; // the poses found: the tracker's guide, and frames without one
+  StillPoseFilter still_;
+  std::vector<glm::dvec3> board_extent_; // for the still filter
   bool stop_ = false;
   std::thread thread_;
 };

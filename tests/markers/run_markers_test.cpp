@@ -21,6 +21,7 @@
 #include "run/run_loop.h"
 #include "run_test_support.h"
 #include "synthetic_view.h"
+#include "tracking/still_pose.h"
 
 #include <gtest/gtest.h>
 
@@ -86,8 +87,9 @@ class RunMarkers : public RunLoop {
 protected:
   // The take, its lens and scene, and a board that finds its pose in it;
   // `realtime`: played at its 25 fps as a live camera delivers (else
-  // offline, every frame composited).
-  Board take_board(bool realtime) const {
+  // offline, every frame composited); `locked_off`: the camera stands at
+  // the move's first pose throughout, the board always in view.
+  Board take_board(bool realtime, bool locked_off = false) const {
     const MarkerBoard board = parse_marker_board(
         R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
           "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
@@ -103,9 +105,11 @@ protected:
     camera.cy = (kHeight - 1) / 2.0;
     std::mt19937 random(5);
     std::vector<std::vector<std::uint8_t>> frames;
+    const cv::Mat still = test::charuco_view(board, camera, truth_at(0), {kWidth, kHeight});
     for (int k = 0; k < kBoardFrames + kEmptyFrames; ++k) {
       const cv::Mat luma =
-          k < kBoardFrames
+          locked_off ? test::frame(still, 1.0, random)
+          : k < kBoardFrames
               ? test::frame(test::charuco_view(board, camera, truth_at(k), {kWidth, kHeight}), 1.0,
                             random)
               : cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(120)); // the camera looks away
@@ -193,6 +197,43 @@ TEST_F(RunMarkers, EachFramesPoseIsFoundInThatFrame) {
               worst_deg, empty);
   EXPECT_EQ(checked, kBoardFrames);
   EXPECT_EQ(empty, kEmptyFrames);
+}
+
+// A locked-off camera: each frame's pose is measured afresh and jitters
+// with the sensor's noise by more than the renderer's history allows a
+// still view to move; held while still (still_pose.h), it lets the
+// picture's history grow frame after frame as it does on a static pose.
+TEST_F(RunMarkers, ALockedOffCamerasPoseHoldsStillEnoughToAccumulate) {
+  RunOptions options;
+  options.board = take_board(false, true);
+  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
+  options.stats_file = dir_ / "stats.jsonl";
+  options.frames = kBoardFrames + kEmptyFrames;
+  options.duration_s = 300.0;
+  options.status = nullptr;
+  (void)run_pipeline(options);
+  std::vector<double> history;
+  double worst_mm = 0.0;
+  std::ifstream stats(dir_ / "stats.jsonl");
+  for (std::string line; std::getline(stats, line);)
+    if (line.find("\"kind\":\"composite\"") != std::string::npos) {
+      history.push_back(json_number(line, "history_samples"));
+      worst_mm = std::max(worst_mm,
+                          1000.0 * glm::length(recorded(line, "position") - truth_at(0).position));
+    }
+  ASSERT_EQ(history.size(), std::size_t(kBoardFrames + kEmptyFrames));
+  std::printf("locked off: history %g samples after %zu frames, worst %.3f mm\n", history.back(),
+              history.size(), worst_mm);
+  // The filter averages the first measurements (each a new camera to the
+  // renderer), then holds: from there, one ray a pixel a frame, the history
+  // keeps every frame (a reset would bring it back to 1).
+  const std::size_t settle = StillPoseParams{}.settle;
+  // (The renderer shares some frames' rays by noise: the count a pixel
+  // holds everywhere may stand still for a frame, never fall.)
+  for (std::size_t k = settle; k < history.size(); ++k)
+    EXPECT_GE(history[k], history[k - 1]) << "frame " << k << " started its history afresh";
+  EXPECT_GE(history.back(), double(history.size() - settle));
+  EXPECT_LT(worst_mm, 2.0);
 }
 
 // Live (the take at its 25 fps), the render and output threads wait for
