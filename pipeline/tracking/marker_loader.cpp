@@ -44,11 +44,15 @@ std::vector<std::string> candidates(std::string &searched) {
 
 // Opened once and never closed: its trackers run its code until the end.
 marker_module::Module &module() {
+  struct Opened {
+    hal::SharedLibrary *library; // kept reachable, for leak checkers too
+    marker_module::Module *module;
+  };
   static std::mutex mutex;
-  static marker_module::Module *opened = nullptr;
+  static const Opened *opened = nullptr;
   const std::lock_guard lock(mutex);
   if (opened != nullptr)
-    return *opened;
+    return *opened->module;
   std::string searched, last_error;
   for (const std::string &path : candidates(searched)) {
     auto library = std::make_unique<hal::SharedLibrary>(path, kOpenCvPackage);
@@ -69,8 +73,7 @@ marker_module::Module &module() {
       throw MarkerModuleError(path + ": built for another camhead (module ABI " +
                               std::to_string(marker_module::kAbiVersion) +
                               " wanted); rebuild camhead and its markers module together");
-    (void)library.release(); // never closed: see above
-    opened = instance;
+    opened = new Opened{library.release(), instance}; // never closed: see above
     return *instance;
   }
   if (!last_error.empty())

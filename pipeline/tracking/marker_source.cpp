@@ -134,16 +134,20 @@ void MarkerPoseSource::track_loop() {
       previous = found_.at(slot->mid_ns)->pose;
     lock.unlock();
 
+    // The markers see from the entrance pupil; the renderer's camera, the
+    // still filter and the history of poses are the lens's reference plane,
+    // which stays put while focusing moves the pupil.
+    const lens_control::LensState lens = lens_.state_at(slot->mid_ns).state;
+    const double pupil_m = lens.entrance_pupil_offset_mm.value / 1000.0;
+    if (previous)
+      previous->position += previous->forward() * pupil_m;
     const LumaImage luma{slot->luma.data(), format_.width, format_.height,
                          std::ptrdiff_t(format_.width)};
-    const lens_control::LensState lens = lens_.state_at(slot->mid_ns).state;
     const CameraModel camera = camera_of(lens);
     MarkerPose found = tracker_->track(luma, camera, previous ? &*previous : nullptr);
     if (found.found) {
-      // Held while the camera is still (still_pose.h), then from the
-      // entrance pupil back to the lens's reference plane.
+      found.pose.position -= found.pose.forward() * pupil_m;
       found.pose = still_.filter(found.pose, camera.fx, board_extent_);
-      found.pose.position -= found.pose.forward() * (lens.entrance_pupil_offset_mm.value / 1000.0);
     }
 
     lock.lock();

@@ -18,7 +18,9 @@
 //
 // The found pose is the entrance pupil's (the pinhole of the model the
 // markers are solved with); the renderer's camera is the lens's reference
-// plane, the profile's entrance-pupil offset behind it.
+// plane, the profile's entrance-pupil offset behind it, which stays put
+// while focusing moves the pupil: the still filter and the poses kept are
+// the reference plane's.
 //
 // Storage is made at construction; submit() and pose_for() allocate
 // nothing. The tracking thread runs OpenCV, which allocates as it detects:
