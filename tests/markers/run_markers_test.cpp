@@ -17,6 +17,7 @@
 #include <glm/geometric.hpp>
 #include <pthread.h>
 
+#include "camhead/lens_control/lens_profile.h"
 #include "counting_new.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
@@ -88,8 +89,12 @@ protected:
   // The take, its lens and scene, and a board that finds its pose in it;
   // `realtime`: played at its 25 fps as a live camera delivers (else
   // offline, every frame composited); `locked_off`: the camera stands at
-  // the move's first pose throughout, the board always in view.
-  Board take_board(bool realtime, bool locked_off = false) const {
+  // the move's first pose throughout, the board always in view;
+  // `profiled`: the lens is the example 35 mm prime's profile at 2 m and
+  // f/8 (projection focal length 35.6 mm, entrance pupil 68 mm ahead of the
+  // reference plane the poses are of), else calibrated values of a plain
+  // 35 mm (no profile: no breathing, no pupil offset).
+  Board take_board(bool realtime, bool locked_off = false, bool profiled = false) const {
     const MarkerBoard board = parse_marker_board(
         R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
           "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
@@ -97,29 +102,49 @@ protected:
     write("floor.json", R"({"format": "camhead-markers", "version": 1, "name": "floor",
       "type": "charuco", "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1,
       "marker_m": 0.075})");
-    // The still lens the take was drawn with: 35 mm on 36 mm, from calibrated
-    // values (no profile, so no entrance-pupil offset either).
+    // The still lens the take was drawn with, seen from its entrance pupil.
+    double focal_mm = 35.0, pupil_m = 0.0;
+    if (profiled) {
+      lens_control::LensCounts counts;
+      counts.focus = lens_control::AxisReading{9400.0, 0, true}; // 2 m
+      counts.iris = lens_control::AxisReading{3100.0, 0, true};  // f/8
+      const lens_control::LensState state =
+          lens_control::LensProfile::load(kLenses / "example_35mm.json").evaluate(counts);
+      focal_mm = state.projection_focal_length_mm.value;
+      pupil_m = state.entrance_pupil_offset_mm.value / 1000.0;
+    }
+    const auto pupil_at = [pupil_m](CameraPose pose) {
+      pose.position += pose.forward() * pupil_m;
+      return pose;
+    };
     CameraModel camera;
-    camera.fx = camera.fy = 35.0 / 36.0 * kWidth;
+    camera.fx = camera.fy = focal_mm / 36.0 * kWidth;
     camera.cx = (kWidth - 1) / 2.0;
     camera.cy = (kHeight - 1) / 2.0;
     std::mt19937 random(5);
     std::vector<std::vector<std::uint8_t>> frames;
-    const cv::Mat still = test::charuco_view(board, camera, truth_at(0), {kWidth, kHeight});
+    const cv::Mat still =
+        test::charuco_view(board, camera, pupil_at(truth_at(0)), {kWidth, kHeight});
     for (int k = 0; k < kBoardFrames + kEmptyFrames; ++k) {
       const cv::Mat luma =
           locked_off ? test::frame(still, 1.0, random)
           : k < kBoardFrames
-              ? test::frame(test::charuco_view(board, camera, truth_at(k), {kWidth, kHeight}), 1.0,
-                            random)
+              ? test::frame(
+                    test::charuco_view(board, camera, pupil_at(truth_at(k)), {kWidth, kHeight}),
+                    1.0, random)
               : cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(120)); // the camera looks away
       std::vector<std::uint8_t> planar(std::size_t(kWidth) * kHeight * 2, 128);
       std::copy(luma.data, luma.data + std::size_t(kWidth) * kHeight, planar.begin());
       frames.push_back(std::move(planar));
     }
     const fs::path take = write("take.y4m", y4m_422(kWidth, kHeight, frames));
-    const fs::path lens = write("lens.csv", "# camhead lens trace v1\nt_s,focus_m,f_stop,focal_mm\n"
-                                            "0,2,8,35\n1,2,8,35\n");
+    const fs::path lens =
+        profiled ? write("lens.csv", "# camhead lens trace v1\nt_s,focus,iris\n"
+                                     "0,9400,3100\n0.5,9400,3100\n1,9400,3100\n")
+                 : write("lens.csv", "# camhead lens trace v1\nt_s,focus_m,f_stop,focal_mm\n"
+                                     "0,2,8,35\n1,2,8,35\n");
+    const std::string profile =
+        profiled ? R"("profile": ")" + (kLenses / "example_35mm.json").string() + R"(", )" : "";
     const fs::path scene =
         write("scene.json", R"({"render": {"width": 640, "height": 360, "samples": 1},
       "camera": {"position": [0.45, 1.5, 1.5], "look_at": [0.45, 0, 0.3], "up": [0, 1, 0],
@@ -130,7 +155,8 @@ protected:
         {"name": "ball", "type": "sphere", "center": [0, 0.05, 0], "radius": 0.05, "material": "grey", "real": false}],
       "lights": [{"name": "key", "type": "point", "position": [0, 2, 1], "power_W": 100}]})");
     return load_board(write("board.json", R"({"format": "camhead-board", "version": 1,
-      "name": "markers", "lens": {"sources": [{"type": "trace", "file": ")" +
+      "name": "markers", "lens": {)" + profile +
+                                              R"("sources": [{"type": "trace", "file": ")" +
                                               lens.string() + R"(", "loop": true}]},
       "camera": {"type": "file", "path": ")" + take.string() +
                                               R"(", "loop": false, "realtime": )" +
@@ -142,9 +168,15 @@ protected:
   }
 };
 
-TEST_F(RunMarkers, EachFramesPoseIsFoundInThatFrame) {
+class RunMarkersLens : public RunMarkers, public testing::WithParamInterface<bool> {};
+
+// With the lens's profile, the tracker sees through its projection focal
+// length (breathing) and from its entrance pupil, 68 mm ahead of the
+// reference plane the record's pose is of: left out, the pose would be
+// 68 mm off along the view.
+TEST_P(RunMarkersLens, EachFramesPoseIsFoundInThatFrame) {
   RunOptions options;
-  options.board = take_board(false);
+  options.board = take_board(false, false, GetParam());
   options.outputs = {"file:" + (dir_ / "out.y4m").string()};
   options.stats_file = dir_ / "stats.jsonl";
   options.frames = kBoardFrames + kEmptyFrames;
@@ -198,6 +230,11 @@ TEST_F(RunMarkers, EachFramesPoseIsFoundInThatFrame) {
   EXPECT_EQ(checked, kBoardFrames);
   EXPECT_EQ(empty, kEmptyFrames);
 }
+
+INSTANTIATE_TEST_SUITE_P(Lenses, RunMarkersLens, testing::Bool(),
+                         [](const testing::TestParamInfo<bool> &lens) {
+                           return std::string(lens.param ? "Profiled" : "CalibratedValues");
+                         });
 
 // A locked-off camera: each frame's pose is measured afresh and jitters
 // with the sensor's noise by more than the renderer's history allows a
