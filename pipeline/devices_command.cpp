@@ -10,6 +10,7 @@
 #include "camhead/hal/lens/usb/usb_lens_protocol.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "commands.h"
+#include "tracking/marker_tracker.h"
 
 namespace camhead::cli {
 namespace {
@@ -94,6 +95,20 @@ void list_lens_encoders() {
                 "listen on UDP and need no device\n");
 }
 
+void list_pose_sources() {
+  std::printf("Camera pose (board \"pose\"):\n"
+              "  {\"type\": \"static\", \"position\": ..., \"look_at\": ...}\n"
+              "  {\"type\": \"freed\" or \"opentrackio\"}  a tracker's, in the datagrams of "
+              "a lens source of that type\n");
+  const std::string problem = pipeline::marker_module_problem();
+  if (problem.empty())
+    std::printf("  {\"type\": \"marker\", \"board\": \"MARKERS.json\"}  found in the "
+                "frames (%s loads)\n",
+                pipeline::marker_module_name());
+  else
+    std::printf("  marker: not here: %s\n", problem.c_str());
+}
+
 int list_vulkan() {
   try {
     const auto devices = renderer::list_gpu_devices();
@@ -114,6 +129,7 @@ int list_devices() {
   list_video(discovery::list_video_nodes());
   list_displays(discovery::list_display_cards());
   list_lens_encoders();
+  list_pose_sources();
   return list_vulkan();
 }
 
@@ -128,8 +144,9 @@ void set_exit_code(int code) {
 
 void add_devices_command(CLI::App &app) {
   CLI::App *cmd = app.add_subcommand(
-      "devices", "List the cameras, webcam and display outputs, lens encoders and Vulkan\n"
-                 "devices this machine has, with the board field or option that uses each");
+      "devices", "List the cameras, webcam and display outputs, lens encoders, camera pose\n"
+                 "sources and Vulkan devices this machine has, with the board field or\n"
+                 "option that uses each");
   cmd->callback([] { set_exit_code(list_devices()); });
 }
 

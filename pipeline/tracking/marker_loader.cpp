@@ -91,6 +91,15 @@ const char *marker_module_name() {
   return kModuleName;
 }
 
+std::string marker_module_problem() {
+  try {
+    (void)module();
+    return {};
+  } catch (const MarkerModuleError &e) {
+    return e.what();
+  }
+}
+
 std::unique_ptr<MarkerTracker> open_marker_tracker(const MarkerBoard &board) {
   std::string error;
   std::unique_ptr<MarkerTracker> tracker = module().open(board, error);

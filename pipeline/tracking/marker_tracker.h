@@ -76,5 +76,8 @@ public:
 
 // "libcamhead_markers.so".
 [[nodiscard]] const char *marker_module_name();
+// Why marker tracking cannot run here (the module or OpenCV missing, a
+// module of another build), or empty where it can: opens the module.
+[[nodiscard]] std::string marker_module_problem();
 
 } // namespace camhead::pipeline
