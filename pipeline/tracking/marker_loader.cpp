@@ -1,12 +1,11 @@
 // Finds and opens libcamhead_markers.so (marker_tracker.h), as the libcamera
 // camera's loader does: $CAMHEAD_MARKERS_MODULE, beside the executable, the
 // install's lib folder, then the library path. No OpenCV header here.
-#include <cstdlib>
-#include <filesystem>
+#include <memory>
 #include <mutex>
-#include <system_error>
-#include <vector>
+#include <string>
 
+#include "camhead/hal/module_search.h"
 #include "camhead/hal/shared_library.h"
 #include "marker_module_abi.h"
 #include "marker_tracker.h"
@@ -14,33 +13,9 @@
 namespace camhead::pipeline {
 namespace {
 
-namespace fs = std::filesystem;
-
 constexpr const char *kModuleName = CAMHEAD_MARKERS_MODULE_NAME;
 // The Debian package whose library the module needs at run time.
 constexpr const char *kOpenCvPackage = "libopencv-contrib406";
-
-std::vector<std::string> candidates(std::string &searched) {
-  if (const char *path = std::getenv("CAMHEAD_MARKERS_MODULE"); path != nullptr && *path) {
-    searched = std::string("$CAMHEAD_MARKERS_MODULE (") + path + ")";
-    return {path};
-  }
-  std::vector<std::string> paths;
-  std::error_code error;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
-  if (!error) {
-    const fs::path dir = exe.parent_path();
-    for (const fs::path &place : {dir, dir / CAMHEAD_MARKERS_MODULE_RELDIR}) {
-      const fs::path file = (place / kModuleName).lexically_normal();
-      if (fs::exists(file, error))
-        paths.push_back(file);
-      searched += (searched.empty() ? "" : ", ") + file.parent_path().string();
-    }
-  }
-  paths.emplace_back(kModuleName);
-  searched += (searched.empty() ? "" : ", ") + std::string("the library path");
-  return paths;
-}
 
 // Opened once and never closed: its trackers run its code until the end.
 marker_module::Module &module() {
@@ -53,16 +28,16 @@ marker_module::Module &module() {
   const std::lock_guard lock(mutex);
   if (opened != nullptr)
     return *opened->module;
-  std::string searched, last_error;
-  for (const std::string &path : candidates(searched)) {
+  const hal::ModuleSearch search =
+      hal::module_search("CAMHEAD_MARKERS_MODULE", kModuleName, CAMHEAD_MARKERS_MODULE_RELDIR);
+  std::string last_error;
+  for (const std::string &path : search.candidates) {
     auto library = std::make_unique<hal::SharedLibrary>(path, kOpenCvPackage);
     marker_module::Factory factory = nullptr;
     library->resolve(marker_module::kFactorySymbol, factory);
     if (!library->ok()) {
       last_error = library->error();
-      if (path == kModuleName &&
-          last_error.find(std::string(kModuleName) + ": cannot open shared object file") !=
-              std::string::npos)
+      if (path == kModuleName && hal::module_not_installed(last_error, kModuleName))
         last_error.clear();
       if (!last_error.empty())
         break;
@@ -79,7 +54,7 @@ marker_module::Module &module() {
   if (!last_error.empty())
     throw MarkerModuleError("marker tracking: " + last_error);
   throw MarkerModuleError(std::string("marker tracking: ") + kModuleName + " is not in " +
-                          searched +
+                          search.searched +
                           ": camhead builds it where libopencv-contrib-dev is installed, and it "
                           "needs the Debian package " +
                           kOpenCvPackage + " to run");

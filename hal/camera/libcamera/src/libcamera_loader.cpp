@@ -2,49 +2,22 @@
 // factory. Linked into camhead, which must not need libcamera itself: this
 // file includes no libcamera header.
 #include <cstdlib>
-#include <filesystem>
 #include <map>
+#include <memory>
 #include <mutex>
-#include <system_error>
+#include <string>
 
 #include "camhead/hal/camera/libcamera/libcamera_camera.h"
+#include "camhead/hal/module_search.h"
 #include "camhead/hal/shared_library.h"
 #include "module_abi.h"
 
 namespace camhead::hal::camera {
 namespace {
 
-namespace fs = std::filesystem;
-
 constexpr const char *kModuleName = CAMHEAD_LIBCAMERA_MODULE_NAME;
 // The Debian package the module needs at run time (libcamera.so.0.0.3).
 constexpr const char *kLibcameraPackage = "libcamera0.0.3";
-
-// Where the module may be, in the order it is looked for: the environment's
-// override, beside the executable (the build tree: build/camhead), the
-// install layout's lib folder relative to bin, then the loader's own search
-// (LD_LIBRARY_PATH, ld.so.cache), which dlopen does for a bare name.
-std::vector<std::string> candidates(std::string &searched) {
-  if (const char *path = std::getenv("CAMHEAD_LIBCAMERA_MODULE"); path != nullptr && *path) {
-    searched = std::string("$CAMHEAD_LIBCAMERA_MODULE (") + path + ")";
-    return {path};
-  }
-  std::vector<std::string> paths;
-  std::error_code error;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
-  if (!error) {
-    const fs::path dir = exe.parent_path();
-    for (const fs::path &place : {dir, dir / CAMHEAD_LIBCAMERA_MODULE_RELDIR}) {
-      const fs::path file = (place / kModuleName).lexically_normal();
-      if (fs::exists(file, error))
-        paths.push_back(file);
-      searched += (searched.empty() ? "" : ", ") + file.parent_path().string();
-    }
-  }
-  paths.emplace_back(kModuleName);
-  searched += (searched.empty() ? "" : ", ") + std::string("the library path");
-  return paths;
-}
 
 // The module's factory table, opened once per file and never closed: the
 // cameras it made run its code until the process ends.
@@ -56,13 +29,14 @@ libcamera_module::Module &module() {
   static std::mutex mutex;
   static auto *const opened = new std::map<std::string, Opened>;
   const std::lock_guard lock(mutex);
-  std::string searched;
+  const ModuleSearch search =
+      module_search("CAMHEAD_LIBCAMERA_MODULE", kModuleName, CAMHEAD_LIBCAMERA_MODULE_RELDIR);
   std::string last_error;
   // libcamera logs every start at INFO on stderr, into the middle of
   // camhead's own output, and reads its levels once, as it loads: warnings
   // and errors only, unless the user set LIBCAMERA_LOG_LEVELS.
   setenv("LIBCAMERA_LOG_LEVELS", "*:WARN", 0);
-  for (const std::string &path : candidates(searched)) {
+  for (const std::string &path : search.candidates) {
     if (const auto it = opened->find(path); it != opened->end())
       return *it->second.module;
     auto library = std::make_unique<SharedLibrary>(path, kLibcameraPackage);
@@ -73,9 +47,7 @@ libcamera_module::Module &module() {
       // A bare name that dlopen did not find means the module is not
       // installed; a file that exists but does not load is worth its own
       // message (its libcamera is missing or another version).
-      if (path == kModuleName &&
-          last_error.find(std::string(kModuleName) + ": cannot open shared object file") !=
-              std::string::npos)
+      if (path == kModuleName && module_not_installed(last_error, kModuleName))
         last_error.clear();
       if (!last_error.empty())
         break;
@@ -92,7 +64,7 @@ libcamera_module::Module &module() {
   if (!last_error.empty())
     throw LibcameraCameraError("libcamera backend: " + last_error);
   throw LibcameraCameraError(std::string("libcamera backend: ") + kModuleName + " is not in " +
-                             searched +
+                             search.searched +
                              ": camhead builds it where libcamera-dev is installed, and it "
                              "needs the Debian package " +
                              kLibcameraPackage + " to run");
