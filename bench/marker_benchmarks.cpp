@@ -21,8 +21,7 @@ namespace {
 
 using namespace camhead::pipeline;
 
-const bool kModuleFound =
-    setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_BENCH_MARKERS_MODULE, 0) == 0;
+const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_BENCH_MARKERS_MODULE, 0) == 0;
 
 void Track(benchmark::State &state) {
   const int width = int(state.range(0)), height = int(state.range(1));

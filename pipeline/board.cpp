@@ -129,8 +129,10 @@ private:
     };
     if (type == "sim") {
       d.object({"type"}, with_common({"fps", "samples", "cache_mb", "disconnect_after_frames",
-                                      "disconnect_s", "disconnect_silently"}));
+                                      "disconnect_s", "disconnect_silently", "path"}));
       SimCameraConfig sim;
+      if (d.has("path"))
+        sim.path = d.at("path").path();
       if (d.has("fps"))
         sim.fps = d.at("fps").number(Range::within(1.0, 240.0));
       if (d.has("samples"))
@@ -215,6 +217,13 @@ private:
     const std::string type = d.has("type") ? d.at("type").string() : "static";
     if (type == "freed" || type == "opentrackio")
       return read_tracked_pose(d, lens, type);
+    if (type == "trace") {
+      d.object({"type", "file"});
+      PoseConfig pose;
+      pose.type = PoseType::trace;
+      pose.trace = d.at("file").path();
+      return pose;
+    }
     if (type == "marker") {
       // Found in the frame itself: no delay to correct.
       d.object({"type", "board"});
@@ -225,7 +234,7 @@ private:
     }
     if (type != "static")
       d.at("type").fail("unknown pose type \"" + type +
-                        "\" (static, freed, opentrackio or marker)");
+                        "\" (static, freed, opentrackio, marker or trace)");
     d.object({"position", "look_at"}, {"type", "up"});
     PoseConfig pose;
     pose.position = vec3(d.at("position"));
@@ -476,6 +485,8 @@ std::string_view pose_type_name(PoseType type) {
     return "opentrackio";
   case PoseType::marker:
     return "marker";
+  case PoseType::trace:
+    return "trace";
   }
   return "static";
 }

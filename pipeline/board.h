@@ -124,6 +124,9 @@ struct SimCameraConfig {
   std::optional<std::uint64_t> disconnect_after_frames;
   double disconnect_s = 1.0;
   bool disconnect_silently = false;
+  // A camera path (pipeline/tracking/pose_trace.h) the camera moves along;
+  // else it stands at the board's pose.
+  std::optional<std::filesystem::path> path;
 };
 
 // A Y4M video or PNG sequence played as the camera (hal/camera/file).
@@ -167,8 +170,10 @@ struct CameraConfig {
 // carries both), moved back by `delay_ms`; the scene's camera until the
 // first pose arrives (pipeline/tracking/tracker_axes.h: the axes).
 // `marker`: found in each frame's own picture from a marker board
-// (pipeline/tracking/marker_board.h), with that frame's lens.
-enum class PoseType { fixed, freed, opentrackio, marker };
+// (pipeline/tracking/marker_board.h), with that frame's lens. `trace`: a
+// camera path (pipeline/tracking/pose_trace.h) at each frame's mid-exposure,
+// a perfect tracker (the simulated camera's own path is its truth).
+enum class PoseType { fixed, freed, opentrackio, marker, trace };
 
 struct PoseConfig {
   PoseType type = PoseType::fixed;
@@ -179,8 +184,9 @@ struct PoseConfig {
   // and how much later than the physical instant its poses are stamped.
   std::string source;
   double delay_ms = 0.0;
-  // A marker pose's board file.
+  // A marker pose's board file; a trace pose's path.
   std::filesystem::path marker_board;
+  std::filesystem::path trace;
 };
 
 // Whether the pose comes in a lens source's datagrams (freed, opentrackio).
@@ -188,7 +194,8 @@ struct PoseConfig {
   return type == PoseType::freed || type == PoseType::opentrackio;
 }
 
-// "static", "freed", "opentrackio", "marker", as board files spell the type.
+// "static", "freed", "opentrackio", "marker", "trace", as board files spell
+// the type.
 [[nodiscard]] std::string_view pose_type_name(PoseType type);
 
 // The pose as the renderer takes it: float32, `up` made of unit length

@@ -29,6 +29,7 @@
 #include "trace_lens.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
+#include "tracking/pose_trace.h"
 
 namespace camhead::pipeline {
 
@@ -170,8 +171,9 @@ void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &fo
 // at each exposure's middle, rendered by its own frame renderer, with a new
 // noise pattern every frame as a sensor has. The lens is the physical truth
 // where the board's trace gives it (trace_lens.h), else what the lens chain
-// says. It films from the board's pose: a tracker's moves it (the simulated
-// world is where the tracker says the camera is).
+// says. It films from its path where it has one (the physical truth of a
+// moving rig), else from the board's pose: a tracker's moves it (the
+// simulated world is where the tracker says the camera is).
 std::unique_ptr<CameraSource>
 open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
                 const renderer::Scene &scene, const renderer::FrameCamera &pose,
@@ -186,12 +188,18 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
   const std::uint32_t samples = sim.samples;
   auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
   explain_world_cache(sim, format, truth, *cache);
+  std::optional<PoseTrace> path;
+  if (sim.path)
+    path = load_pose_trace(*sim.path);
   auto generator = [world, cache, format, pose, rest = pose_of(pose), samples, &lens,
-                    truth = std::move(truth)](std::int64_t start_ns, std::int64_t exposure_ns,
-                                              std::span<std::uint8_t> out) {
+                    truth = std::move(truth),
+                    path = std::move(path)](std::int64_t start_ns, std::int64_t exposure_ns,
+                                            std::span<std::uint8_t> out) {
     const std::int64_t mid = start_ns + exposure_ns / 2;
-    const renderer::FrameCamera posed =
-        lens.tracks_pose() ? placed(pose, lens.pose_at(mid, rest).pose) : pose;
+    const renderer::FrameCamera posed = path ? placed(pose, path->at(mid))
+                                        : lens.tracks_pose()
+                                            ? placed(pose, lens.pose_at(mid, rest).pose)
+                                            : pose;
     renderer::FrameRequest request;
     request.camera = lens_camera(posed, truth ? truth->state_at(mid) : lens.state_at(mid).state);
     if (cache->copy(request.camera, out))

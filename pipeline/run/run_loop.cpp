@@ -33,6 +33,7 @@
 #include "run_status.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
+#include "tracking/pose_trace.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -89,6 +90,9 @@ private:
   // the frame (waiting for the tracker as long as for the lens, at most),
   // a tracker's, or the static one.
   PoseSnapshot pose_at(std::uint64_t sequence, FrameRecord &record);
+  // "static", "freed:NAME", "marker:NAME", "trace:FILE" for the record and
+  // the status line.
+  [[nodiscard]] std::string pose_source_name() const;
   RunSummary finish();
   // Sends one frame to every sink: `frame(i)` is sink i's, sent from where
   // it is (frame_sink.h).
@@ -106,6 +110,8 @@ private:
   // A marker pose's tracker (null for any other pose): fed by the capture
   // thread, asked by the render thread.
   std::unique_ptr<MarkerPoseSource> markers_;
+  // A trace pose's camera path.
+  std::optional<PoseTrace> pose_trace_;
   double fps_ = 25.0;
   std::unique_ptr<renderer::FrameRenderer> renderer_;
   std::vector<std::unique_ptr<FrameSink>> sinks_;
@@ -167,12 +173,14 @@ Pipeline::Pipeline(const RunOptions &options)
       camera_(open_camera(board_, scene_, base_camera_, lens_, options.threads)),
       markers_(
           open_marker_source(board_, camera_->format(), base_camera_, lens_, offline_take(board_))),
+      pose_trace_(board_.pose && board_.pose->type == PoseType::trace
+                      ? std::optional<PoseTrace>(load_pose_trace(board_.pose->trace))
+                      : std::nullopt),
       fps_(camera_fps(*camera_)),
       renderer_(make_renderer(board_, options.executor.value_or(board_.render.executor), scene_,
                               options.threads)),
-      executor_name_(renderer_->executor()),
-      record_fields_{json_string(executor_name_),
-                     json_string(markers_ ? markers_->name() : lens_.pose_source())} {
+      executor_name_(renderer_->executor()), record_fields_{json_string(executor_name_),
+                                                            json_string(pose_source_name())} {
   const std::vector<OutputSpec> specs = output_specs(options);
   std::vector<RunPath> paths = run_inputs(board_, scene_);
   for (RunPath &output : run_outputs(specs))
@@ -212,7 +220,7 @@ Pipeline::Pipeline(const RunOptions &options)
   lossless_ = offline_take(board_);
   if (options.status != nullptr)
     status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_,
-                    markers_ ? markers_->name() : lens_.pose_source());
+                    pose_source_name());
   if (markers_)
     markers_->start();
   // Last: a trace played from the rig's start starts with the run, not a
@@ -324,8 +332,9 @@ void Pipeline::render_loop() {
     r.focal_length_mm = lens.state.focal_length_mm.value;
     r.lens_fresh = lens.fresh;
     const PoseSnapshot pose = pose_at(frame.sequence, r);
-    const renderer::FrameCamera posed =
-        markers_ || lens_.tracks_pose() ? placed(base_camera_, pose.pose) : base_camera_;
+    const renderer::FrameCamera posed = markers_ || pose_trace_ || lens_.tracks_pose()
+                                            ? placed(base_camera_, pose.pose)
+                                            : base_camera_;
     r.pose_fresh = pose.fresh;
     counters_.pose_stale = !pose.fresh;
     r.position = posed.position;
@@ -397,7 +406,17 @@ LensSnapshot Pipeline::lens_at(std::int64_t mid_exposure_ns, FrameRecord &record
   return lens;
 }
 
+std::string Pipeline::pose_source_name() const {
+  if (markers_)
+    return markers_->name();
+  if (pose_trace_)
+    return "trace:" + board_.pose->trace.filename().string();
+  return lens_.pose_source();
+}
+
 PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
+  if (pose_trace_)
+    return {pose_trace_->at(record.exposure_mid_ns), true};
   if (!markers_)
     return lens_.pose_at(record.exposure_mid_ns, rest_pose_);
   const std::int64_t deadline =

@@ -129,6 +129,8 @@ std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene
     add("the lens profile", *board.lens.profile);
   if (board.pose && board.pose->type == PoseType::marker)
     add("the pose's marker board", board.pose->marker_board);
+  if (board.pose && board.pose->type == PoseType::trace)
+    add("the pose's camera path", board.pose->trace);
   for (const LensSourceConfig &source : board.lens.sources) {
     const std::string role = "lens source \"" + source.name + "\"'s trace";
     if (const auto *trace = std::get_if<TraceSourceConfig>(&source.kind))
@@ -144,6 +146,9 @@ std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene
       const bool sequence = hal::video_file::FramePattern::is_pattern(file->path.string()) ||
                             fs::is_directory(file->path, error);
       add("the camera's take", file->path, sequence);
+    } else if (const auto *sim = std::get_if<SimCameraConfig>(&board.camera->kind);
+               sim && sim->path) {
+      add("the simulated camera's path", *sim->path);
     } else if (const auto *v4l2 = std::get_if<V4l2CameraConfig>(&board.camera->kind)) {
       add("the camera", v4l2->device);
     }

@@ -284,8 +284,8 @@ TEST(BoardLive, ATrackersPoseNamesTheSourceThatCarriesIt) {
 
   const std::string file = "/rigs/test.json: ";
   EXPECT_EQ(error_of(board(usb, R"({"type": "markers"})")),
-            file + "pose.type: unknown pose type \"markers\" (static, freed, opentrackio or "
-                   "marker)");
+            file + "pose.type: unknown pose type \"markers\" (static, freed, opentrackio, "
+                   "marker or trace)");
   EXPECT_EQ(error_of(board(usb, R"({"type": "marker"})")), file + "pose.board: missing");
   EXPECT_EQ(parse_board(board(usb, R"({"type": "marker", "board": "floor.json"})"), "/rigs/b.json")
                 .pose->marker_board,
@@ -310,6 +310,19 @@ TEST(BoardLive, ATrackersPoseNamesTheSourceThatCarriesIt) {
                    "tracker says the camera is");
   EXPECT_EQ(error_of(board(freed, R"({"type": "freed", "delay_ms": 5000})")),
             file + "pose.delay_ms: must be within -1000 .. 1000");
+}
+
+// A camera path: the simulated camera moves along it, and a board's pose
+// can be the same path (the simulated rig's truth).
+TEST(BoardLive, ASimulatedCameraMovesAlongAPathAndAPoseCanFollowIt) {
+  const Board b = parse_board(live(R"({"type": "sim", "path": "paths/dolly.csv"})",
+                                   R"(, "pose": {"type": "trace", "file": "paths/dolly.csv"})"),
+                              "/rigs/test.json");
+  EXPECT_EQ(std::get<SimCameraConfig>(b.camera->kind).path, "/rigs/paths/dolly.csv");
+  EXPECT_EQ(b.pose->type, PoseType::trace);
+  EXPECT_EQ(b.pose->trace, "/rigs/paths/dolly.csv");
+  EXPECT_EQ(error_of(live(R"({"type": "sim"})", R"(, "pose": {"type": "trace"})")),
+            "/rigs/test.json: pose.file: missing");
 }
 
 TEST(BoardLive, TheSimulatedRigHasACameraASceneAndAnOutput) {
