@@ -22,9 +22,10 @@
 // while focusing moves the pupil: the still filter and the poses kept are
 // the reference plane's.
 //
-// Storage is made at construction; submit() and pose_for() allocate
-// nothing. The tracking thread runs OpenCV, which allocates as it detects:
-// it holds no frame and no output waits on it.
+// The slots and the results are made at construction: submit() copies into
+// a slot, and pose_for() allocates nothing (the render thread's allocations
+// are counted in tests/markers). The tracking thread runs OpenCV, which
+// allocates as it detects: it holds no frame and no output waits on it.
 #pragma once
 
 #include <condition_variable>

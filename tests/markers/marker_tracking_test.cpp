@@ -236,5 +236,26 @@ TEST(MarkerTracking, ABlurredBoardIsFollowedLostAndFoundAgain) {
   EXPECT_LT(1000.0 * glm::length(again.pose.position - truth.position), 2.0);
 }
 
+// A ChArUco strip one corner wide (2 squares across): its corners lie on one
+// line, which leaves the turn about it free. It gives no pose, rather than
+// the NaN pose the solve made of it (found: a later follow of that NaN
+// crashed in cornerSubPix); a wider board beside it is unaffected.
+TEST(MarkerTracking, AStripOfCornersOnOneLineGivesNoPose) {
+  const MarkerBoard strip = parse_marker_board(
+      R"({"format": "camhead-markers", "version": 1, "name": "strip", "type": "charuco",
+          "dictionary": "4X4_50", "squares": [2, 14], "square_m": 0.1, "marker_m": 0.075})",
+      "strip.json");
+  const auto tracker = open_marker_tracker(strip);
+  std::mt19937 random(8);
+  const glm::dvec3 centre(0.1, 0.0, 0.7);
+  const CameraPose truth = looking_at(centre + glm::dvec3(0.9, 1.3, 0.9), centre);
+  const cv::Mat sharp = test::charuco_view(strip, camera(), truth, {kWidth, kHeight});
+  const MarkerPose got = tracker->track(luma(test::frame(sharp, 1.0, random)), camera(), nullptr);
+  EXPECT_GT(got.markers_seen, 10) << "its markers are read";
+  EXPECT_FALSE(got.found);
+  const MarkerPose guided = tracker->track(luma(test::frame(sharp, 1.0, random)), camera(), &truth);
+  EXPECT_FALSE(guided.found) << "nor by following it";
+}
+
 } // namespace
 } // namespace camhead::pipeline

@@ -86,10 +86,12 @@ double angle_between(const glm::dquat &a, const glm::dquat &b) {
   return 2.0 * std::acos(std::min(1.0, std::abs(glm::dot(a, b))));
 }
 
-bool coplanar(const std::vector<cv::Point3f> &points) {
+// The spread of the points along their three principal axes, largest
+// first (variances, square metres).
+cv::Vec3f spread(const std::vector<cv::Point3f> &points) {
   cv::Mat data(int(points.size()), 3, CV_32F, const_cast<cv::Point3f *>(points.data()));
   cv::PCA pca(data, cv::Mat(), cv::PCA::DATA_AS_ROW);
-  return pca.eigenvalues.at<float>(2) <= 1e-8f * std::max(1.0f, pca.eigenvalues.at<float>(0));
+  return {pca.eigenvalues.at<float>(0), pca.eigenvalues.at<float>(1), pca.eigenvalues.at<float>(2)};
 }
 
 class OpenCvTracker final : public MarkerTracker {
@@ -183,10 +185,15 @@ private:
     out.followed = following_;
     if (object_.size() < kMinPoints)
       return out;
+    // Points on one line (a ChArUco strip one corner wide, the one row of a
+    // board seen) leave the turn about that line free: no pose.
+    const cv::Vec3f s = spread(object_);
+    if (s[1] <= 1e-6f * s[0])
+      return out;
 
     std::vector<cv::Vec3d> rvecs, tvecs;
     std::vector<double> errors;
-    const bool planar = charuco_ || coplanar(object_);
+    const bool planar = charuco_ || s[2] <= 1e-8f * std::max(1.0f, s[0]);
     cv::solvePnPGeneric(object_, image_points_, k, distortion, rvecs, tvecs, false,
                         planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_SQPNP, cv::noArray(),
                         cv::noArray(), errors);
@@ -213,6 +220,9 @@ private:
       sum += double(d.dot(d));
     }
     out.reprojection_px = std::sqrt(sum / double(projected_.size()));
+    if (!std::isfinite(out.reprojection_px) || !std::isfinite(cv::norm(rvec)) ||
+        !std::isfinite(cv::norm(tvec)))
+      return out; // a solve that did not converge
     if (following_ && out.reprojection_px > kMaxFollowedReprojectionPx)
       return out; // the followed corners do not make one board: not it
     out.pose = world_pose(rvec, tvec, to_world_);
@@ -259,15 +269,26 @@ private:
     cv::projectPoints(charuco_->chessboardCorners, rvec, tvec, k, distortion, predicted_);
     charuco_corners_.clear();
     charuco_ids_.clear();
-    const int cols = board_.squares_x - 1;
-    for (std::size_t i = 0; i < predicted_.size(); ++i) {
+    // The corners run row by row, `cols` to a row.
+    const std::size_t cols = std::size_t(board_.squares_x - 1), n = predicted_.size();
+    if (n < kMinFollowed)
+      return; // a board too small to follow
+    for (std::size_t i = 0; i < n; ++i) {
       const cv::Point2f p = predicted_[i];
-      // The square's size here: the distance to a neighbouring corner.
-      const std::size_t neighbour = int(i) % cols + 1 < cols ? i + 1 : i - 1;
+      // The square's size here: the distance to a neighbouring corner, in
+      // its row where it has one, else in its column.
+      const std::size_t neighbour = i % cols + 1 < cols ? i + 1
+                                    : i % cols > 0      ? i - 1
+                                    : i + cols < n      ? i + cols
+                                                        : i - cols;
       const float square = float(cv::norm(predicted_[neighbour] - p));
-      const int half = std::clamp(int(square / 3.0f), kMinRefineHalfWindow, 24);
-      if (p.x < half + 2 || p.y < half + 2 || p.x > image.cols - half - 3 ||
-          p.y > image.rows - half - 3)
+      // A corner the pose puts nowhere (behind the camera, or a projection
+      // that overflowed) is not looked for; nor one too near the edge.
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(square))
+        continue;
+      const int half = std::clamp(int(std::min(square / 3.0f, 24.0f)), kMinRefineHalfWindow, 24);
+      if (!(p.x >= half + 2 && p.y >= half + 2 && p.x <= image.cols - half - 3 &&
+            p.y <= image.rows - half - 3))
         continue;
       refined_.assign(1, p);
       cv::cornerSubPix(
