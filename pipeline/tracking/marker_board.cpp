@@ -1,12 +1,11 @@
 #include "marker_board.h"
 
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include <glm/geometric.hpp>
 
+#include "camhead/base/config_error.h"
 #include "camhead/base/config_json.h"
 
 namespace camhead::pipeline {
@@ -144,12 +143,13 @@ MarkerBoard parse_marker_board(std::string_view json_text, const std::filesystem
 }
 
 MarkerBoard load_marker_board(const std::filesystem::path &file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in)
-    throw MarkerBoardError(file.string(), "(file)", "cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_marker_board(text.str(), file);
+  std::string text;
+  try {
+    text = base::read_config_file(file); // bounded; a folder refused
+  } catch (const base::ConfigError &e) {
+    throw MarkerBoardError(e);
+  }
+  return parse_marker_board(text, file);
 }
 
 } // namespace camhead::pipeline

@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <glm/gtc/quaternion.hpp>
 
 #include "camhead/base/config_csv.h"
+#include "camhead/base/config_error.h"
 #include "tracker_axes.h"
 
 namespace camhead::pipeline {
@@ -89,12 +88,13 @@ PoseTrace parse_pose_trace(std::string_view text, const std::filesystem::path &f
 }
 
 PoseTrace load_pose_trace(const std::filesystem::path &file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in)
-    throw PoseTraceError(file.string(), "(file)", "cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_pose_trace(text.str(), file);
+  std::string text;
+  try {
+    text = base::read_config_file(file); // bounded; a folder refused
+  } catch (const base::ConfigError &e) {
+    throw PoseTraceError(e);
+  }
+  return parse_pose_trace(text, file);
 }
 
 } // namespace camhead::pipeline

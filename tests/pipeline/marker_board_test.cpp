@@ -1,5 +1,6 @@
 // Marker-board files: a ChArUco board and a marker field read with their
 // geometry, and every mistake refused with the file and field named.
+#include <filesystem>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -65,6 +66,16 @@ TEST(MarkerBoard, AFieldsMarkersHaveTheirCornersInOpenCvsOrder) {
   const auto &f = b.markers[1].corners;
   EXPECT_EQ(f[0], glm::dvec3(-0.1, 0, -2.1));
   EXPECT_EQ(f[2], glm::dvec3(0.1, 0, -1.9));
+}
+
+TEST(MarkerBoard, AFileThatCannotBeReadIsNamed) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path();
+  try {
+    static_cast<void>(load_marker_board(folder));
+    ADD_FAILURE() << "a folder loaded";
+  } catch (const MarkerBoardError &e) {
+    EXPECT_EQ(std::string(e.what()), folder.string() + ": (file): is a folder, not a file");
+  }
 }
 
 TEST(MarkerBoard, EveryMistakeIsNamed) {

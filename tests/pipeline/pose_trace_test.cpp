@@ -1,6 +1,7 @@
 // Pose traces: a camera path read with every field checked, played with its
 // time 0 at CLOCK_MONOTONIC 0 in a loop, in a camera head's axes.
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -49,6 +50,16 @@ TEST(PoseTrace, PlaysBetweenItsRowsInALoop) {
               "half way in time, half way round");
   expect_near(trace.at(2 * kS + kS / 4).position, {0.25, 1, 3}, "the loop");
   expect_near(trace.at(kS + kS / 2).position, {0.5, 1, 3}, "and back");
+}
+
+TEST(PoseTrace, AFileThatCannotBeReadIsNamed) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path();
+  try {
+    static_cast<void>(load_pose_trace(folder));
+    ADD_FAILURE() << "a folder loaded";
+  } catch (const PoseTraceError &e) {
+    EXPECT_EQ(std::string(e.what()), folder.string() + ": (file): is a folder, not a file");
+  }
 }
 
 TEST(PoseTrace, EveryMistakeIsNamed) {
