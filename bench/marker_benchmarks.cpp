@@ -25,15 +25,9 @@ const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_BENCH_MARKERS
 
 void Track(benchmark::State &state) {
   const int width = int(state.range(0)), height = int(state.range(1));
-  const MarkerBoard board = parse_marker_board(
-      R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
-          "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
-      "floor.json");
-  CameraModel camera;
-  camera.fx = camera.fy = 35.0 / 36.0 * width;
-  camera.cx = (width - 1) / 2.0;
-  camera.cy = (height - 1) / 2.0;
-  const glm::dvec3 centre(0.45, 0.0, 0.30);
+  const MarkerBoard board = test::floor_board();
+  const CameraModel camera = test::pinhole(width, height);
+  const glm::dvec3 centre = test::kFloorBoardCentre;
   camhead::renderer::FrameCamera c;
   c.position = glm::vec3(centre + 2.0 * glm::normalize(glm::dvec3(0.6, 1.3, 1.4)));
   c.look_at = glm::vec3(centre);

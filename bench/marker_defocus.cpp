@@ -71,15 +71,9 @@ double percentile(std::vector<double> v, double p) {
 
 int main(int argc, char **argv) {
   const std::string out = argc > 1 ? argv[1] : "marker_defocus";
-  const MarkerBoard board = parse_marker_board(
-      R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
-          "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
-      "floor.json");
-  CameraModel camera;
-  camera.fx = camera.fy = 35.0 / 36.0 * kWidth;
-  camera.cx = (kWidth - 1) / 2.0;
-  camera.cy = (kHeight - 1) / 2.0;
-  const glm::dvec3 centre(0.45, 0.0, 0.30);
+  const MarkerBoard board = test::floor_board();
+  const CameraModel camera = test::pinhole(kWidth, kHeight);
+  const glm::dvec3 centre = test::kFloorBoardCentre;
   const glm::dvec3 directions[] = {{0.0, 1.2, 1.6}, {0.6, 1.3, 1.4}, {0.1, 0.75, 1.8}};
   const double diameters[] = {0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0};
   const auto tracker = open_marker_tracker(board);

@@ -217,19 +217,14 @@ private:
     const std::string type = d.has("type") ? d.at("type").string() : "static";
     if (type == "freed" || type == "opentrackio")
       return read_tracked_pose(d, lens, type);
-    if (type == "trace") {
-      d.object({"type", "file"});
+    if (type == "marker" || type == "trace") {
+      // Found in the frame itself, or the path the camera is on: no delay
+      // to correct.
+      const std::string_view key = type == "marker" ? "board" : "file";
+      d.object({"type", key});
       PoseConfig pose;
-      pose.type = PoseType::trace;
-      pose.trace = d.at("file").path();
-      return pose;
-    }
-    if (type == "marker") {
-      // Found in the frame itself: no delay to correct.
-      d.object({"type", "board"});
-      PoseConfig pose;
-      pose.type = PoseType::marker;
-      pose.marker_board = d.at("board").path();
+      pose.type = type == "marker" ? PoseType::marker : PoseType::trace;
+      pose.file = d.at(key).path();
       return pose;
     }
     if (type != "static")

@@ -184,9 +184,9 @@ struct PoseConfig {
   // and how much later than the physical instant its poses are stamped.
   std::string source;
   double delay_ms = 0.0;
-  // A marker pose's board file; a trace pose's path.
-  std::filesystem::path marker_board;
-  std::filesystem::path trace;
+  // A marker pose's marker-board file ("board"); a trace pose's camera path
+  // ("file").
+  std::filesystem::path file;
 };
 
 // Whether the pose comes in a lens source's datagrams (freed, opentrackio).

@@ -346,8 +346,8 @@ std::unique_ptr<MarkerPoseSource> open_marker_source(const Board &board,
                                                      const LensHub &lens, bool every_frame) {
   if (!board.pose || board.pose->type != PoseType::marker)
     return nullptr;
-  return std::make_unique<MarkerPoseSource>(load_marker_board(board.pose->marker_board), format,
-                                            base, lens, every_frame);
+  return std::make_unique<MarkerPoseSource>(load_marker_board(board.pose->file), format, base, lens,
+                                            every_frame);
 }
 
 double camera_fps(const CameraSource &camera) {

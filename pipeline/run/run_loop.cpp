@@ -174,7 +174,7 @@ Pipeline::Pipeline(const RunOptions &options)
       markers_(
           open_marker_source(board_, camera_->format(), base_camera_, lens_, offline_take(board_))),
       pose_trace_(board_.pose && board_.pose->type == PoseType::trace
-                      ? std::optional<PoseTrace>(load_pose_trace(board_.pose->trace))
+                      ? std::optional<PoseTrace>(load_pose_trace(board_.pose->file))
                       : std::nullopt),
       fps_(camera_fps(*camera_)),
       renderer_(make_renderer(board_, options.executor.value_or(board_.render.executor), scene_,
@@ -410,7 +410,7 @@ std::string Pipeline::pose_source_name() const {
   if (markers_)
     return markers_->name();
   if (pose_trace_)
-    return "trace:" + board_.pose->trace.filename().string();
+    return "trace:" + board_.pose->file.filename().string();
   return lens_.pose_source();
 }
 

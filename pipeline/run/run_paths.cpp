@@ -128,9 +128,9 @@ std::vector<RunPath> run_inputs(const Board &board, const renderer::Scene &scene
   if (board.lens.profile)
     add("the lens profile", *board.lens.profile);
   if (board.pose && board.pose->type == PoseType::marker)
-    add("the pose's marker board", board.pose->marker_board);
+    add("the pose's marker board", board.pose->file);
   if (board.pose && board.pose->type == PoseType::trace)
-    add("the pose's camera path", board.pose->trace);
+    add("the pose's camera path", board.pose->file);
   for (const LensSourceConfig &source : board.lens.sources) {
     const std::string role = "lens source \"" + source.name + "\"'s trace";
     if (const auto *trace = std::get_if<TraceSourceConfig>(&source.kind))

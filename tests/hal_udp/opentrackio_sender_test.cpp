@@ -29,6 +29,14 @@ OpenTrackIoSenderConfig unicast(std::string host, std::uint16_t port) {
   return c;
 }
 
+// A receiver on 127.0.0.1, on a port the kernel picks.
+OpenTrackIoReceiverConfig loopback_receiver() {
+  OpenTrackIoReceiverConfig c;
+  c.bind_address = "127.0.0.1";
+  c.port = 0;
+  return c;
+}
+
 OpenTrackIoState state(int i) {
   OpenTrackIoState s;
   s.focus_distance_m = 0.5 + i;
@@ -42,10 +50,7 @@ OpenTrackIoState state(int i) {
 }
 
 TEST(OpenTrackIoSender, RoundTripThroughRealSockets) {
-  OpenTrackIoReceiverConfig rc;
-  rc.bind_address = "127.0.0.1";
-  rc.port = 0;
-  OpenTrackIoReceiver rx(rc);
+  OpenTrackIoReceiver rx(loopback_receiver());
   OpenTrackIoSender tx(unicast("127.0.0.1", rx.port()));
   EXPECT_EQ(tx.name(), "opentrackio udp -> 127.0.0.1:" + std::to_string(rx.port()));
 
@@ -74,10 +79,7 @@ TEST(OpenTrackIoSender, RoundTripThroughRealSockets) {
 }
 
 TEST(OpenTrackIoSender, APoseSentIsReceivedUnchanged) {
-  OpenTrackIoReceiverConfig rc;
-  rc.bind_address = "127.0.0.1";
-  rc.port = 0;
-  OpenTrackIoReceiver rx(rc);
+  OpenTrackIoReceiver rx(loopback_receiver());
   OpenTrackIoSender tx(unicast("127.0.0.1", rx.port()));
   // Values no decimal shorter than 17 digits carries.
   const TrackedPose camera{.x_m = 0.1 + 0.2,

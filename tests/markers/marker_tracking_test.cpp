@@ -29,13 +29,8 @@ const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_TEST_MARKERS_
 
 constexpr int kWidth = 720, kHeight = 576;
 
-// 35 mm on a 36 mm wide sensor, centred: 700 px.
 CameraModel camera() {
-  CameraModel c;
-  c.fx = c.fy = 35.0 / 36.0 * kWidth;
-  c.cx = (kWidth - 1) / 2.0;
-  c.cy = (kHeight - 1) / 2.0;
-  return c;
+  return test::pinhole(kWidth, kHeight);
 }
 
 CameraPose looking_at(glm::dvec3 from, glm::dvec3 at) {
@@ -55,13 +50,8 @@ LumaImage luma(const cv::Mat &m) {
   return {m.data, m.cols, m.rows, std::ptrdiff_t(m.step)};
 }
 
-const MarkerBoard kCharuco = parse_marker_board(
-    R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
-        "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
-    "floor.json");
-
-// The board's centre: 9 x 6 squares of 0.1 m, face up, y towards +z.
-const glm::dvec3 kBoardCentre(0.45, 0.0, 0.30);
+const MarkerBoard kCharuco = test::floor_board();
+const glm::dvec3 kBoardCentre = test::kFloorBoardCentre;
 
 TEST(MarkerTracking, ACharucoBoardAt2mGivesTheCameraWithin2mmAndATenthOfADegree) {
   const auto tracker = open_marker_tracker(kCharuco);

@@ -48,7 +48,7 @@ const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_TEST_MARKERS_
 
 constexpr int kWidth = 640, kHeight = 360;
 constexpr int kBoardFrames = 16, kEmptyFrames = 3;
-const glm::dvec3 kBoardCentre(0.45, 0.0, 0.30);
+const glm::dvec3 kBoardCentre = test::kFloorBoardCentre;
 
 // Frame k of the move: 1.9 m from the board's centre, swinging from its
 // left to its right while rising, looking at a point that wanders about
@@ -95,13 +95,8 @@ protected:
   // reference plane the poses are of), else calibrated values of a plain
   // 35 mm (no profile: no breathing, no pupil offset).
   Board take_board(bool realtime, bool locked_off = false, bool profiled = false) const {
-    const MarkerBoard board = parse_marker_board(
-        R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
-          "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})",
-        "floor.json");
-    write("floor.json", R"({"format": "camhead-markers", "version": 1, "name": "floor",
-      "type": "charuco", "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1,
-      "marker_m": 0.075})");
+    const MarkerBoard board = test::floor_board();
+    write("floor.json", test::kFloorBoardJson);
     // The still lens the take was drawn with, seen from its entrance pupil.
     double focal_mm = 35.0, pupil_m = 0.0;
     if (profiled) {
@@ -117,10 +112,7 @@ protected:
       pose.position += pose.forward() * pupil_m;
       return pose;
     };
-    CameraModel camera;
-    camera.fx = camera.fy = focal_mm / 36.0 * kWidth;
-    camera.cx = (kWidth - 1) / 2.0;
-    camera.cy = (kHeight - 1) / 2.0;
+    const CameraModel camera = test::pinhole(kWidth, kHeight, focal_mm);
     std::mt19937 random(5);
     std::vector<std::vector<std::uint8_t>> frames;
     const cv::Mat still =

@@ -15,6 +15,7 @@
 #include <random>
 
 #include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
 #include <opencv2/aruco.hpp>
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
@@ -24,6 +25,27 @@
 #include "tracking/marker_tracker.h"
 
 namespace camhead::pipeline::test {
+
+// The board the marker tests and benchmarks track: a 9x6 ChArUco of 10 cm
+// squares and 7.5 cm markers (5X5_100), about A1; on the floor, its centre
+// at kFloorBoardCentre.
+inline constexpr const char *kFloorBoardJson =
+    R"({"format": "camhead-markers", "version": 1, "name": "floor", "type": "charuco",
+        "dictionary": "5X5_100", "squares": [9, 6], "square_m": 0.1, "marker_m": 0.075})";
+inline const glm::dvec3 kFloorBoardCentre(0.45, 0.0, 0.30);
+inline MarkerBoard floor_board() {
+  return parse_marker_board(kFloorBoardJson, "floor.json");
+}
+
+// A pinhole of `focal_mm` on a 36 mm wide sensor, centred, `width` x
+// `height` pixels (35 mm at 720 wide: 700 px).
+inline CameraModel pinhole(int width, int height, double focal_mm = 35.0) {
+  CameraModel c;
+  c.fx = c.fy = focal_mm / 36.0 * width;
+  c.cx = (width - 1) / 2.0;
+  c.cy = (height - 1) / 2.0;
+  return c;
+}
 
 constexpr int kSupersample = 8;
 

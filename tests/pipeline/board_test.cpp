@@ -288,7 +288,7 @@ TEST(BoardLive, ATrackersPoseNamesTheSourceThatCarriesIt) {
                    "marker or trace)");
   EXPECT_EQ(error_of(board(usb, R"({"type": "marker"})")), file + "pose.board: missing");
   EXPECT_EQ(parse_board(board(usb, R"({"type": "marker", "board": "floor.json"})"), "/rigs/b.json")
-                .pose->marker_board,
+                .pose->file,
             "/rigs/floor.json")
       << "relative to the board file";
   EXPECT_EQ(error_of(board(usb + ", " + freed, R"({"type": "freed", "source": "lens"})")),
@@ -320,7 +320,7 @@ TEST(BoardLive, ASimulatedCameraMovesAlongAPathAndAPoseCanFollowIt) {
                               "/rigs/test.json");
   EXPECT_EQ(std::get<SimCameraConfig>(b.camera->kind).path, "/rigs/paths/dolly.csv");
   EXPECT_EQ(b.pose->type, PoseType::trace);
-  EXPECT_EQ(b.pose->trace, "/rigs/paths/dolly.csv");
+  EXPECT_EQ(b.pose->file, "/rigs/paths/dolly.csv");
   EXPECT_EQ(error_of(live(R"({"type": "sim"})", R"(, "pose": {"type": "trace"})")),
             "/rigs/test.json: pose.file: missing");
 }
