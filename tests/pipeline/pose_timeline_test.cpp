@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "counting_new.h"
 #include "tracking/pose_timeline.h"
 
 #include <gtest/gtest.h>
@@ -98,6 +99,19 @@ TEST(PoseTimeline, AFullHistoryForgetsTheOldest) {
   EXPECT_EQ(timeline.size(), 4u);
   EXPECT_FALSE(timeline.at(50 * kMs)->fresh) << "sample 5 is gone: older than the history";
   EXPECT_NEAR(timeline.at(75 * kMs)->pose.position.x, 7.5, 1e-12);
+}
+
+// pose_timeline.h: storage reserved once; push() and at() allocate nothing
+// (the lens thread pushes, the render thread asks).
+TEST(PoseTimeline, PushingAndAskingAllocateNothing) {
+  PoseTimeline timeline(PoseTimelineParams{.capacity = 16});
+  camhead::test::counting_new::start([] { return 0; });
+  for (int i = 0; i < 100; ++i) { // past its capacity: the ring wraps
+    (void)timeline.push(i * 10 * kMs, at(0.01 * i, 0.1 * i));
+    (void)timeline.at(i * 10 * kMs - 5 * kMs);
+  }
+  camhead::test::counting_new::stop();
+  EXPECT_EQ(camhead::test::counting_new::count(0), 0u);
 }
 
 } // namespace
