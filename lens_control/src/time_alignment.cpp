@@ -6,27 +6,19 @@
 
 namespace camhead::lens_control {
 
-AxisTimeline::AxisTimeline(TimelineParams p) : p_(p), ring_(std::max<std::size_t>(p.capacity, 2)) {}
+AxisTimeline::AxisTimeline(TimelineParams p) : p_(p), ring_(p.capacity) {}
 
 bool AxisTimeline::push(TimedCounts s) {
   s.t_ns -= p_.delay_ns;
-  if (size_ > 0 && s.t_ns <= sample(size_ - 1).t_ns)
-    return false;
-  if (size_ == ring_.size()) {
-    ring_[head_] = s; // overwrite the oldest
-    head_ = (head_ + 1) % ring_.size();
-  } else {
-    ring_[(head_ + size_) % ring_.size()] = s;
-    ++size_;
-  }
-  return true;
+  return ring_.push(s);
 }
 
 std::optional<AxisReading> AxisTimeline::at(std::int64_t t_ns) const {
-  if (size_ == 0)
+  const std::size_t n = ring_.size();
+  if (n == 0)
     return std::nullopt;
-  const TimedCounts &oldest = sample(0);
-  const TimedCounts &newest = sample(size_ - 1);
+  const TimedCounts &oldest = ring_[0];
+  const TimedCounts &newest = ring_[n - 1];
 
   if (t_ns < oldest.t_ns)
     return AxisReading{oldest.counts, t_ns, false}; // older than the history holds
@@ -37,8 +29,8 @@ std::optional<AxisReading> AxisTimeline::at(std::int64_t t_ns) const {
     const std::int64_t ahead = t_ns - newest.t_ns;
     const bool fresh = ahead <= p_.max_extrapolation_ns;
     double slope = 0.0; // counts per ns
-    if (size_ >= 2) {
-      const TimedCounts &prev = sample(size_ - 2);
+    if (n >= 2) {
+      const TimedCounts &prev = ring_[n - 2];
       // Only along a continuous stretch; across a dropout the slope is a guess.
       if (newest.t_ns - prev.t_ns <= p_.stale_after_ns)
         slope = (newest.counts - prev.counts) / double(newest.t_ns - prev.t_ns);
@@ -47,16 +39,8 @@ std::optional<AxisReading> AxisTimeline::at(std::int64_t t_ns) const {
     return AxisReading{newest.counts + slope * dt, t_ns, fresh};
   }
 
-  // Binary search over the ring for the first sample later than t.
-  std::size_t lo = 0, hi = size_ - 1; // sample(lo) <= t < sample(hi)
-  while (hi - lo > 1) {
-    const std::size_t mid = (lo + hi) / 2;
-    if (sample(mid).t_ns <= t_ns)
-      lo = mid;
-    else
-      hi = mid;
-  }
-  const TimedCounts &a = sample(lo), &b = sample(hi);
+  const std::size_t i = ring_.bracket(t_ns);
+  const TimedCounts &a = ring_[i], &b = ring_[i + 1];
   const double u = double(t_ns - a.t_ns) / double(b.t_ns - a.t_ns);
   return AxisReading{a.counts + u * (b.counts - a.counts), t_ns,
                      b.t_ns - a.t_ns <= p_.stale_after_ns};

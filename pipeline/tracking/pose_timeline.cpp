@@ -19,40 +19,30 @@ CameraPose between(const CameraPose &a, const CameraPose &b, double u) {
 
 } // namespace
 
-PoseTimeline::PoseTimeline(PoseTimelineParams p)
-    : p_(p), ring_(std::max<std::size_t>(p.capacity, 2)) {}
+PoseTimeline::PoseTimeline(PoseTimelineParams p) : p_(p), ring_(p.capacity) {}
 
 bool PoseTimeline::push(std::int64_t t_ns, const CameraPose &pose) {
-  const std::int64_t physical = t_ns - p_.delay_ns;
-  if (size_ > 0 && physical <= sample(size_ - 1).t_ns)
-    return false;
-  if (size_ < ring_.size()) {
-    ring_[(head_ + size_) % ring_.size()] = {physical, pose};
-    ++size_;
-  } else {
-    ring_[head_] = {physical, pose};
-    head_ = (head_ + 1) % ring_.size();
-  }
-  return true;
+  return ring_.push({t_ns - p_.delay_ns, pose});
 }
 
 std::int64_t PoseTimeline::newest_ns() const {
-  return size_ == 0 ? 0 : sample(size_ - 1).t_ns;
+  return ring_.size() == 0 ? 0 : ring_[ring_.size() - 1].t_ns;
 }
 
 std::optional<PoseAt> PoseTimeline::at(std::int64_t t_ns) const {
-  if (size_ == 0)
+  const std::size_t n = ring_.size();
+  if (n == 0)
     return std::nullopt;
-  const Timed &oldest = sample(0);
-  const Timed &newest = sample(size_ - 1);
+  const Timed &oldest = ring_[0];
+  const Timed &newest = ring_[n - 1];
   if (t_ns < oldest.t_ns)
     return PoseAt{oldest.pose, false};
   if (t_ns >= newest.t_ns) {
     const std::int64_t ahead = t_ns - newest.t_ns;
     const bool fresh = ahead <= p_.max_extrapolation_ns;
-    if (size_ < 2)
+    if (n < 2)
       return PoseAt{newest.pose, fresh};
-    const Timed &prev = sample(size_ - 2);
+    const Timed &prev = ring_[n - 2];
     // Only along a continuous stretch; across a dropout the motion is a guess.
     if (newest.t_ns - prev.t_ns > p_.stale_after_ns)
       return PoseAt{newest.pose, fresh};
@@ -60,15 +50,8 @@ std::optional<PoseAt> PoseTimeline::at(std::int64_t t_ns) const {
     return PoseAt{between(prev.pose, newest.pose, 1.0 + dt / double(newest.t_ns - prev.t_ns)),
                   fresh};
   }
-  std::size_t lo = 0, hi = size_ - 1; // sample(lo) <= t < sample(hi)
-  while (hi - lo > 1) {
-    const std::size_t mid = (lo + hi) / 2;
-    if (sample(mid).t_ns <= t_ns)
-      lo = mid;
-    else
-      hi = mid;
-  }
-  const Timed &a = sample(lo), &b = sample(hi);
+  const std::size_t i = ring_.bracket(t_ns);
+  const Timed &a = ring_[i], &b = ring_[i + 1];
   const double u = double(t_ns - a.t_ns) / double(b.t_ns - a.t_ns);
   return PoseAt{between(a.pose, b.pose, u), b.t_ns - a.t_ns <= p_.stale_after_ns};
 }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "camera_pose.h"
+#include "camhead/base/time_ring.h"
 
 namespace camhead::pipeline {
 
@@ -44,7 +45,7 @@ public:
   bool push(std::int64_t t_ns, const CameraPose &pose);
   // The pose at physical instant t_ns; empty before the first pose.
   [[nodiscard]] std::optional<PoseAt> at(std::int64_t t_ns) const;
-  [[nodiscard]] std::size_t size() const { return size_; }
+  [[nodiscard]] std::size_t size() const { return ring_.size(); }
   // The newest pose's physical instant; 0 when empty.
   [[nodiscard]] std::int64_t newest_ns() const;
 
@@ -53,13 +54,9 @@ private:
     std::int64_t t_ns; // physical: stamped - delay
     CameraPose pose;
   };
-  [[nodiscard]] const Timed &sample(std::size_t i) const {
-    return ring_[(head_ + i) % ring_.size()];
-  }
 
   PoseTimelineParams p_;
-  std::vector<Timed> ring_;
-  std::size_t head_ = 0, size_ = 0;
+  base::TimeRing<Timed> ring_;
 };
 
 } // namespace camhead::pipeline

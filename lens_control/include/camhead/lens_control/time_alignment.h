@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include "camhead/base/time_ring.h"
 #include "camhead/lens_control/lens_state.h"
 
 namespace camhead::lens_control {
@@ -61,18 +62,12 @@ public:
   // the query time.
   [[nodiscard]] std::optional<AxisReading> at(std::int64_t t_ns) const;
 
-  [[nodiscard]] std::size_t size() const { return size_; }
+  [[nodiscard]] std::size_t size() const { return ring_.size(); }
   [[nodiscard]] const TimelineParams &params() const { return p_; }
 
 private:
-  // i-th oldest sample, with its time moved to physical time.
-  [[nodiscard]] const TimedCounts &sample(std::size_t i) const {
-    return ring_[(head_ + i) % ring_.size()];
-  }
-
   TimelineParams p_;
-  std::vector<TimedCounts> ring_;
-  std::size_t head_ = 0, size_ = 0;
+  base::TimeRing<TimedCounts> ring_; // times moved to physical time
 };
 
 } // namespace camhead::lens_control
