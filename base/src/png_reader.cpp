@@ -39,20 +39,40 @@ void read_from_memory(png_structp png, png_bytep out, std::size_t n) {
   png_longjmp(png, 1);
 }
 
-// The bytes of image data (IDAT chunks) of `file`, as far as its chunks are
-// whole.
-std::uint64_t image_data_bytes(std::span<const std::uint8_t> file) {
-  std::uint64_t total = 0;
-  for (std::size_t at = 8; file.size() >= 12 && at <= file.size() - 12;) {
+// The chunks of a PNG `file`, walked before libpng reads any: libpng
+// allocates some ancillary chunks at the length they claim before it reads
+// a byte of them (1.6.39's sPLT: 1.9 GB for a 126-byte file), so a chunk that
+// runs past the end of the file is refused here, and no chunk can cost more
+// memory than the file holds. True with the bytes of image data (IDAT
+// chunks) when every chunk up to IEND is whole; else false with `error`.
+bool walk_chunks(std::span<const std::uint8_t> file, std::uint64_t &image_data,
+                 char (&error)[192]) {
+  image_data = 0;
+  for (std::size_t at = 8;;) {
+    if (file.size() - at < 12) {
+      std::snprintf(error, sizeof error, "not a readable PNG: the file ends before IEND");
+      return false;
+    }
     const std::size_t length = std::size_t(file[at]) << 24 | std::size_t(file[at + 1]) << 16 |
                                std::size_t(file[at + 2]) << 8 | file[at + 3];
-    if (length > file.size() - at - 12)
-      break;
-    if (std::memcmp(&file[at + 4], "IDAT", 4) == 0)
-      total += length;
+    char name[5] = {};
+    for (int i = 0; i < 4; ++i) {
+      const auto c = static_cast<unsigned char>(file[at + 4 + std::size_t(i)]);
+      name[i] = std::isalpha(c) ? char(c) : '?';
+    }
+    if (length > file.size() - at - 12) {
+      std::snprintf(error, sizeof error,
+                    "not a readable PNG: the file ends inside its %s chunk, which claims %zu "
+                    "bytes",
+                    name, length);
+      return false;
+    }
+    if (std::memcmp(name, "IDAT", 4) == 0)
+      image_data += length;
+    if (std::memcmp(name, "IEND", 4) == 0)
+      return true;
     at += 12 + length;
   }
-  return total;
 }
 
 // Deflate expands a byte to at most 1032 (a 258-byte match in 2 bits); a
@@ -78,6 +98,11 @@ struct Target {
 // the setjmp below; no object with a destructor lives in this frame, so the
 // jump skips nothing. The caller's buffer is written row by row.
 bool read(Source &source, const Target &target, PngInfo &info) {
+  // Not a PNG at all: libpng's own words ("Not a PNG file").
+  const bool signed_png = source.file.size() >= 8 && png_sig_cmp(source.file.data(), 0, 8) == 0;
+  std::uint64_t data_bytes = 0;
+  if (signed_png && !walk_chunks(source.file, data_bytes, source.error))
+    return false;
   png_structp png =
       png_create_read_struct(PNG_LIBPNG_VER_STRING, &source, &stop_on_error, &skip_warning);
   png_infop header = png != nullptr ? png_create_info_struct(png) : nullptr;
@@ -107,7 +132,6 @@ bool read(Source &source, const Target &target, PngInfo &info) {
            png_get_channels(png, header) +
        7) /
       8;
-  const std::uint64_t data_bytes = image_data_bytes(source.file);
   if (pixel_bytes > data_bytes * kMaxInflation + kInflationSlack) {
     std::snprintf(source.error, sizeof source.error,
                   "not a readable PNG: its %llu bytes of image data cannot hold the %ux%u "

@@ -152,9 +152,9 @@ TEST(PngSequence, AFrameThatIsNotAPngFailsTheTake) {
 // libpng). What the fuzzers found against stb_image, which trusted the chunk
 // structure (chunks cut short, where stb reallocated to the length claimed:
 // 1.3 GB for 41 bytes; an empty IDAT it copied from a null pointer), is
-// refused or read whole, by the frame decoder itself; so is image data that
-// inflates far past its header's image. The findings' CRCs are made right
-// first, so that libpng meets what is really wrong with them, not a CRC.
+// refused, most already as the header is read (the chunks are walked
+// first); so is image data that inflates far past its header's image. The findings' CRCs are made
+// right first, so that libpng meets what is really wrong with them, not a CRC.
 TEST(PngSequence, DamagedFramesAreRefused) {
   const auto decode_error = [](const std::string &png) {
     const std::vector<std::uint8_t> bytes(png.begin(), png.end());
@@ -172,19 +172,29 @@ TEST(PngSequence, DamagedFramesAreRefused) {
   };
   for (const char *name : {"png_inflate_oom_1.png", "png_inflate_oom_2.png",
                            "png_inflate_oom_1_min.png", "png_inflate_oom_2_min.png"})
-    EXPECT_EQ(decode_error(finding(name)),
-              "PNG: not a readable PNG: the file ends inside a chunk, or before IEND")
-        << name;
+    EXPECT_EQ(decode_error(finding(name)).rfind("size: PNG: not a readable PNG: the file ends ", 0),
+              0u)
+        << name << ": " << decode_error(finding(name));
+  // libpng allocates an sPLT chunk at its claimed length before reading it:
+  // the chunk walk refuses it first, CRC right or not.
+  const std::string splt = test::read_text(std::filesystem::path(CAMHEAD_SOURCE_DIR) /
+                                           "tests/assets/fuzz/png_splt_oom.png");
+  for (const std::string &png : {splt, test::with_crcs_fixed(splt)})
+    EXPECT_EQ(decode_error(png), "size: PNG: not a readable PNG: the file ends inside its sPLT "
+                                 "chunk, which claims 1936946035 bytes");
+  const std::string whole = test::rgb8_png(2, 1, std::string(1, '\0') + "abcdef");
+  EXPECT_EQ(decode_error(whole.substr(0, whole.size() - 12)), // IEND left out
+            "size: PNG: not a readable PNG: the file ends before IEND");
+  EXPECT_EQ(decode_error(whole), "decoded");
   for (const char *name : {"png_empty_idat_null.png", "png_empty_idat_null_min.png"})
-    EXPECT_EQ(decode_error(finding(name)).rfind("PNG: not a readable PNG: ", 0), 0u)
+    EXPECT_EQ(decode_error(finding(name)).rfind("size: PNG: not a readable PNG: ", 0), 0u)
         << name << ": " << decode_error(finding(name));
   EXPECT_EQ(decode_error(test::rgb8_png(2, 2, std::string(64 << 20, '\0'))),
             "PNG: not a readable PNG: IDAT: Too much image data");
-  EXPECT_EQ(decode_error(test::rgb8_png(2, 1, std::string(1, '\0') + "abcdef")), "decoded");
+
   // A frame of the size expected, by pixels but not by shape, is refused
   // before a row is written.
-  const std::string png = test::rgb8_png(2, 1, std::string(1, '\0') + "abcdef");
-  const std::vector<std::uint8_t> bytes(png.begin(), png.end());
+  const std::vector<std::uint8_t> bytes(whole.begin(), whole.end());
   std::vector<std::uint8_t> rgb(6, 0x55);
   std::string error;
   EXPECT_FALSE(hal::video_file::decode_png_rgb(bytes, {1, 2}, rgb, error));
