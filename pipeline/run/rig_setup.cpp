@@ -73,12 +73,12 @@ public:
   }
 
 private:
-  using Key = std::array<std::uint32_t, 15>;
+  using Key = std::array<std::uint32_t, 23>;
 
   // Every field's bits: two cameras share a picture only if they are equal.
   static Key key_of(const renderer::FrameCamera &c) {
     static_assert(sizeof(renderer::FrameCamera) == sizeof(Key), "a FrameCamera field is not keyed");
-    const float fields[15] = {c.position.x,
+    const float fields[23] = {c.position.x,
                               c.position.y,
                               c.position.z,
                               c.look_at.x,
@@ -92,7 +92,15 @@ private:
                               c.focal_length_mm,
                               c.projection_focal_length_mm,
                               c.sensor_width_mm,
-                              c.entrance_pupil_offset_m};
+                              c.entrance_pupil_offset_m,
+                              c.lens_model.principal_point.x,
+                              c.lens_model.principal_point.y,
+                              c.lens_model.fy_over_fx,
+                              c.lens_model.k1,
+                              c.lens_model.k2,
+                              c.lens_model.k3,
+                              c.lens_model.p1,
+                              c.lens_model.p2};
     Key key;
     std::memcpy(key.data(), fields, sizeof fields);
     return key;

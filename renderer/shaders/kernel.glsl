@@ -19,6 +19,7 @@
 
 #include "sampling.glsl"
 #include "intersect.glsl"
+#include "lens_model.glsl"
 
 // ---------------------------------------------------------------- camera
 
@@ -45,8 +46,18 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   vec3 right = vec3(frame.cam_right);
   vec3 up = vec3(frame.cam_up);
   vec3 forward = vec3(frame.cam_forward);
-  vec3 d = normalize(right * (px - 0.5f * width) + up * (0.5f * height - py) +
-                     forward * frame.lens.z);
+  vec3 d;
+  if (KERNEL_HAS(KERNEL_LENS_MODEL) && (frame.tracing.w & TRACING_LENS_MODEL) != 0u) {
+    // The real lens: the point of the image plane that the lens's
+    // distortion takes to this sample's position (normalised, y down).
+    vec2 ideal = lens_undistort(vec2((px - frame.projection.x) / frame.lens.z,
+                                     (py - frame.projection.y) / frame.projection.z),
+                                frame.distortion, frame.projection.w);
+    d = normalize(right * ideal.x - up * ideal.y + forward);
+  } else {
+    d = normalize(right * (px - 0.5f * width) + up * (0.5f * height - py) +
+                  forward * frame.lens.z);
+  }
   Ray ray;
   ray.origin = vec3(frame.cam_position);
   ray.dir = d;
@@ -316,6 +327,9 @@ bool bundle_meets_box(vec3 origin, vec3 inv_dir, float footprint, vec4 bmin4, ve
 // bundle test above that stops at the first leaf the bundle may reach;
 // conservative (a full stack counts as a leaf reached).
 bool pixel_misses_scene(uint x, uint y) {
+  if (KERNEL_HAS(KERNEL_LENS_MODEL) && (frame.tracing.w & TRACING_LENS_MODEL) != 0u) {
+    return false; // the bundle below is a pinhole's; a distorted pixel's is not bounded yet
+  }
   BvhNode root = node_at(0u);
   if (!(abs(root.bmin.x) < 1e30f)) {
     return true; // the empty BVH (bounds at +inf) admits no ray

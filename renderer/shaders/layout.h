@@ -87,6 +87,12 @@ struct FrameParams {
                   // sampler (SAMPLER_*); w: TRACING_* flags
   vec4 adaptive;  // adaptive allocation: x coc_weight, y cap (samples per pixel), z pixels
                   // sharing the budget (the influence region's; 0 = all); w reserved
+  // The real lens beyond the pinhole (lens_model.glsl), read only with
+  // TRACING_LENS_MODEL: x, y the principal point (pixels from the image's
+  // top-left corner, y down); z the focal length in pixels down the image
+  // (fy; across it, fx, is lens.z); w k3.
+  vec4 projection;
+  vec4 distortion; // k1, k2, p1, p2 (OpenCV's order and convention)
 };
 
 // Camera-ray samplers (FrameParams.tracing.z, sampling.glsl).
@@ -99,6 +105,10 @@ struct FrameParams {
 // CPU reference, but up to 1.4x slower on lavapipe where the proxy covers the
 // frame, and not yet measured on a GPU; the CPU reference sets it.
 #define TRACING_SKIP_EMPTY_PIXELS 1u
+// The lens is more than a centred pinhole of square pixels: camera rays go
+// through FrameParams.projection and .distortion (make_frame_params sets it
+// for any lens that is; the ideal lens keeps the pinhole's arithmetic).
+#define TRACING_LENS_MODEL 2u
 
 // What a trace pipeline is built for: specialization constant 0 of
 // trace.comp, KERNEL_FEATURES (buffers.glsl), the scene's primitive kinds,
@@ -115,7 +125,8 @@ struct FrameParams {
 #define KERNEL_CAMERA_CMJ 32u   // camera samples may be SAMPLER_CMJ
 #define KERNEL_CAMERA_SOBOL 64u // ... or SAMPLER_SOBOL
 #define KERNEL_SKIP_EMPTY_PIXELS 128u
-#define KERNEL_ALL 255u
+#define KERNEL_LENS_MODEL 256u // frames may have TRACING_LENS_MODEL
+#define KERNEL_ALL 511u
 #define KERNEL_HAS(feature) ((KERNEL_FEATURES & (feature)) != 0u)
 
 // The layers resolve.comp writes: specialization constant 1, RESOLVE_LAYERS.

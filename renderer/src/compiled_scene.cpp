@@ -353,6 +353,12 @@ gpu::FrameParams make_frame_params(const Scene &scene, const FrameCamera &cam, i
                         std::uint32_t(scene.lights.size()));
   fp.sampling = gpu::uvec4(0u, spp, spp, r.seed);
   fp.tracing = gpu::uvec4(std::uint32_t(r.max_bounces), 0u, 0u, 0u);
+  if (const LensModel &m = cam.lens_model; !m.ideal()) {
+    fp.tracing.w |= TRACING_LENS_MODEL;
+    fp.projection = gpu::vec4(m.principal_point.x * float(r.width),
+                              m.principal_point.y * float(r.height), focal_px * m.fy_over_fx, m.k3);
+    fp.distortion = gpu::vec4(m.k1, m.k2, m.p1, m.p2);
+  }
   return fp;
 }
 

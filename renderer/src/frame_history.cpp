@@ -8,6 +8,8 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "camhead/renderer/frame_settings.h"
+
 namespace camhead::renderer {
 namespace {
 
@@ -48,7 +50,8 @@ double nearest_depth_m(const CompiledScene &scene, const gpu::FrameParams &frame
 double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, double nearest_m) {
   // What no tolerance covers: what is not the camera.
   if (a.lens.w != b.lens.w || a.world_color != b.world_color || a.image != b.image ||
-      a.tracing.x != b.tracing.x)
+      a.tracing.x != b.tracing.x || has_lens_model(a) != has_lens_model(b) ||
+      (has_lens_model(a) && (a.projection != b.projection || a.distortion != b.distortion)))
     return kInfinity;
   for (const gpu::FrameParams *frame : {&a, &b})
     for (int k = 0; k < 4; ++k)
@@ -56,8 +59,6 @@ double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, dou
           !std::isfinite(frame->cam_right[k]) || !std::isfinite(frame->cam_up[k]) ||
           !std::isfinite(frame->cam_forward[k]))
         return kInfinity; // no bound to give
-  const double width = a.image.x;
-  const double height = a.image.y;
   const double f = a.lens.z;
   const double w_far = 0.0;
   const double w_near = 1.0 / nearest_m;
@@ -67,8 +68,11 @@ double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, dou
   for (const gpu::FrameParams *frame : {&a, &b})
     for (const double w : {w_far, w_near})
       widest = std::max(widest, blur_radius_px(*frame, w));
-  // The farthest a visible point lies from the image centre, as a tangent.
-  const double max_tan = (0.5 * std::hypot(width, height) + widest + a.lens.w) / f;
+  // The farthest a visible point lies from the image centre, as a tangent
+  // (through a lens model, its preimage's), and the most the lens model
+  // stretches a motion on the ideal image plane (1 for a pinhole).
+  const LensExtent extent = lens_extent(a, (widest + a.lens.w) / f);
+  const double max_tan = extent.max_tan + (widest + a.lens.w) / f;
   // 1. Position. A point at depth z >= nearest seen at u = f x / z moves by
   //    (f / z)(|dx| + max_tan |dz|) <= |dp| (f + f max_tan) / nearest when
   //    the pupil moves by dp (the entrance pupil follows focus and zoom),
@@ -101,6 +105,7 @@ double frame_change_px(const gpu::FrameParams &a, const gpu::FrameParams &b, dou
   const double theta = 2.0 * std::asin(std::min(1.0, std::sqrt(turned2 / 8.0)));
   change += f * theta * (1.0 + max_tan * max_tan);
   change += f * aperture * theta * max_tan / nearest_m;
+  change *= extent.stretch;
   return std::isfinite(change) ? change : kInfinity;
 }
 

@@ -98,6 +98,8 @@ std::uint32_t frame_kernel_features(const gpu::FrameParams &frame) {
       frame.tracing.z == SAMPLER_SOBOL ? KERNEL_CAMERA_SOBOL : KERNEL_CAMERA_CMJ;
   if ((frame.tracing.w & TRACING_SKIP_EMPTY_PIXELS) != 0u)
     features |= KERNEL_SKIP_EMPTY_PIXELS;
+  if ((frame.tracing.w & TRACING_LENS_MODEL) != 0u)
+    features |= KERNEL_LENS_MODEL;
   return features;
 }
 

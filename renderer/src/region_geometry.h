@@ -15,6 +15,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/gpu_layout.h"
 #include "camhead/renderer/influence_region.h"
 
@@ -164,8 +165,11 @@ public:
     for (ConvexPolyhedron *p : {&front_, &near_, &far_})
       p->reserve(v, f);
     cap_.reserve(2 * f);
-    points_.reserve(8 * v); // an octagon per vertex
-    hull_.reserve(16 * v);
+    // An octagon per vertex; through a lens model, the hull's edges in steps.
+    points_.reserve(kMostLensPoints + 8 * v + 8);
+    hull_.reserve(2 * points_.capacity());
+    clipped_.reserve(16 * v + 8);
+    clipping_.reserve(16 * v + 8);
     const std::size_t tiles_x = (width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X;
     const std::size_t tiles_y = (height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y;
     marked_.reserve(tiles_x * tiles_y);
@@ -192,10 +196,19 @@ public:
     tiles_x_ = (width_ + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X;
     tiles_y_ = (height_ + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y;
     marked_.assign(std::size_t(tiles_x_) * tiles_y_, 0);
+    lens_model_ = has_lens_model(frame);
+    if (lens_model_) {
+      frame_ = frame;
+      bound_lens();
+    }
   }
 
   // Marks the pixels that may see a point of `poly`.
   void add(const ConvexPolyhedron &poly) {
+    if (lens_model_ && !lens_invertible_) {
+      mark_everywhere(); // a lens that folds over: where anything lands is unknown
+      return;
+    }
     poly.clip_into({-forward_, -glm::dot(forward_, centre_)}, front_, cap_); // behind: no ray
     if (front_.empty())
       return;
@@ -206,10 +219,14 @@ public:
     front_.clip_into({forward_, glm::dot(forward_, centre_) + kNearM}, near_, cap_);
     if (!near_.empty()) {
       const double reach_aperture = aperture_ * std::max(1.0, std::abs(1.0 - kNearM / focus_));
-      const double reach_x =
-          reach_aperture + (0.5 * width_ + filter_px_ + 2.0) * kNearM / focal_px_;
-      const double reach_y =
-          reach_aperture + (0.5 * height_ + filter_px_ + 2.0) * kNearM / focal_px_;
+      // The frame's half-width and half-height on the ideal image plane:
+      // through a lens model, the bounds of its preimage.
+      const double half_x = lens_model_ ? std::max(-lens_lo_.u, lens_hi_.u)
+                                        : (0.5 * width_ + filter_px_ + 2.0) / focal_px_;
+      const double half_y = lens_model_ ? std::max(-lens_lo_.v, lens_hi_.v)
+                                        : (0.5 * height_ + filter_px_ + 2.0) / focal_px_;
+      const double reach_x = reach_aperture + half_x * kNearM;
+      const double reach_y = reach_aperture + half_y * kNearM;
       double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
       near_.for_each_vertex([&](const dvec3 &v) {
         x_lo = std::min(x_lo, glm::dot(right_, v - centre_));
@@ -230,6 +247,10 @@ public:
     // Each vertex's blur circle by the octagon around it; the image lies in
     // the convex hull of the octagons.
     constexpr double kOctagon = 1.0823922002923940; // 1 / cos(pi / 8)
+    if (lens_model_) {
+      add_through_lens(kOctagon);
+      return;
+    }
     points_.clear();
     bool finite = true;
     far_.for_each_vertex([&](const dvec3 &p) {
@@ -256,6 +277,137 @@ public:
   [[nodiscard]] std::size_t rects_capacity() const { return rects_capacity_; }
 
 private:
+  // A piece seen through the frame's lens model (renderer/shaders/
+  // lens_model.glsl): the hull of its blur octagons on the ideal image plane
+  // (normalised), cut to the rectangle that holds every sample position's
+  // preimage (bound_lens), then its edges taken through the lens in steps of
+  // at most kLensStepPx: the hull of those points, grown by kChordPx, holds
+  // the piece's distorted image (the lens bends an edge between two steps
+  // by far less: a barrel of k1 = -0.3 by a thousandth of a pixel).
+  void add_through_lens(double octagon) {
+    points_.clear();
+    bool finite = true;
+    far_.for_each_vertex([&](const dvec3 &p) {
+      const dvec3 d = p - centre_;
+      const double z = glm::dot(forward_, d);
+      const double x = glm::dot(right_, d) / z, y = -glm::dot(up_, d) / z;
+      const double blur = aperture_ * std::abs(1.0 / focus_ - 1.0 / z) * octagon;
+      finite = finite && std::isfinite(x) && std::isfinite(y) && std::isfinite(blur);
+      for (const Point &corner : kOctagonCorners)
+        points_.push_back({x + blur * corner.u, y + blur * corner.v});
+    });
+    if (!finite) {
+      mark_everywhere(); // unknown
+      return;
+    }
+    convex_hull(points_, hull_);
+    clip_to_lens_bounds();
+    if (clipped_.empty())
+      return;
+    double perimeter_px = 0.0;
+    for (std::size_t i = 0; i < clipped_.size(); ++i) {
+      const Point &a = clipped_[i], &b = clipped_[(i + 1) % clipped_.size()];
+      perimeter_px += std::hypot(b.u - a.u, b.v - a.v) * focal_px_;
+    }
+    const double step_px = std::max(kLensStepPx, perimeter_px / double(kMostLensPoints));
+    points_.clear();
+    for (std::size_t i = 0; i < clipped_.size(); ++i) {
+      const Point &a = clipped_[i], &b = clipped_[(i + 1) % clipped_.size()];
+      const double steps =
+          std::max(1.0, std::ceil(std::hypot(b.u - a.u, b.v - a.v) * focal_px_ / step_px));
+      for (double k = 0.0; k < steps; k += 1.0) {
+        const double t = k / steps;
+        const glm::vec2 pixel = ideal_to_pixel(
+            frame_, glm::vec2(float(a.u + (b.u - a.u) * t), float(a.v + (b.v - a.v) * t)));
+        points_.push_back({pixel.x, pixel.y});
+      }
+    }
+    convex_hull(points_, hull_);
+    mark_polygon(hull_, kChordPx);
+  }
+
+  // The rectangle of the ideal image plane that holds the preimage of every
+  // sample position (the frame grown by the reach): the border's, taken back
+  // through the lens every few pixels, when the lens is one-to-one there
+  // (its Jacobian's determinant positive on a grid, and each border point's
+  // preimage going back to it). A lens that folds over inside the frame, as
+  // a strong barrel polynomial does past its turning radius, has no such
+  // rectangle: every tile is marked.
+  void bound_lens() {
+    const double grow = kReachPx + 0.5 * filter_px_ + 1.0;
+    const double u0 = -grow, u1 = double(width_) + grow;
+    const double v0 = -grow, v1 = double(height_) + grow;
+    lens_lo_ = {INFINITY, INFINITY};
+    lens_hi_ = {-INFINITY, -INFINITY};
+    lens_invertible_ = true;
+    const auto take = [&](double u, double v) {
+      const glm::vec2 ideal = pixel_to_ideal(frame_, glm::vec2(float(u), float(v)));
+      const glm::vec2 back = ideal_to_pixel(frame_, ideal);
+      if (!(std::abs(double(back.x) - u) < 0.01 && std::abs(double(back.y) - v) < 0.01))
+        lens_invertible_ = false;
+      lens_lo_ = {std::min(lens_lo_.u, double(ideal.x)), std::min(lens_lo_.v, double(ideal.y))};
+      lens_hi_ = {std::max(lens_hi_.u, double(ideal.x)), std::max(lens_hi_.v, double(ideal.y))};
+    };
+    constexpr double kBorderStepPx = 4.0;
+    for (double u = u0; u < u1 + kBorderStepPx; u += kBorderStepPx) {
+      take(std::min(u, u1), v0);
+      take(std::min(u, u1), v1);
+    }
+    for (double v = v0; v < v1 + kBorderStepPx; v += kBorderStepPx) {
+      take(u0, std::min(v, v1));
+      take(u1, std::min(v, v1));
+    }
+    // A hair more, for the float arithmetic of the kernels' own preimages.
+    const double slack = 1e-4 * std::max(lens_hi_.u - lens_lo_.u, lens_hi_.v - lens_lo_.v);
+    lens_lo_ = {lens_lo_.u - slack, lens_lo_.v - slack};
+    lens_hi_ = {lens_hi_.u + slack, lens_hi_.v + slack};
+    constexpr int kGrid = 16;
+    const double h = 1e-4;
+    for (int j = 0; j <= kGrid && lens_invertible_; ++j)
+      for (int i = 0; i <= kGrid && lens_invertible_; ++i) {
+        const double x = lens_lo_.u + (lens_hi_.u - lens_lo_.u) * i / kGrid;
+        const double y = lens_lo_.v + (lens_hi_.v - lens_lo_.v) * j / kGrid;
+        const glm::dvec2 p(ideal_to_pixel(frame_, glm::vec2(float(x), float(y))));
+        const glm::dvec2 px(ideal_to_pixel(frame_, glm::vec2(float(x + h), float(y))));
+        const glm::dvec2 py(ideal_to_pixel(frame_, glm::vec2(float(x), float(y + h))));
+        const glm::dvec2 a = px - p, b = py - p;
+        lens_invertible_ = a.x * b.y - a.y * b.x > 0.0;
+      }
+    if (!std::isfinite(lens_lo_.u + lens_lo_.v + lens_hi_.u + lens_hi_.v))
+      lens_invertible_ = false;
+  }
+
+  // hull_ cut to the rectangle lens_lo_..lens_hi_ (Sutherland-Hodgman), into
+  // clipped_.
+  void clip_to_lens_bounds() {
+    clipped_.assign(hull_.begin(), hull_.end());
+    const auto cut = [&](auto inside, auto cross) {
+      clipping_.clear();
+      for (std::size_t i = 0; i < clipped_.size(); ++i) {
+        const Point &a = clipped_[i], &b = clipped_[(i + 1) % clipped_.size()];
+        if (inside(a))
+          clipping_.push_back(a);
+        if (inside(a) != inside(b))
+          clipping_.push_back(cross(a, b));
+      }
+      clipped_.swap(clipping_);
+    };
+    const auto at_u = [](double u) {
+      return [u](const Point &a, const Point &b) {
+        return Point{u, a.v + (b.v - a.v) * ((u - a.u) / (b.u - a.u))};
+      };
+    };
+    const auto at_v = [](double v) {
+      return [v](const Point &a, const Point &b) {
+        return Point{a.u + (b.u - a.u) * ((v - a.v) / (b.v - a.v)), v};
+      };
+    };
+    cut([&](const Point &p) { return p.u >= lens_lo_.u; }, at_u(lens_lo_.u));
+    cut([&](const Point &p) { return p.u <= lens_hi_.u; }, at_u(lens_hi_.u));
+    cut([&](const Point &p) { return p.v >= lens_lo_.v; }, at_v(lens_lo_.v));
+    cut([&](const Point &p) { return p.v <= lens_hi_.v; }, at_v(lens_hi_.v));
+  }
+
   // Marks every tile: where a piece's image is not known.
   void mark_everywhere() { std::fill(marked_.begin(), marked_.end(), std::uint8_t(1)); }
 
@@ -263,7 +415,7 @@ private:
   // half the filter width, and one pixel more for the rays' rounding) can
   // fall in a convex polygon (image coordinates, in order), a row of
   // tiles at a time: its x-range within the row's band of sample positions.
-  void mark_polygon(std::span<const Point> hull) {
+  void mark_polygon(std::span<const Point> hull, double extra_reach_px = 0.0) {
     if (hull.empty())
       return;
     double v_lo = INFINITY, v_hi = -INFINITY;
@@ -271,7 +423,7 @@ private:
       v_lo = std::min(v_lo, p.v);
       v_hi = std::max(v_hi, p.v);
     }
-    const double reach = kReachPx + 0.5 * filter_px_;
+    const double reach = kReachPx + 0.5 * filter_px_ + extra_reach_px;
     for (std::uint32_t ty = 0; ty < tiles_y_; ++ty) {
       // The sample positions of the row's pixels: their centres within reach.
       const double band_lo = double(ty * CAMHEAD_TILE_Y) + 0.5 - reach;
@@ -306,6 +458,12 @@ private:
 
   // A pixel of margin for the rays' rounding, beyond the pixel filter.
   static constexpr double kReachPx = 1.0;
+  // Through a lens model: the longest step along a hull's edge, the points
+  // an edge may take (a longer hull takes longer steps), and the margin for
+  // the lens's bending of an edge between two steps.
+  static constexpr double kLensStepPx = 4.0;
+  static constexpr std::size_t kMostLensPoints = 2048;
+  static constexpr double kChordPx = 0.25;
 
   // The unit octagon's corners, at multiples of 45 degrees.
   static constexpr double kHalfRoot2 = 0.70710678118654752;
@@ -320,6 +478,10 @@ private:
 
   dvec3 centre_{}, right_{}, up_{}, forward_{};
   double aperture_ = 0.0, focus_ = 0.0, focal_px_ = 0.0, filter_px_ = 0.0;
+  bool lens_model_ = false, lens_invertible_ = false;
+  gpu::FrameParams frame_{}; // with a lens model: its projection
+  Point lens_lo_{}, lens_hi_{};
+  std::vector<Point> clipped_, clipping_;
   std::uint32_t width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
   std::vector<std::uint8_t> marked_;
   ConvexPolyhedron front_, near_, far_;

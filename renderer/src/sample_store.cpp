@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "camhead/renderer/frame_settings.h"
+
 namespace camhead::renderer::cpu {
 namespace {
 
@@ -20,13 +22,18 @@ bool same_view(const gpu::FrameParams &a, const gpu::FrameParams &b) {
   return same(a.cam_position, b.cam_position) && same(a.cam_right, b.cam_right) &&
          same(a.cam_up, b.cam_up) && same(a.cam_forward, b.cam_forward) &&
          same(a.world_color, b.world_color) && a.image.x == b.image.x && a.image.y == b.image.y &&
-         a.image.w == b.image.w && a.tracing.x == b.tracing.x && a.lens.w == b.lens.w;
+         a.image.w == b.image.w && a.tracing.x == b.tracing.x && a.lens.w == b.lens.w &&
+         has_lens_model(a) == has_lens_model(b) &&
+         (!has_lens_model(a) ||
+          (same(a.projection, b.projection) && same(a.distortion, b.distortion)));
 }
 
 bool reprojectable(const gpu::FrameParams &from, const gpu::FrameParams &to) {
-  return same_view(from, to) && from.lens.w == 1.0f && finite(from.lens) && finite(to.lens) &&
-         from.lens.y > 0.0f && to.lens.y > 0.0f && from.lens.z > 0.0f && to.lens.z > 0.0f &&
-         to.lens.x >= 0.0f && to.lens.x <= from.lens.x;
+  // Through a lens model a sample's pixel is not linear in its ray
+  // (sample_store.h), and samples moved would not stay uniform.
+  return same_view(from, to) && !has_lens_model(to) && from.lens.w == 1.0f && finite(from.lens) &&
+         finite(to.lens) && from.lens.y > 0.0f && to.lens.y > 0.0f && from.lens.z > 0.0f &&
+         to.lens.z > 0.0f && to.lens.x >= 0.0f && to.lens.x <= from.lens.x;
 }
 
 void SampleStore::reserve(std::size_t capacity, std::uint32_t width, std::uint32_t height) {

@@ -24,7 +24,9 @@
 // (its rays' pixels bounded by a box), and a pixel takes only the samples
 // inside its new aperture (a frame whose aperture was smaller than the new
 // one is not used). A different pose, image, pixel filter, light count,
-// world colour or bounce count makes a frame unusable.
+// world colour or bounce count makes a frame unusable, and so does a lens
+// model (frame_settings.h, has_lens_model): through its distortion the map
+// is not linear.
 #pragma once
 
 #include <algorithm>
@@ -50,7 +52,8 @@ struct StoredSample {
 };
 
 // Whether cameras `a` and `b` see the same rays: the same pose, image,
-// pixel filter, light count, world colour and bounce count (the lens aside).
+// pixel filter, light count, world colour, bounce count and lens model (the
+// thin lens aside).
 [[nodiscard]] bool same_view(const gpu::FrameParams &a, const gpu::FrameParams &b);
 
 // Whether samples of a frame of camera `from` can be moved into one of

@@ -48,9 +48,11 @@ struct Comparison {
 
 // The CPU reference with and without the region, one thread each (the
 // samples of a pixel do not depend on the thread count, only the time).
-Comparison compare_cpu(const Scene &scene, int rpp) {
+Comparison compare_cpu(const Scene &scene, int rpp, const renderer::LensModel &lens = {}) {
   const CompiledScene compiled = renderer::compile_scene(scene);
-  const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, rpp);
+  renderer::FrameCamera camera = renderer::scene_camera(scene);
+  camera.lens_model = lens;
+  const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, camera, rpp);
   const InfluenceRegion region = renderer::influence_region(compiled, frame);
   const renderer::RenderResult full = renderer::render_cpu(compiled, frame, {}, 1);
   const renderer::RenderResult part = renderer::render_cpu(compiled, frame, {}, 1, &region);
@@ -163,6 +165,56 @@ TEST(InfluenceRegion, SphereAndShadowBoundsBitForBit) {
     EXPECT_EQ(c.differing_pixel, -1) << name << ": pixel (" << c.differing_pixel % 320 << ", "
                                      << c.differing_pixel / 320 << ") differs";
   }
+}
+
+// Through a lens model (renderer/shaders/lens_model.glsl) the region bounds
+// the distorted image: strong barrel, pincushion and tangential lenses with
+// the principal point off centre, over random scenes and a field of small
+// defocused balls reaching into the corners, where the lens moves things
+// most (a region projected through the pinhole misses rims there by tens
+// of pixels).
+TEST(InfluenceRegion, ThroughALensModelBitForBit) {
+  std::vector<renderer::LensModel> lenses(3);
+  lenses[0].k1 = -0.3f;
+  lenses[0].k2 = 0.08f;
+  lenses[0].principal_point = {0.53f, 0.46f};
+  lenses[1].k1 = 0.25f;
+  lenses[1].k3 = 0.05f;
+  lenses[1].fy_over_fx = 0.98f;
+  lenses[2].k1 = -0.08f;
+  lenses[2].p1 = 0.015f;
+  lenses[2].p2 = -0.01f;
+  lenses[2].principal_point = {0.47f, 0.52f};
+  int partial = 0, compared = 0;
+  for (std::size_t k = 0; k < lenses.size(); ++k) {
+    for (std::uint32_t seed = 1; seed <= 60; ++seed) {
+      const Scene scene = test::random_scene(seed);
+      const Comparison c = compare_cpu(scene, 2, lenses[k]);
+      ++compared;
+      partial += c.fraction < 1.0 ? 1 : 0;
+      EXPECT_EQ(c.differing_pixel, -1)
+          << "lens " << k << ", " << scene.source << ": pixel ("
+          << c.differing_pixel % scene.render.width << ", "
+          << c.differing_pixel / scene.render.width << ") differs; region " << c.fraction;
+    }
+    Scene scene = test::empty_scene("corners", 1.4f, 0.8f, 160, 120);
+    scene.materials = {{"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
+    for (int i = 0; i < 20; ++i) {
+      const float x = (float(i % 5) - 2.0f) * 0.36f * 2.5f;
+      const float y = (float(i / 5) - 1.5f) * 0.3f * 2.5f;
+      scene.objects.push_back(test::sphere("ball", glm::vec3(x, y, -2.5f), 0.01f * 2.5f, 0, false));
+    }
+    scene = test::with_noise_plate(std::move(scene), 7);
+    const Comparison c = compare_cpu(scene, 16, lenses[k]);
+    std::printf("lens %zu, 20 defocused balls to the corners: %.1f %% traced\n", k,
+                100.0 * c.fraction);
+    EXPECT_LT(c.fraction, 1.0) << "lens " << k;
+    EXPECT_EQ(c.differing_pixel, -1) << "lens " << k << ": pixel (" << c.differing_pixel % 160
+                                     << ", " << c.differing_pixel / 160 << ") differs";
+  }
+  std::printf("%d scenes through lens models, %d with a region smaller than the frame\n", compared,
+              partial);
+  EXPECT_GT(partial, compared / 2);
 }
 
 // What it saves: a small virtual sphere alone over the plate is a small

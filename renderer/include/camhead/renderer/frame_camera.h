@@ -4,11 +4,29 @@
 // default (scene_camera()).
 #pragma once
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "camhead/renderer/scene.h"
 
 namespace camhead::renderer {
+
+// The real lens beyond a centred pinhole of square pixels, in OpenCV's
+// terms (renderer/shaders/lens_model.glsl): the principal point as a
+// fraction of the image's width and height from its top-left corner, the
+// focal length down the image over the one across it (fy / fx), and
+// Brown-Conrady distortion. The defaults are the ideal lens, which renders
+// as a pinhole camera always has.
+struct LensModel {
+  glm::vec2 principal_point{0.5f, 0.5f};
+  float fy_over_fx = 1.0f;
+  float k1 = 0.0f, k2 = 0.0f, k3 = 0.0f, p1 = 0.0f, p2 = 0.0f;
+
+  [[nodiscard]] bool ideal() const {
+    return principal_point == glm::vec2(0.5f) && fy_over_fx == 1.0f && k1 == 0.0f && k2 == 0.0f &&
+           k3 == 0.0f && p1 == 0.0f && p2 == 0.0f;
+  }
+};
 
 struct FrameCamera {
   // The pose: the lens's reference plane (where the lens profile measures the
@@ -31,6 +49,9 @@ struct FrameCamera {
   // The entrance pupil, metres in front of `position` along the view axis:
   // where the lens rays start and the focus distance is measured from.
   float entrance_pupil_offset_m = 0.0f;
+  // The principal point and distortion; the image scale across the image is
+  // the projection focal length's.
+  LensModel lens_model;
 };
 
 // What stops make_frame_params() from building a camera frame, in the

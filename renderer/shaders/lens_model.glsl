@@ -1,0 +1,45 @@
+// The real lens beyond the pinhole: Brown-Conrady distortion in OpenCV's
+// convention (cv::projectPoints), on normalised image coordinates (x right,
+// y down, 1 at one focal length from the principal point):
+//
+//     r^2 = x^2 + y^2,   R = 1 + k1 r^2 + k2 r^4 + k3 r^6
+//     x_d = x R + 2 p1 x y + p2 (r^2 + 2 x^2)
+//     y_d = y R + p1 (r^2 + 2 y^2) + 2 p2 x y
+//
+// `k` holds k1, k2, p1, p2 (OpenCV's order) and `k3` the sixth-order term.
+//
+// Written once for the GPU kernels (kernel.glsl includes it) and the C++ side
+// (renderer/src/lens_model_math.h includes it inside a struct, as
+// cpu_kernel.h does kernel.glsl), so it keeps to the same common subset: no
+// swizzles, explicit float literals, do-while loops.
+
+vec2 lens_distort(vec2 p, vec4 k, float k3) {
+  float r2 = p.x * p.x + p.y * p.y;
+  float radial = 1.0f + r2 * (k.x + r2 * (k.y + r2 * k3));
+  return vec2(p.x * radial + 2.0f * k.z * p.x * p.y + k.w * (r2 + 2.0f * p.x * p.x),
+              p.y * radial + k.z * (r2 + 2.0f * p.y * p.y) + 2.0f * k.w * p.x * p.y);
+}
+
+// The point that lens_distort() takes to `d`: Newton's method from `d`
+// itself, a fixed number of steps (every lane alike). Within the radius
+// where the lens maps outward monotonically (renderer/lens_model.h checks
+// that a frame stays inside it), a lens of |k1| up to 0.5 converges to
+// float precision in four steps; six leave room.
+vec2 lens_undistort(vec2 d, vec4 k, float k3) {
+  vec2 p = d;
+  int step = 0;
+  do {
+    float r2 = p.x * p.x + p.y * p.y;
+    float radial = 1.0f + r2 * (k.x + r2 * (k.y + r2 * k3));
+    float slope = k.x + r2 * (2.0f * k.y + 3.0f * r2 * k3); // dR / d(r^2)
+    vec2 residual = lens_distort(p, k, k3) - d;
+    // The Jacobian of lens_distort (symmetric).
+    float jxx = radial + 2.0f * p.x * p.x * slope + 2.0f * k.z * p.y + 6.0f * k.w * p.x;
+    float jyy = radial + 2.0f * p.y * p.y * slope + 6.0f * k.z * p.y + 2.0f * k.w * p.x;
+    float jxy = 2.0f * p.x * p.y * slope + 2.0f * k.z * p.x + 2.0f * k.w * p.y;
+    float det = jxx * jyy - jxy * jxy;
+    p = p - vec2(jyy * residual.x - jxy * residual.y, jxx * residual.y - jxy * residual.x) / det;
+    ++step;
+  } while (step < 6);
+  return p;
+}
