@@ -135,7 +135,33 @@ LensProfile::Lookup LensProfile::entrance_pupil_offset_mm(double zoom_counts) co
   return {r.y, r.clamped};
 }
 
+LensProfile::CameraPoint LensProfile::CameraTable::at(double d) const {
+  if (points.size() == 1)
+    return points.front();
+  CameraPoint out;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = curves[i](d).y;
+  return out;
+}
+
+LensProfile::CameraPoint LensProfile::camera_for_focus(double zoom_counts, double diopters) const {
+  const ZoomSpan s = zoom_span(zoom_counts);
+  const CameraPoint a = zoom_points_[s.k].camera->at(diopters);
+  if (s.t == 0.0)
+    return a;
+  const CameraPoint b = zoom_points_[s.k + 1].camera->at(diopters);
+  if (s.t == 1.0)
+    return b;
+  CameraPoint out;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = (1.0 - s.t) * a[i] + s.t * b[i];
+  return out;
+}
+
 double LensProfile::projection_at_point(const ZoomPoint &z, double diopters) const {
+  // Version 3: the camera model's image scale, fx, on the sensor.
+  if (z.camera)
+    return z.camera->at(diopters)[kFx] * image_->sensor_width_mm / double(image_->width_px);
   if (!z.breathing.empty())
     return z.breathing(diopters).y;
   return z.projection_focal_length_mm.value_or(z.focal_length_mm);
@@ -229,6 +255,12 @@ LensState LensProfile::evaluate(const LensCounts &counts, const LensValues &valu
         Measured{proj.value, std::min(fo.t_ns, zo.t_ns), fo.fresh && zo.fresh, proj.clamped};
   }
   s.distortion = distortion_;
+  if (image_) {
+    const CameraPoint c = camera_for_focus(zo.counts, focus.y);
+    s.projection = {(c[kCx] + 0.5) / double(image_->width_px),
+                    (c[kCy] + 0.5) / double(image_->height_px), c[kFy] / c[kFx]};
+    s.distortion = Distortion{c[kK1], c[kK2], c[kK3], c[kP1], c[kP2]};
+  }
   return s;
 }
 

@@ -6,10 +6,11 @@
 // that would make the renderer's focus run backwards between two calibration
 // marks is a configuration error, not something to smooth over.
 //
-// The version names the focus layout, one layout per version, so that an
-// older reader refuses what it cannot read instead of misreading it: version 1
-// has one top-level focus table, version 2 one table on every zoom point and
-// none at the top (README.md, "Profile format").
+// The version names the layout, so that an older reader refuses what it
+// cannot read instead of misreading it: version 1 has one top-level focus
+// table, version 2 one table on every zoom point and none at the top, and
+// version 3 a camera model on every zoom point, with its focus tables as
+// version 1's or 2's (README.md, "Profile format").
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -28,6 +29,7 @@ using base::Range;
 constexpr std::string_view kFormat = "camhead-lens-profile";
 constexpr std::int64_t kVersionOneFocus = 1;     // one top-level focus table
 constexpr std::int64_t kVersionPerZoomFocus = 2; // a focus table on every zoom point
+constexpr std::int64_t kVersionCameraModel = 3;  // a camera model on every zoom point
 
 // Strictly monotone in either direction; returns the index of the first
 // element that breaks it, or 0 when the sequence is monotone.
@@ -96,22 +98,35 @@ class ProfileReader {
 public:
   LensProfile read(const JsonValue &root) {
     root.object({"format", "version", "name", "iris"},
-                {"description", "focus", "zoom", "prime", "distortion"});
+                {"description", "focus", "zoom", "prime", "distortion", "image"});
     const JsonValue format = root.at("format");
     if (!format.json().is_string() || format.json().get<std::string>() != kFormat)
       format.fail("must be \"" + std::string(kFormat) + "\"");
     const JsonValue version = root.at("version");
     const Json &v = version.json();
     if (!v.is_number_integer() || (v.get<std::int64_t>() != kVersionOneFocus &&
-                                   v.get<std::int64_t>() != kVersionPerZoomFocus))
-      version.fail("unsupported version (this reader understands 1 and 2)");
-    per_zoom_focus_ = v.get<std::int64_t>() == kVersionPerZoomFocus;
+                                   v.get<std::int64_t>() != kVersionPerZoomFocus &&
+                                   v.get<std::int64_t>() != kVersionCameraModel))
+      version.fail("unsupported version (this reader understands 1, 2 and 3)");
+    camera_model_ = v.get<std::int64_t>() == kVersionCameraModel;
+    // Version 3 takes either focus layout, told apart by where the tables are.
+    per_zoom_focus_ = v.get<std::int64_t>() == kVersionPerZoomFocus ||
+                      (camera_model_ && root.has("zoom") && !root.has("focus"));
     LensProfile p;
+    if (camera_model_) {
+      p.image_ = read_image(root.at("image"));
+      image_ = *p.image_;
+      if (root.has("distortion"))
+        root.fail_member("distortion", "a version 3 profile gives the distortion with each "
+                                       "camera point (zoom[i].camera or prime.camera)");
+    } else if (root.has("image")) {
+      root.fail_member("image", "belongs to a camera model, which needs \"version\": 3");
+    }
     p.name_ = root.at("name").string();
     if (root.has("description"))
       (void)root.at("description").text();
 
-    if (per_zoom_focus_ && root.has("focus"))
+    if (per_zoom_focus_ && root.has("focus") && !camera_model_)
       version.fail("2 means a focus table on every zoom point (zoom[i].focus) and no "
                    "top-level focus; a profile with one focus table is version 1");
     if (!per_zoom_focus_)
@@ -122,7 +137,7 @@ public:
       root.fail_member(zoom ? "prime" : "zoom",
                        zoom ? "a profile has either zoom or prime, not both"
                             : "missing (give zoom for a zoom lens, prime for a prime)");
-    if (per_zoom_focus_ && prime)
+    if (per_zoom_focus_ && prime && !camera_model_)
       version.fail("2 means per-zoom focus tables, which need a zoom table; a prime has "
                    "one top-level focus table and is version 1");
     if (zoom)
@@ -189,9 +204,19 @@ private:
                                          const LensProfile::ZoomPoint *first) const {
     if (in_table)
       d.object({"counts", "focal_length_mm"},
-               {"projection_focal_length_mm", "entrance_pupil_offset_mm", "focus"});
+               {"projection_focal_length_mm", "entrance_pupil_offset_mm", "focus", "camera"});
     else
-      d.object({"focal_length_mm"}, {"projection_focal_length_mm", "entrance_pupil_offset_mm"});
+      d.object({"focal_length_mm"},
+               {"projection_focal_length_mm", "entrance_pupil_offset_mm", "camera"});
+    if (camera_model_ && !d.has("camera"))
+      d.fail_member("camera", "missing (a version 3 profile gives a camera model on every zoom "
+                              "point, or on the prime)");
+    if (!camera_model_ && d.has("camera"))
+      d.fail_member("camera", "a camera model needs \"version\": 3 (and the \"image\" it was "
+                              "calibrated in)");
+    if (d.has("camera") && d.has("projection_focal_length_mm"))
+      d.fail_member("projection_focal_length_mm",
+                    "a camera model's fx sets the image scale; give one or the other");
     LensProfile::ZoomPoint z;
     z.focal_length_mm = d.at("focal_length_mm").number(Range::above(0.0, 1e4));
     const bool pupil = d.has("entrance_pupil_offset_mm");
@@ -212,6 +237,8 @@ private:
       else
         z.projection_focal_length_mm = v.number(Range::above(0.0, 1e4));
     }
+    if (camera_model_)
+      z.camera = read_camera(d.at("camera"));
     if (in_table) {
       if (d.has("focus") && !per_zoom_focus_)
         d.fail_member("focus", "per-zoom focus tables need \"version\": 2 (then one on every "
@@ -279,6 +306,60 @@ private:
                               "or the blend between them would run backwards");
   }
 
+  // The images the camera tables were calibrated in.
+  static LensProfile::Image read_image(const JsonValue &v) {
+    v.object({"width_px", "height_px", "sensor_width_mm"});
+    LensProfile::Image image;
+    image.width_px = int(v.at("width_px").integer(1, 1 << 16));
+    image.height_px = int(v.at("height_px").integer(1, 1 << 16));
+    image.sensor_width_mm = v.at("sensor_width_mm").number(Range::above(0.0, 1e3));
+    return image;
+  }
+
+  // A camera table: OpenCV's model over focus distance, at least one point.
+  LensProfile::CameraTable read_camera(const JsonValue &v) const {
+    const std::vector<JsonValue> t = v.elements("camera points");
+    if (t.empty())
+      v.fail("needs at least 1 camera point");
+    LensProfile::CameraTable table;
+    const double w = image_.width_px, h = image_.height_px;
+    for (const JsonValue &point : t) {
+      point.object({"distance_m", "fx", "fy", "cx", "cy"}, {"k1", "k2", "k3", "p1", "p2"});
+      table.diopters.push_back(diopters(point.at("distance_m")));
+      LensProfile::CameraPoint c{};
+      c[LensProfile::kFx] = point.at("fx").number(Range::above(0.0, 1e6));
+      c[LensProfile::kFy] = point.at("fy").number(Range::above(0.0, 1e6));
+      // The principal point within the image (OpenCV's pixel centres).
+      c[LensProfile::kCx] = point.at("cx").number(Range::within(-0.5, w - 0.5));
+      c[LensProfile::kCy] = point.at("cy").number(Range::within(-0.5, h - 0.5));
+      const auto coefficient = [&](std::string_view k, LensProfile::CameraParam i) {
+        if (point.has(k))
+          c[i] = point.at(k).number(Range::within(-100.0, 100.0));
+      };
+      coefficient("k1", LensProfile::kK1);
+      coefficient("k2", LensProfile::kK2);
+      coefficient("p1", LensProfile::kP1);
+      coefficient("p2", LensProfile::kP2);
+      coefficient("k3", LensProfile::kK3);
+      table.points.push_back(c);
+    }
+    if (t.size() > 1)
+      require_monotone(table.diopters, t, "distance_m");
+    // MonotoneCurve wants increasing x: near-to-far becomes far-to-near.
+    if (table.diopters.front() > table.diopters.back()) {
+      std::reverse(table.diopters.begin(), table.diopters.end());
+      std::reverse(table.points.begin(), table.points.end());
+    }
+    if (table.points.size() > 1)
+      for (std::size_t i = 0; i < LensProfile::kCameraParams; ++i) {
+        std::vector<double> ys;
+        for (const LensProfile::CameraPoint &c : table.points)
+          ys.push_back(c[i]);
+        table.curves[i] = MonotoneCurve(table.diopters, ys);
+      }
+    return table;
+  }
+
   static Distortion read_distortion(const JsonValue &d) {
     d.object({}, {"k1", "k2", "k3", "p1", "p2"});
     Distortion out;
@@ -294,7 +375,9 @@ private:
     return out;
   }
 
-  bool per_zoom_focus_ = false; // version 2
+  bool per_zoom_focus_ = false; // version 2, or 3 with per-zoom tables
+  bool camera_model_ = false;   // version 3
+  LensProfile::Image image_;    // version 3
 };
 
 LensProfile LensProfile::parse(std::string_view json_text, const std::filesystem::path &source) {

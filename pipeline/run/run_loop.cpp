@@ -205,7 +205,11 @@ Pipeline::Pipeline(const RunOptions &options)
   std::vector<base::VideoFormat> formats;
   for (const auto &sink : sinks_)
     formats.push_back(sink->format());
-  renderer_->prepare(board_request(), camera_->format(), formats);
+  // Prepared with the lens as it is now (at rest until its readings come):
+  // its model decides the kernels that prepare() builds for every frame.
+  renderer::FrameRequest first = board_request();
+  first.camera = lens_camera(base_camera_, lens_.state_at(base::monotonic_ns()).state);
+  renderer_->prepare(first, camera_->format(), formats);
   for (Slot &slot : slots_)
     for (const auto &sink : sinks_)
       slot.images.emplace_back(base::frame_bytes(sink->format()));

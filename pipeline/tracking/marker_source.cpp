@@ -7,6 +7,7 @@
 
 #include "camhead/base/thread_name.h"
 #include "luma.h"
+#include "run/lens_camera.h"
 #include "run/lens_hub.h"
 
 namespace camhead::pipeline {
@@ -98,8 +99,12 @@ CameraModel MarkerPoseSource::camera_of(const lens_control::LensState &lens) con
   CameraModel camera;
   camera.fx = camera.fy =
       lens.projection_focal_length_mm.value * double(format_.width) / sensor_width_mm_;
-  camera.cx = (format_.width - 1) / 2.0;
-  camera.cy = (format_.height - 1) / 2.0;
+  // The renderer's pixel x spans [x, x + 1); OpenCV's is centred on x.
+  const renderer::LensModel model = lens_model(lens);
+  camera.fy = camera.fx * double(model.fy_over_fx);
+  camera.cx = double(model.principal_point.x) * format_.width - 0.5;
+  camera.cy = double(model.principal_point.y) * format_.height - 0.5;
+  camera.distortion = {model.k1, model.k2, model.p1, model.p2, model.k3};
   return camera;
 }
 

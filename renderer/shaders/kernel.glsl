@@ -50,9 +50,10 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   if (KERNEL_HAS(KERNEL_LENS_MODEL) && (frame.tracing.w & TRACING_LENS_MODEL) != 0u) {
     // The real lens: the point of the image plane that the lens's
     // distortion takes to this sample's position (normalised, y down).
-    vec2 ideal = lens_undistort(vec2((px - frame.projection.x) / frame.lens.z,
-                                     (py - frame.projection.y) / frame.projection.z),
-                                frame.distortion, frame.projection.w);
+    float fy = frame.lens.z * frame.projection.z;
+    vec2 ideal = lens_undistort(
+        vec2((px - frame.projection.x) / frame.lens.z, (py - frame.projection.y) / fy),
+        frame.distortion, frame.projection.w);
     d = normalize(right * ideal.x - up * ideal.y + forward);
   } else {
     d = normalize(right * (px - 0.5f * width) + up * (0.5f * height - py) +
@@ -327,9 +328,6 @@ bool bundle_meets_box(vec3 origin, vec3 inv_dir, float footprint, vec4 bmin4, ve
 // bundle test above that stops at the first leaf the bundle may reach;
 // conservative (a full stack counts as a leaf reached).
 bool pixel_misses_scene(uint x, uint y) {
-  if (KERNEL_HAS(KERNEL_LENS_MODEL) && (frame.tracing.w & TRACING_LENS_MODEL) != 0u) {
-    return false; // the bundle below is a pinhole's; a distorted pixel's is not bounded yet
-  }
   BvhNode root = node_at(0u);
   if (!(abs(root.bmin.x) < 1e30f)) {
     return true; // the empty BVH (bounds at +inf) admits no ray
@@ -337,11 +335,31 @@ bool pixel_misses_scene(uint x, uint y) {
   vec3 origin = vec3(frame.cam_position);
   float px = float(x) + 0.5f;
   float py = float(y) + 0.5f;
-  vec3 d = normalize(vec3(frame.cam_right) * (px - 0.5f * float(frame.image.x)) +
-                     vec3(frame.cam_up) * (0.5f * float(frame.image.y) - py) +
-                     vec3(frame.cam_forward) * frame.lens.z);
+  vec3 d;
+  float footprint;
+  if (KERNEL_HAS(KERNEL_LENS_MODEL) && (frame.tracing.w & TRACING_LENS_MODEL) != 0u) {
+    // Through the lens: the pixel centre's preimage, and its samples' within
+    // their distance over the least stretch of the lens there, a tenth more
+    // for the stretch's change across a pixel.
+    float fy = frame.lens.z * frame.projection.z;
+    vec2 ideal = lens_undistort(
+        vec2((px - frame.projection.x) / frame.lens.z, (py - frame.projection.y) / fy),
+        frame.distortion, frame.projection.w);
+    float least = lens_least_stretch(ideal, frame.distortion, frame.projection.w);
+    if (!(least > 0.05f)) {
+      return false; // where the lens folds over: no bound
+    }
+    d = normalize(vec3(frame.cam_right) * ideal.x - vec3(frame.cam_up) * ideal.y +
+                  vec3(frame.cam_forward));
+    footprint = 1.1f * 0.70710678f * frame.lens.w * frame.lens.y /
+                (min(frame.lens.z, fy) * least);
+  } else {
+    d = normalize(vec3(frame.cam_right) * (px - 0.5f * float(frame.image.x)) +
+                  vec3(frame.cam_up) * (0.5f * float(frame.image.y) - py) +
+                  vec3(frame.cam_forward) * frame.lens.z);
+    footprint = 0.70710678f * frame.lens.w * frame.lens.y / frame.lens.z;
+  }
   vec3 inv_dir = safe_reciprocal(d);
-  float footprint = 0.70710678f * frame.lens.w * frame.lens.y / frame.lens.z;
   uint stack[CAMHEAD_STACK_SIZE];
   int top = 0;
   if (!bundle_meets_box(origin, inv_dir, footprint, root.bmin, root.bmax)) {

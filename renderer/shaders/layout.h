@@ -89,8 +89,8 @@ struct FrameParams {
                   // sharing the budget (the influence region's; 0 = all); w reserved
   // The real lens beyond the pinhole (lens_model.glsl), read only with
   // TRACING_LENS_MODEL: x, y the principal point (pixels from the image's
-  // top-left corner, y down); z the focal length in pixels down the image
-  // (fy; across it, fx, is lens.z); w k3.
+  // top-left corner, y down); z the focal length down the image over the one
+  // across it (fy / fx; fx is lens.z, which breathes); w k3.
   vec4 projection;
   vec4 distortion; // k1, k2, p1, p2 (OpenCV's order and convention)
 };

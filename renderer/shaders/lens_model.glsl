@@ -20,6 +20,25 @@ vec2 lens_distort(vec2 p, vec4 k, float k3) {
               p.y * radial + k.z * (r2 + 2.0f * p.y * p.y) + 2.0f * k.w * p.x * p.y);
 }
 
+// The Jacobian of lens_distort() at `p`, symmetric: (d x_d / d x,
+// d y_d / d y, d x_d / d y = d y_d / d x).
+vec3 lens_jacobian(vec2 p, vec4 k, float k3) {
+  float r2 = p.x * p.x + p.y * p.y;
+  float radial = 1.0f + r2 * (k.x + r2 * (k.y + r2 * k3));
+  float slope = k.x + r2 * (2.0f * k.y + 3.0f * r2 * k3); // dR / d(r^2)
+  return vec3(radial + 2.0f * p.x * p.x * slope + 2.0f * k.z * p.y + 6.0f * k.w * p.x,
+              radial + 2.0f * p.y * p.y * slope + 6.0f * k.z * p.y + 2.0f * k.w * p.x,
+              2.0f * p.x * p.y * slope + 2.0f * k.z * p.x + 2.0f * k.w * p.y);
+}
+
+// The least the lens stretches the image plane at `p`: its Jacobian's
+// smaller eigenvalue (zero or less where the lens folds over).
+float lens_least_stretch(vec2 p, vec4 k, float k3) {
+  vec3 j = lens_jacobian(p, k, k3);
+  float half_difference = 0.5f * (j.x - j.y);
+  return 0.5f * (j.x + j.y) - sqrt(half_difference * half_difference + j.z * j.z);
+}
+
 // The point that lens_distort() takes to `d`: Newton's method from `d`
 // itself, a fixed number of steps (every lane alike). Within the radius
 // where the lens maps outward monotonically (renderer/lens_model.h checks
@@ -29,16 +48,10 @@ vec2 lens_undistort(vec2 d, vec4 k, float k3) {
   vec2 p = d;
   int step = 0;
   do {
-    float r2 = p.x * p.x + p.y * p.y;
-    float radial = 1.0f + r2 * (k.x + r2 * (k.y + r2 * k3));
-    float slope = k.x + r2 * (2.0f * k.y + 3.0f * r2 * k3); // dR / d(r^2)
     vec2 residual = lens_distort(p, k, k3) - d;
-    // The Jacobian of lens_distort (symmetric).
-    float jxx = radial + 2.0f * p.x * p.x * slope + 2.0f * k.z * p.y + 6.0f * k.w * p.x;
-    float jyy = radial + 2.0f * p.y * p.y * slope + 6.0f * k.z * p.y + 2.0f * k.w * p.x;
-    float jxy = 2.0f * p.x * p.y * slope + 2.0f * k.z * p.x + 2.0f * k.w * p.y;
-    float det = jxx * jyy - jxy * jxy;
-    p = p - vec2(jyy * residual.x - jxy * residual.y, jxx * residual.y - jxy * residual.x) / det;
+    vec3 j = lens_jacobian(p, k, k3);
+    float det = j.x * j.y - j.z * j.z;
+    p = p - vec2(j.y * residual.x - j.z * residual.y, j.x * residual.y - j.z * residual.x) / det;
     ++step;
   } while (step < 6);
   return p;

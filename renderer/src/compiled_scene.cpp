@@ -356,7 +356,7 @@ gpu::FrameParams make_frame_params(const Scene &scene, const FrameCamera &cam, i
   if (const LensModel &m = cam.lens_model; !m.ideal()) {
     fp.tracing.w |= TRACING_LENS_MODEL;
     fp.projection = gpu::vec4(m.principal_point.x * float(r.width),
-                              m.principal_point.y * float(r.height), focal_px * m.fy_over_fx, m.k3);
+                              m.principal_point.y * float(r.height), m.fy_over_fx, m.k3);
     fp.distortion = gpu::vec4(m.k1, m.k2, m.p1, m.p2);
   }
   return fp;

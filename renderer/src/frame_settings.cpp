@@ -55,15 +55,17 @@ glm::vec2 ideal_to_pixel(const gpu::FrameParams &frame, glm::vec2 ideal) {
     return 0.5f * glm::vec2(image_size(frame)) + frame.lens.z * ideal;
   const glm::vec2 d =
       cpu::LensModelMath{}.lens_distort(ideal, frame.distortion, frame.projection.w);
-  return {frame.projection.x + frame.lens.z * d.x, frame.projection.y + frame.projection.z * d.y};
+  return {frame.projection.x + frame.lens.z * d.x,
+          frame.projection.y + frame.lens.z * frame.projection.z * d.y};
 }
 
 glm::vec2 pixel_to_ideal(const gpu::FrameParams &frame, glm::vec2 pixel) {
   if (!has_lens_model(frame))
     return (pixel - 0.5f * glm::vec2(image_size(frame))) / frame.lens.z;
-  return cpu::LensModelMath{}.lens_undistort({(pixel.x - frame.projection.x) / frame.lens.z,
-                                              (pixel.y - frame.projection.y) / frame.projection.z},
-                                             frame.distortion, frame.projection.w);
+  return cpu::LensModelMath{}.lens_undistort(
+      {(pixel.x - frame.projection.x) / frame.lens.z,
+       (pixel.y - frame.projection.y) / (frame.lens.z * frame.projection.z)},
+      frame.distortion, frame.projection.w);
 }
 
 LensExtent lens_extent(const gpu::FrameParams &frame, double margin) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/common.hpp>
+
 #include "camhead/renderer/frame_settings.h"
 
 namespace camhead::renderer::cpu {
@@ -23,17 +25,17 @@ bool same_view(const gpu::FrameParams &a, const gpu::FrameParams &b) {
          same(a.cam_up, b.cam_up) && same(a.cam_forward, b.cam_forward) &&
          same(a.world_color, b.world_color) && a.image.x == b.image.x && a.image.y == b.image.y &&
          a.image.w == b.image.w && a.tracing.x == b.tracing.x && a.lens.w == b.lens.w &&
+         // The principal point, fy / fx and the distortion; the image scale
+         // (lens.z) may breathe.
          has_lens_model(a) == has_lens_model(b) &&
          (!has_lens_model(a) ||
           (same(a.projection, b.projection) && same(a.distortion, b.distortion)));
 }
 
 bool reprojectable(const gpu::FrameParams &from, const gpu::FrameParams &to) {
-  // Through a lens model a sample's pixel is not linear in its ray
-  // (sample_store.h), and samples moved would not stay uniform.
-  return same_view(from, to) && !has_lens_model(to) && from.lens.w == 1.0f && finite(from.lens) &&
-         finite(to.lens) && from.lens.y > 0.0f && to.lens.y > 0.0f && from.lens.z > 0.0f &&
-         to.lens.z > 0.0f && to.lens.x >= 0.0f && to.lens.x <= from.lens.x;
+  return same_view(from, to) && from.lens.w == 1.0f && finite(from.lens) && finite(to.lens) &&
+         from.lens.y > 0.0f && to.lens.y > 0.0f && from.lens.z > 0.0f && to.lens.z > 0.0f &&
+         to.lens.x >= 0.0f && to.lens.x <= from.lens.x;
 }
 
 void SampleStore::reserve(std::size_t capacity, std::uint32_t width, std::uint32_t height) {
@@ -138,11 +140,23 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
         0.5 * double(width_), 0.5 * double(height_)};
     // A row y of `frame` is seen at y' - h/2 = (y - h/2) / s + f a (w_from -
     // w_to): at most |1/s - 1| h/2 + f A_from |w_to - w_from| rows away.
-    source.reach = std::uint32_t(
-        std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * 0.5 * double(height_) +
-                  double(to.lens.z) * double(frame.camera.lens.x) *
-                      std::abs(1.0 / double(to.lens.y) - 1.0 / double(frame.camera.lens.y)) +
-                  2.0));
+    // Through a lens model, from the principal point rather than the centre,
+    // and with the move on the ideal plane stretched by the lens (at most
+    // lens_extent's stretch) and the image scaled as pinhole's.
+    const double dw = std::abs(1.0 / double(to.lens.y) - 1.0 / double(frame.camera.lens.y));
+    if (has_lens_model(to)) {
+      source.preimage.move = double(to.lens.x) * dw + 1e-6;
+      const double from_axis =
+          std::max(double(to.projection.y), double(height_) - double(to.projection.y));
+      const double ideal_move = double(frame.camera.lens.x) * dw;
+      source.reach = std::uint32_t(
+          std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * from_axis +
+                    lens_extent(to, ideal_move).stretch * double(to.lens.z) * ideal_move + 2.0));
+    } else {
+      source.reach =
+          std::uint32_t(std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * 0.5 * double(height_) +
+                                  double(to.lens.z) * double(frame.camera.lens.x) * dw + 2.0));
+    }
     std::fill(source.tiles.begin(), source.tiles.end(), kOutside);
     for (const PixelRect &rect : region.rects)
       for (std::uint32_t ty = rect.y0 / CAMHEAD_TILE_Y; ty * CAMHEAD_TILE_Y < rect.y1; ++ty)
@@ -154,6 +168,54 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
               covers(frame, source.preimage, x0, y0, x1, y1) ? kCovered : kEdge;
         }
   }
+}
+
+bool SampleStore::covers_through_lens(const Frame &frame, const Preimage &p, std::uint32_t x0,
+                                      std::uint32_t y0, std::uint32_t x1, std::uint32_t y1) const {
+  // The box's border every few pixels, taken to the ideal plane: the bounds
+  // hold its preimage but for the lens's bending between two points (a
+  // tangent's sagitta: under 0.01 px for steps of 4 px through a lens of
+  // k1 = -0.3), which the margins cover.
+  constexpr double kStepPx = 4.0, kMarginPx = 0.05;
+  const auto border = [](double u0, double v0, double u1, double v1, auto &&take) {
+    const int nu = std::max(1, int(std::ceil((u1 - u0) / kStepPx)));
+    const int nv = std::max(1, int(std::ceil((v1 - v0) / kStepPx)));
+    for (int i = 0; i <= nu; ++i) {
+      const double u = u0 + (u1 - u0) * i / nu;
+      take(u, v0);
+      take(u, v1);
+    }
+    for (int j = 1; j < nv; ++j) {
+      const double v = v0 + (v1 - v0) * j / nv;
+      take(u0, v);
+      take(u1, v);
+    }
+  };
+  glm::dvec2 lo(INFINITY), hi(-INFINITY);
+  const double margin = kMarginPx / double(to_.lens.z);
+  border(double(x0) - kMarginPx, double(y0) - kMarginPx, double(x1) + kMarginPx,
+         double(y1) + kMarginPx, [&](double u, double v) {
+           const glm::dvec2 ideal(pixel_to_ideal(to_, glm::vec2(float(u), float(v))));
+           lo = glm::min(lo, ideal);
+           hi = glm::max(hi, ideal);
+         });
+  lo -= p.move + margin;
+  hi += p.move + margin;
+  // ... and into the old frame's pixels, by its own image scale.
+  glm::dvec2 old_lo(INFINITY), old_hi(-INFINITY);
+  const double width = hi.x - lo.x, height = hi.y - lo.y;
+  const double f = frame.camera.lens.z;
+  border(0.0, 0.0, width * f, height * f, [&](double u, double v) {
+    const glm::dvec2 pixel(ideal_to_pixel(frame.camera, glm::vec2(lo + glm::dvec2(u, v) / f)));
+    old_lo = glm::min(old_lo, pixel);
+    old_hi = glm::max(old_hi, pixel);
+  });
+  old_lo -= kMarginPx;
+  old_hi += kMarginPx;
+  if (!(std::isfinite(old_lo.x + old_lo.y + old_hi.x + old_hi.y)))
+    return false;
+  return traced(frame, int(std::floor(old_lo.x)), int(std::floor(old_lo.y)),
+                int(std::ceil(old_hi.x)) - 1, int(std::ceil(old_hi.y)) - 1);
 }
 
 } // namespace camhead::renderer::cpu

@@ -75,8 +75,9 @@ std::vector<cv::Point2d> opencv_projection(const renderer::gpu::FrameParams &fra
   for (const glm::dvec3 &p : world)
     in_camera.emplace_back(glm::dot(p - pupil, right), -glm::dot(p - pupil, up),
                            glm::dot(p - pupil, forward));
-  const cv::Matx33d k(frame.lens.z, 0.0, frame.projection.x, 0.0, frame.projection.z,
-                      frame.projection.y, 0.0, 0.0, 1.0);
+  const cv::Matx33d k(frame.lens.z, 0.0, frame.projection.x, 0.0,
+                      double(frame.lens.z) * double(frame.projection.z), frame.projection.y, 0.0,
+                      0.0, 1.0);
   const std::vector<double> distortion{frame.distortion.x, frame.distortion.y, frame.distortion.z,
                                        frame.distortion.w, frame.projection.w};
   std::vector<cv::Point2d> pixels;

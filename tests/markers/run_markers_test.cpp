@@ -5,6 +5,7 @@
 // truth, and when the board leaves the picture the frames go out with the
 // pose predicted from the last two found (20 ms of their motion, then held),
 // flagged, with no markers seen.
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -99,6 +100,7 @@ protected:
     write("floor.json", test::kFloorBoardJson);
     // The still lens the take was drawn with, seen from its entrance pupil.
     double focal_mm = 35.0, pupil_m = 0.0;
+    std::array<double, 5> distortion{};
     if (profiled) {
       lens_control::LensCounts counts;
       counts.focus = lens_control::AxisReading{9400.0, 0, true}; // 2 m
@@ -107,12 +109,15 @@ protected:
           lens_control::LensProfile::load(kLenses / "example_35mm.json").evaluate(counts);
       focal_mm = state.projection_focal_length_mm.value;
       pupil_m = state.entrance_pupil_offset_mm.value / 1000.0;
+      if (const auto &d = state.distortion)
+        distortion = {d->k1, d->k2, d->p1, d->p2, d->k3};
     }
     const auto pupil_at = [pupil_m](CameraPose pose) {
       pose.position += pose.forward() * pupil_m;
       return pose;
     };
-    const CameraModel camera = test::pinhole(kWidth, kHeight, focal_mm);
+    CameraModel camera = test::pinhole(kWidth, kHeight, focal_mm);
+    camera.distortion = distortion;
     std::mt19937 random(5);
     std::vector<std::vector<std::uint8_t>> frames;
     const cv::Mat still =

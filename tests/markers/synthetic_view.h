@@ -12,7 +12,9 @@
 // linear interpolation makes every edge a ramp the box filter integrates.
 #pragma once
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
@@ -87,7 +89,42 @@ inline cv::Mat frame(const cv::Mat &light, double noise, std::mt19937 &random) {
   return out;
 }
 
-// A ChArUco board where marker_board.h puts it, seen from `pose`: the light.
+// A supersampled `canvas` drawn through the ideal pinhole of `camera`'s
+// matrix, seen through its distortion: each pixel takes the ideal picture at
+// its preimage (OpenCV's undistortPoints, converged), the map computed at
+// the picture's pixels and spread over the canvas's linearly.
+inline cv::Mat distorted(const cv::Mat &canvas, const CameraModel &camera) {
+  if (std::all_of(camera.distortion.begin(), camera.distortion.end(),
+                  [](double k) { return k == 0.0; }))
+    return canvas;
+  const cv::Size size(canvas.cols / kSupersample, canvas.rows / kSupersample);
+  std::vector<cv::Point2d> pixels;
+  for (int v = 0; v < size.height; ++v)
+    for (int u = 0; u < size.width; ++u)
+      pixels.emplace_back(u, v);
+  const cv::Matx33d k(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
+  std::vector<cv::Point2d> ideal;
+  cv::undistortPoints(pixels, ideal, k,
+                      std::vector<double>(camera.distortion.begin(), camera.distortion.end()),
+                      cv::noArray(), k,
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-14));
+  cv::Mat map_x(size, CV_32F), map_y(size, CV_32F);
+  const double s = kSupersample, o = (s - 1.0) / 2.0;
+  for (int v = 0; v < size.height; ++v)
+    for (int u = 0; u < size.width; ++u) {
+      const cv::Point2d &p = ideal[std::size_t(v) * size.width + u];
+      map_x.at<float>(v, u) = float(s * p.x + o);
+      map_y.at<float>(v, u) = float(s * p.y + o);
+    }
+  cv::Mat big_x, big_y, out;
+  cv::resize(map_x, big_x, canvas.size(), 0.0, 0.0, cv::INTER_LINEAR);
+  cv::resize(map_y, big_y, canvas.size(), 0.0, 0.0, cv::INTER_LINEAR);
+  cv::remap(canvas, out, big_x, big_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
+  return out;
+}
+
+// A ChArUco board where marker_board.h puts it, seen from `pose` through
+// `camera` (its distortion too): the light.
 inline cv::Mat charuco_view(const MarkerBoard &board, const CameraModel &camera,
                             const CameraPose &pose, cv::Size size) {
   const auto dictionary = cv::aruco::getPredefinedDictionary(board.dictionary);
@@ -114,7 +151,7 @@ inline cv::Mat charuco_view(const MarkerBoard &board, const CameraModel &camera,
   cv::warpPerspective(page, canvas, cv::Mat(h),
                       cv::Size(size.width * kSupersample, size.height * kSupersample),
                       cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
-  return expose(canvas, size);
+  return expose(distorted(canvas, camera), size);
 }
 
 // A marker field's markers, each with a white quiet zone of one cell around

@@ -58,8 +58,28 @@ private:
 // at 0.6 m, stopped down to f/2.8, the image scale breathing by 3 %: at
 // this size a blur circle grows or shrinks by up to a pixel, and the frame's
 // edges move by one.
-FrameCamera after_the_jump(const Scene &scene) {
+// Either lens: the ideal one, or a strong barrel with its principal point
+// off centre, through which samples land by the lens's distortion
+// (renderer/src/sample_store.h).
+LensModel lens_of(bool distorted) {
+  LensModel lens;
+  if (distorted) {
+    lens.k1 = -0.25f;
+    lens.k2 = 0.05f;
+    lens.p1 = 0.004f;
+    lens.principal_point = {0.53f, 0.47f};
+  }
+  return lens;
+}
+
+FrameCamera before_the_jump(const Scene &scene, bool distorted) {
   FrameCamera camera = scene_camera(scene);
+  camera.lens_model = lens_of(distorted);
+  return camera;
+}
+
+FrameCamera after_the_jump(const Scene &scene, bool distorted) {
+  FrameCamera camera = before_the_jump(scene, distorted);
   camera.focus_distance_m = 0.6f;
   camera.f_number = 2.8f;
   camera.projection_focal_length_mm = 1.03f * camera.focal_length_mm;
@@ -73,9 +93,13 @@ FrameRequest frame(const Scene &scene, const FrameCamera &camera, std::uint32_t 
   return request;
 }
 
-TEST(Reprojection, TheFrameAfterAFocusJumpHasAFreshFramesExpectedValue) {
+// Through the ideal lens and through a distorting one.
+class Reprojection : public ::testing::TestWithParam<bool> {};
+
+TEST_P(Reprojection, TheFrameAfterAFocusJumpHasAFreshFramesExpectedValue) {
   const Scene scene = ball_scene();
-  const FrameCamera jumped = after_the_jump(scene);
+  const FrameCamera before = before_the_jump(scene, GetParam());
+  const FrameCamera jumped = after_the_jump(scene, GetParam());
   Frames reference(scene);
   {
     FrameRequest request = still_uniform(scene, 1024, 9);
@@ -98,7 +122,7 @@ TEST(Reprojection, TheFrameAfterAFocusJumpHasAFreshFramesExpectedValue) {
   for (int t = 0; t < kTrials; ++t) {
     Frames moved(scene), afresh(scene), kept(scene);
     for (int n = 0; n < 8; ++n) {
-      FrameRequest request = frame(scene, scene_camera(scene), 1000u * t + n);
+      FrameRequest request = frame(scene, before, 1000u * t + n);
       (void)moved.render(request);
       (void)kept.render(request);
       request.accumulation.reproject = false;
@@ -127,11 +151,13 @@ TEST(Reprojection, TheFrameAfterAFocusJumpHasAFreshFramesExpectedValue) {
   const double e_jump_quarter = error(jump_quarter.mean(), truth);
   const double e_ghost = error(ghost.mean(), truth);
   const double e_ghost_quarter = error(ghost_quarter.mean(), truth);
-  std::printf("[ reproject ] focus jump: a frame's error %.4f (%.1f samples a pixel held), "
-              "%.4f afresh; the mean of %d / %d frames %.4f / %.4f (%.2fx), of the old focus "
-              "kept %.4f / %.4f (%.2fx)\n",
-              e_one, double(samples) / kTrials, e_afresh, kTrials / 4, kTrials, e_jump_quarter,
-              e_jump, e_jump_quarter / e_jump, e_ghost_quarter, e_ghost, e_ghost_quarter / e_ghost);
+  std::printf(
+      "[ reproject ] %s lens, focus jump: a frame's error %.4f (%.1f samples a pixel held), "
+      "%.4f afresh; the mean of %d / %d frames %.4f / %.4f (%.2fx), of the old focus "
+      "kept %.4f / %.4f (%.2fx)\n",
+      GetParam() ? "distorting" : "ideal", e_one, double(samples) / kTrials, e_afresh, kTrials / 4,
+      kTrials, e_jump_quarter, e_jump, e_jump_quarter / e_jump, e_ghost_quarter, e_ghost,
+      e_ghost_quarter / e_ghost);
   EXPECT_GE(samples / kTrials, 2u) << "the jump's frames hold more than their own ray";
   EXPECT_LT(e_one, 0.8 * e_afresh);
   // Unbiased: the mean converges as noise does (2x; a bias would hold it).
@@ -141,13 +167,13 @@ TEST(Reprojection, TheFrameAfterAFocusJumpHasAFreshFramesExpectedValue) {
   EXPECT_GT(e_ghost, 4.0 * e_jump);
 }
 
-TEST(Reprojection, APullFrameComesCloserToItsPictureThanOneStartedAfresh) {
+TEST_P(Reprojection, APullFrameComesCloserToItsPictureThanOneStartedAfresh) {
   // Twelve frames of a pull from the scene's focus (2 m) to 0.6 m, even in
   // diopters, one ray per pixel each, as camhead run renders them; the last
   // against a converged render of its own lens.
   const Scene scene = ball_scene();
-  const FrameCamera end = after_the_jump(scene);
-  const FrameCamera start = scene_camera(scene);
+  const FrameCamera end = after_the_jump(scene, GetParam());
+  const FrameCamera start = before_the_jump(scene, GetParam());
   const auto at = [&](int k) {
     FrameCamera camera = end;
     const float w0 = 1.0f / start.focus_distance_m, w1 = 1.0f / end.focus_distance_m;
@@ -178,15 +204,21 @@ TEST(Reprojection, APullFrameComesCloserToItsPictureThanOneStartedAfresh) {
         }
         e[reconstruct][reproject] += error(frames.composite(), truth) / kTrials;
       }
-  std::printf("[ reproject ] pull frame: error %.4f afresh, %.4f with the frames before moved; "
-              "reconstructed %.4f, %.4f\n",
-              e[0][0], e[0][1], e[1][0], e[1][1]);
+  std::printf(
+      "[ reproject ] %s lens, pull frame: error %.4f afresh, %.4f with the frames before moved; "
+      "reconstructed %.4f, %.4f\n",
+      GetParam() ? "distorting" : "ideal", e[0][0], e[0][1], e[1][0], e[1][1]);
   // The samples alone: six frames' more (the store holds six of this
   // region), independent rather than one pattern's, so less than 7 rpp's gain.
   EXPECT_LT(e[0][1], 0.6 * e[0][0]);
   // With the reconstruction, which does most of the work at this blur.
   EXPECT_LT(e[1][1], e[1][0]);
 }
+
+INSTANTIATE_TEST_SUITE_P(Lenses, Reprojection, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool> &lens) {
+                           return lens.param ? "Distorted" : "Ideal";
+                         });
 
 TEST(Reprojection, KeepingAFramesSamplesChangesNothingInIt) {
   // A frame whose samples are kept traces them through the renderer's own

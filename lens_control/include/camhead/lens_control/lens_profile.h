@@ -14,6 +14,10 @@
 // whose focus scale shifts with focal length, one table per zoom point
 // (version 2): the focus counts go through the two tables around the current
 // zoom and their diopters are blended with the same weight as breathing.
+// Version 3 adds the camera model OpenCV calibrates (fx fy cx cy and
+// Brown-Conrady k1 k2 p1 p2 k3, in the pixels of the profile's image) as a
+// table over focus per zoom point, interpolated in diopters and blended
+// across zoom as breathing is; its fx sets the projection focal length.
 // Tables that all run the same way (profile_reader checks) blend into a curve
 // that runs that way too, so the focus never runs backwards at any zoom.
 //
@@ -21,6 +25,7 @@
 // members concurrently.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -82,6 +87,8 @@ public:
   [[nodiscard]] Lookup projection_focal_length_mm(double zoom_counts, double focus_counts) const;
   [[nodiscard]] Lookup entrance_pupil_offset_mm(double zoom_counts) const;
   [[nodiscard]] const std::optional<Distortion> &distortion() const { return distortion_; }
+  // A camera model per zoom point (format version 3).
+  [[nodiscard]] bool has_camera_model() const { return image_.has_value(); }
 
   // The full lens state for aligned counts. An axis without a reading takes
   // the lens's rest value, not fresh: focus at the far end of the table (of
@@ -96,8 +103,28 @@ public:
   // every axis came as a value.
   [[nodiscard]] LensState evaluate(const LensCounts &counts, const LensValues &values = {}) const;
 
+  // OpenCV's camera parameters, in this order (CameraPoint's indices).
+  enum CameraParam { kFx, kFy, kCx, kCy, kK1, kK2, kP1, kP2, kK3, kCameraParams };
+  using CameraPoint = std::array<double, kCameraParams>;
+
 private:
   friend class ProfileReader; // profile_reader.cpp fills the tables
+
+  // The images a version 3 profile's camera tables were calibrated in, and
+  // the width of the sensor they span (fx in millimetres).
+  struct Image {
+    int width_px = 0, height_px = 0;
+    double sensor_width_mm = 0.0;
+  };
+
+  // The camera model of one zoom point over focus diopters (increasing);
+  // one point serves every focus.
+  struct CameraTable {
+    std::vector<double> diopters;
+    std::vector<CameraPoint> points;
+    std::array<MonotoneCurve, kCameraParams> curves; // empty for one point
+    [[nodiscard]] CameraPoint at(double diopters) const;
+  };
 
   // One zoom calibration point (a prime has exactly one).
   struct ZoomPoint {
@@ -110,6 +137,7 @@ private:
     // Focus counts -> 1/m at this zoom (version 2); empty = the one
     // focus_diopters_ table serves every zoom.
     MonotoneCurve focus;
+    std::optional<CameraTable> camera = std::nullopt; // version 3
   };
 
   // The two zoom points around a zoom position and the blending weight of the
@@ -130,6 +158,8 @@ private:
   [[nodiscard]] Lookup projection_for_focus(double zoom_counts, MonotoneCurve::Result focus) const;
   [[nodiscard]] double rest_counts_iris() const;
   [[nodiscard]] double projection_at_point(const ZoomPoint &z, double diopters) const;
+  // The camera model at a zoom position and focus (version 3).
+  [[nodiscard]] CameraPoint camera_for_focus(double zoom_counts, double diopters) const;
 
   std::string name_;
   bool calibrated_ = true;
@@ -140,6 +170,7 @@ private:
   MonotoneCurve log_focal_length_;  // zoom counts -> ln(mm); empty for a prime
   MonotoneCurve entrance_pupil_mm_; // zoom counts -> mm; empty for a prime
   std::optional<Distortion> distortion_;
+  std::optional<Image> image_; // version 3
 };
 
 } // namespace camhead::lens_control

@@ -69,6 +69,17 @@ struct Distortion {
   double k1 = 0.0, k2 = 0.0, k3 = 0.0, p1 = 0.0, p2 = 0.0;
 };
 
+// Where the lens's image is centred and how its pixels are shaped, beyond
+// the image scale (version 3 profiles; the ideal otherwise): the principal
+// point as a fraction of the image's width and height from its top-left
+// corner, pixel x spanning [x, x + 1) (the renderer's convention: OpenCV's
+// cx, with pixel centres at integers, is principal_x * width - 0.5), and
+// the focal length down the image over the one across it.
+struct LensProjection {
+  double principal_x = 0.5, principal_y = 0.5;
+  double fy_over_fx = 1.0;
+};
+
 struct LensState {
   // Metres from the entrance pupil; +infinity when focused at infinity.
   Measured focus_distance_m;
@@ -85,6 +96,7 @@ struct LensState {
   // profile's reference plane (positive towards the scene).
   Measured entrance_pupil_offset_mm;
   std::optional<Distortion> distortion;
+  LensProjection projection;
   // False for LensProfile::uncalibrated(): the values are a nominal lens, not
   // this lens, and the renderer's depth of field will not match the plate.
   bool calibrated = false;
