@@ -83,4 +83,12 @@ std::unique_ptr<MarkerTracker> open_marker_tracker(const MarkerBoard &board) {
   return tracker;
 }
 
+CameraCalibration calibrate_camera(const MarkerBoard &board, const std::vector<LumaImage> &views) {
+  std::string error;
+  CameraCalibration out;
+  if (!module().calibrate(board, views, out, error))
+    throw MarkerModuleError(board.file.string() + ": " + error);
+  return out;
+}
+
 } // namespace camhead::pipeline

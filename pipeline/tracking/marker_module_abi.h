@@ -12,13 +12,16 @@
 
 namespace camhead::pipeline::marker_module {
 
-inline constexpr int kAbiVersion = 2;
+inline constexpr int kAbiVersion = 3;
 inline constexpr const char *kFactorySymbol = "camhead_markers_module";
 
 class Module {
 public:
   // A tracker for `board`, or null with `error` saying why.
   virtual std::unique_ptr<MarkerTracker> open(const MarkerBoard &board, std::string &error) = 0;
+  // calibrate_camera() (marker_tracker.h): false with `error` saying why.
+  virtual bool calibrate(const MarkerBoard &board, const std::vector<LumaImage> &views,
+                         CameraCalibration &out, std::string &error) = 0;
 
 protected:
   ~Module() = default; // the module owns its one instance

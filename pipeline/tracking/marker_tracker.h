@@ -17,6 +17,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "camera_pose.h"
 #include "marker_board.h"
@@ -69,10 +70,36 @@ public:
                            const CameraPose *previous) = 0;
 };
 
+// One view of a camera calibration: the ChArUco corners found in it, and
+// whether the fit used it (else why not) with its reprojection error.
+struct CalibrationView {
+  int corners = 0;
+  bool used = false;
+  double rms_px = 0.0; // in the final fit, of the views used
+  std::string why_not;
+};
+
+// A camera's model fitted to views of a ChArUco board (OpenCV's
+// calibrateCamera): its matrix and distortion in the views' pixels, the RMS
+// reprojection error over the views used, and each view's part.
+struct CameraCalibration {
+  CameraModel camera;
+  double rms_px = 0.0;
+  std::vector<CalibrationView> views;
+};
+
 // Opens the module (once per process) and makes a tracker for `board`.
 // Throws MarkerModuleError saying what is missing: the module, OpenCV's
 // packages, or a build for another camhead.
 [[nodiscard]] std::unique_ptr<MarkerTracker> open_marker_tracker(const MarkerBoard &board);
+
+// Fits the camera that took `views` (all of one size) of the ChArUco board
+// `board`: views where too few corners are found, and those whose error is
+// far above the rest (a blurred or misdetected view), are left out and the
+// fit repeated. Throws MarkerModuleError: the module missing, a board that
+// is not ChArUco, or too few usable views (each view's reason given).
+[[nodiscard]] CameraCalibration calibrate_camera(const MarkerBoard &board,
+                                                 const std::vector<LumaImage> &views);
 
 // "libcamhead_markers.so".
 [[nodiscard]] const char *marker_module_name();

@@ -72,7 +72,7 @@ LensExtent lens_extent(const gpu::FrameParams &frame, double margin) {
   const double width = frame.image.x, height = frame.image.y;
   if (!has_lens_model(frame))
     return {0.5 * std::hypot(width, height) / double(frame.lens.z), 1.0};
-  LensExtent extent{0.0, 0.0};
+  LensExtent extent{0.0, 0.0, INFINITY};
   glm::dvec2 lo(INFINITY), hi(-INFINITY);
   const auto take = [&](double u, double v) {
     const glm::dvec2 ideal(pixel_to_ideal(frame, glm::vec2(float(u), float(v))));
@@ -104,8 +104,12 @@ LensExtent lens_extent(const gpu::FrameParams &frame, double margin) {
       // The spectral norm of [dx dy], in pixels of the image per pixel of
       // the ideal plane (a focal length of lens.z).
       const double a = glm::dot(dx, dx), b = glm::dot(dx, dy), c = glm::dot(dy, dy);
-      const double largest = 0.5 * (a + c) + std::sqrt(0.25 * (a - c) * (a - c) + b * b);
-      extent.stretch = std::max(extent.stretch, std::sqrt(largest) / double(frame.lens.z));
+      const double spread = std::sqrt(0.25 * (a - c) * (a - c) + b * b);
+      extent.stretch =
+          std::max(extent.stretch, std::sqrt(0.5 * (a + c) + spread) / double(frame.lens.z));
+      extent.least_stretch =
+          std::min(extent.least_stretch,
+                   std::sqrt(std::max(0.5 * (a + c) - spread, 0.0)) / double(frame.lens.z));
     }
   return extent;
 }

@@ -124,6 +124,12 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
                                      std::size_t most) {
   to_ = to;
   source_count_ = 0;
+  // Through a lens model, the most it stretches a move on the ideal plane
+  // out to kStretchMargin beyond the view, found once (a source that moves
+  // samples further finds its own).
+  constexpr double kStretchMargin = 0.05;
+  const LensExtent extent = has_lens_model(to) ? lens_extent(to, kStretchMargin) : LensExtent{};
+  const double stretch = extent.stretch;
   for (std::size_t k = 0; k < stored_ && source_count_ < most; ++k) {
     const Frame &frame = frames_[(newest_ + kMostFrames - k) % kMostFrames];
     if (!reprojectable(frame.camera, to))
@@ -146,12 +152,15 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
     const double dw = std::abs(1.0 / double(to.lens.y) - 1.0 / double(frame.camera.lens.y));
     if (has_lens_model(to)) {
       source.preimage.move = double(to.lens.x) * dw + 1e-6;
+      source.preimage.per_px = 1.1 / (double(to.lens.z) * extent.least_stretch);
+      source.preimage.stretch = stretch;
       const double from_axis =
           std::max(double(to.projection.y), double(height_) - double(to.projection.y));
       const double ideal_move = double(frame.camera.lens.x) * dw;
-      source.reach = std::uint32_t(
-          std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * from_axis +
-                    lens_extent(to, ideal_move).stretch * double(to.lens.z) * ideal_move + 2.0));
+      const double moved_stretch =
+          ideal_move <= kStretchMargin ? stretch : lens_extent(to, ideal_move).stretch;
+      source.reach = std::uint32_t(std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * from_axis +
+                                             moved_stretch * double(to.lens.z) * ideal_move + 2.0));
     } else {
       source.reach =
           std::uint32_t(std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * 0.5 * double(height_) +
@@ -172,50 +181,17 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
 
 bool SampleStore::covers_through_lens(const Frame &frame, const Preimage &p, std::uint32_t x0,
                                       std::uint32_t y0, std::uint32_t x1, std::uint32_t y1) const {
-  // The box's border every few pixels, taken to the ideal plane: the bounds
-  // hold its preimage but for the lens's bending between two points (a
-  // tangent's sagitta: under 0.01 px for steps of 4 px through a lens of
-  // k1 = -0.3), which the margins cover.
-  constexpr double kStepPx = 4.0, kMarginPx = 0.05;
-  const auto border = [](double u0, double v0, double u1, double v1, auto &&take) {
-    const int nu = std::max(1, int(std::ceil((u1 - u0) / kStepPx)));
-    const int nv = std::max(1, int(std::ceil((v1 - v0) / kStepPx)));
-    for (int i = 0; i <= nu; ++i) {
-      const double u = u0 + (u1 - u0) * i / nu;
-      take(u, v0);
-      take(u, v1);
-    }
-    for (int j = 1; j < nv; ++j) {
-      const double v = v0 + (v1 - v0) * j / nv;
-      take(u0, v);
-      take(u1, v);
-    }
-  };
-  glm::dvec2 lo(INFINITY), hi(-INFINITY);
-  const double margin = kMarginPx / double(to_.lens.z);
-  border(double(x0) - kMarginPx, double(y0) - kMarginPx, double(x1) + kMarginPx,
-         double(y1) + kMarginPx, [&](double u, double v) {
-           const glm::dvec2 ideal(pixel_to_ideal(to_, glm::vec2(float(u), float(v))));
-           lo = glm::min(lo, ideal);
-           hi = glm::max(hi, ideal);
-         });
-  lo -= p.move + margin;
-  hi += p.move + margin;
-  // ... and into the old frame's pixels, by its own image scale.
-  glm::dvec2 old_lo(INFINITY), old_hi(-INFINITY);
-  const double width = hi.x - lo.x, height = hi.y - lo.y;
-  const double f = frame.camera.lens.z;
-  border(0.0, 0.0, width * f, height * f, [&](double u, double v) {
-    const glm::dvec2 pixel(ideal_to_pixel(frame.camera, glm::vec2(lo + glm::dvec2(u, v) / f)));
-    old_lo = glm::min(old_lo, pixel);
-    old_hi = glm::max(old_hi, pixel);
-  });
-  old_lo -= kMarginPx;
-  old_hi += kMarginPx;
-  if (!(std::isfinite(old_lo.x + old_lo.y + old_hi.x + old_hi.y)))
+  const glm::vec2 centre = ideal_to_pixel(
+      frame.camera, pixel_to_ideal(to_, 0.5f * glm::vec2(float(x0 + x1), float(y0 + y1))));
+  const double half_diagonal = 0.5 * std::hypot(double(x1 - x0), double(y1 - y0));
+  constexpr double kMarginPx = 0.05; // the rounding of the floats
+  const double reach =
+      (half_diagonal * p.per_px + p.move) * double(frame.camera.lens.z) * p.stretch + kMarginPx;
+  if (!std::isfinite(double(centre.x) + double(centre.y) + reach))
     return false;
-  return traced(frame, int(std::floor(old_lo.x)), int(std::floor(old_lo.y)),
-                int(std::ceil(old_hi.x)) - 1, int(std::ceil(old_hi.y)) - 1);
+  return traced(
+      frame, int(std::floor(double(centre.x) - reach)), int(std::floor(double(centre.y) - reach)),
+      int(std::ceil(double(centre.x) + reach)) - 1, int(std::ceil(double(centre.y) + reach)) - 1);
 }
 
 } // namespace camhead::renderer::cpu

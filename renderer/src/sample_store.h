@@ -120,12 +120,15 @@ private:
   //   x_from - w/2 = s (x - w/2) - f_from a (w_to - w_from),  s = f_from / f,
   // for every pupil point |a| <= A_to, within r = f_from A_to |w_to - w_from|
   // of the scaled pixels; true if `frame` traced all of them.
-  // Through a lens model the same on the ideal image plane (normalised,
-  // frame_settings.h): the box's preimage there, grown by `move` = A_to
-  // |w_to - w_from|, taken into `frame`'s pixels.
+  // Through a lens model the same by the box's centre alone (one inverse
+  // and one image of the lens): the box's preimage lies within its
+  // half-diagonal over the lens's least stretch of the centre's preimage
+  // (`per_px`: ideal-plane units per pixel, a tenth more for the stretch's
+  // change across the box), grown by `move` = A_to |w_to - w_from|, and
+  // that in `frame` within the most it stretches (`stretch`) times as much.
   struct Preimage {
     double s, r, half_w, half_h;
-    double move = 0.0; // with a lens model
+    double move = 0.0, per_px = 0.0, stretch = 1.0; // with a lens model
   };
   [[nodiscard]] bool covers(const Frame &frame, const Preimage &p, std::uint32_t x0,
                             std::uint32_t y0, std::uint32_t x1, std::uint32_t y1) const {

@@ -89,8 +89,16 @@ TEST(LensProfile, ExampleLoadsAndReproducesEveryCalibrationPoint) {
   expect_reproduced(p.projection_focal_length_mm(0, 16383).value, 35.0, "breathing at inf");
   EXPECT_EQ(p.focal_length_mm(123).value, 35.0);
   EXPECT_EQ(p.entrance_pupil_offset_mm(123).value, 68.0);
-  ASSERT_TRUE(p.distortion());
-  EXPECT_EQ(p.distortion()->k1, -0.042);
+  // No distortion in the example (the simulated rig films through it); a
+  // version 1 distortion reads as given.
+  EXPECT_FALSE(p.distortion());
+  Json with = j;
+  with["distortion"] = {{"k1", -0.042}, {"p2", 0.001}};
+  const LensProfile distorted = LensProfile::parse(with.dump(), kExample);
+  ASSERT_TRUE(distorted.distortion());
+  EXPECT_EQ(distorted.distortion()->k1, -0.042);
+  EXPECT_EQ(distorted.distortion()->p2, 0.001);
+  EXPECT_EQ(distorted.distortion()->k2, 0.0);
 }
 
 TEST(LensProfile, MonotoneBetweenCalibrationPointsOnDenseSweep) {
