@@ -92,17 +92,16 @@ LensExtent lens_extent(const gpu::FrameParams &frame, double margin) {
   lo -= margin;
   hi += margin;
   constexpr int kGrid = 16;
-  constexpr double h = 1e-4;
+  const double fx = frame.lens.z, fy = double(frame.lens.z) * double(frame.projection.z);
   for (int j = 0; j <= kGrid; ++j)
     for (int i = 0; i <= kGrid; ++i) {
       const glm::dvec2 p = lo + (hi - lo) * glm::dvec2(i, j) / double(kGrid);
-      const glm::dvec2 at(ideal_to_pixel(frame, glm::vec2(p)));
-      const glm::dvec2 dx =
-          (glm::dvec2(ideal_to_pixel(frame, glm::vec2(p + glm::dvec2(h, 0.0)))) - at) / h;
-      const glm::dvec2 dy =
-          (glm::dvec2(ideal_to_pixel(frame, glm::vec2(p + glm::dvec2(0.0, h)))) - at) / h;
-      // The spectral norm of [dx dy], in pixels of the image per pixel of
-      // the ideal plane (a focal length of lens.z).
+      const glm::dvec3 jac(
+          cpu::LensModelMath{}.lens_jacobian(glm::vec2(p), frame.distortion, frame.projection.w));
+      // The image's Jacobian in pixels, its columns d/dx and d/dy, and
+      // their spectral norm over the ideal plane's pixels (a focal length
+      // of lens.z).
+      const glm::dvec2 dx(fx * jac.x, fy * jac.z), dy(fx * jac.z, fy * jac.y);
       const double a = glm::dot(dx, dx), b = glm::dot(dx, dy), c = glm::dot(dy, dy);
       const double spread = std::sqrt(0.25 * (a - c) * (a - c) + b * b);
       extent.stretch =
