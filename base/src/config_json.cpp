@@ -14,8 +14,10 @@
 namespace camhead::base {
 namespace {
 
+// An empty key is named as JSON spells it: a field is never blank.
 std::string child(const std::string &field, std::string_view key) {
-  return field.empty() ? std::string(key) : field + "." + std::string(key);
+  const std::string name = key.empty() ? std::string("\"\"") : std::string(key);
+  return field.empty() ? name : field + "." + name;
 }
 
 // Python's json reads NaN, Infinity, -Infinity and overflowing literals

@@ -71,8 +71,8 @@ glm::vec2 pixel_to_ideal(const gpu::FrameParams &frame, glm::vec2 pixel) {
 LensExtent lens_extent(const gpu::FrameParams &frame, double margin) {
   const double width = frame.image.x, height = frame.image.y;
   if (!has_lens_model(frame))
-    return {0.5 * std::hypot(width, height) / double(frame.lens.z), 1.0};
-  LensExtent extent{0.0, 0.0, INFINITY};
+    return {0.5 * std::hypot(width, height) / double(frame.lens.z), 1.0, 1.0, 0.0};
+  LensExtent extent{0.0, 0.0, INFINITY, 0.0};
   glm::dvec2 lo(INFINITY), hi(-INFINITY);
   const auto take = [&](double u, double v) {
     const glm::dvec2 ideal(pixel_to_ideal(frame, glm::vec2(float(u), float(v))));
@@ -102,6 +102,9 @@ LensExtent lens_extent(const gpu::FrameParams &frame, double margin) {
       // their spectral norm over the ideal plane's pixels (a focal length
       // of lens.z).
       const glm::dvec2 dx(fx * jac.x, fy * jac.z), dy(fx * jac.z, fy * jac.y);
+      const double row = ideal_to_pixel(frame, glm::vec2(p)).y;
+      extent.max_row_shift_px = std::max(
+          extent.max_row_shift_px, 1.1 * std::abs(row - (double(frame.projection.y) + fy * p.y)));
       const double a = glm::dot(dx, dx), b = glm::dot(dx, dy), c = glm::dot(dy, dy);
       const double spread = std::sqrt(0.25 * (a - c) * (a - c) + b * b);
       extent.stretch =

@@ -130,6 +130,7 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
   constexpr double kStretchMargin = 0.05;
   const LensExtent extent = has_lens_model(to) ? lens_extent(to, kStretchMargin) : LensExtent{};
   const double stretch = extent.stretch;
+  row_shift_ = float(extent.max_row_shift_px + 1.0);
   for (std::size_t k = 0; k < stored_ && source_count_ < most; ++k) {
     const Frame &frame = frames_[(newest_ + kMostFrames - k) % kMostFrames];
     if (!reprojectable(frame.camera, to))

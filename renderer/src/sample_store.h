@@ -163,6 +163,9 @@ private:
   std::array<Source, kMostFrames> sources_;
   std::size_t source_count_ = 0;
   gpu::FrameParams to_{}; // the camera the sources move into
+  // Through a lens model, the most it moves a row from the pinhole's (one
+  // pixel more for the floats).
+  float row_shift_ = 0.0f;
 };
 
 template <typename Add>
@@ -174,6 +177,7 @@ std::uint64_t SampleStore::reproject_rows(std::uint32_t y0, std::uint32_t y1, Ad
   const float inv_focus = 1.0f / to_.lens.y;
   const float aperture2 = to_.lens.x * to_.lens.x;
   const bool lens = has_lens_model(to_);
+  const float fy = to_.lens.z * to_.projection.z;
   for (std::size_t k = 0; k < source_count_; ++k) {
     const Source &source = sources_[k];
     const Frame &frame = *source.frame;
@@ -194,9 +198,15 @@ std::uint64_t SampleStore::reproject_rows(std::uint32_t y0, std::uint32_t y1, Ad
         const glm::vec4 &r = sample.ray;
         float px, py;
         if (lens) {
-          // Where the sample meets the focal plane, through the lens.
-          const glm::vec2 d = LensModelMath{}.lens_distort(
-              {r.x + r.z * inv_focus, -(r.y + r.w * inv_focus)}, to_.distortion, to_.projection.w);
+          // Where the sample meets the focal plane, through the lens; first
+          // whether the lens can move it into these rows at all (two
+          // multiplications, where the lens takes a few dozen).
+          const float ideal_y = -(r.y + r.w * inv_focus);
+          const float row = to_.projection.y + fy * ideal_y;
+          if (!(row >= float(y0) - row_shift_ && row < float(y1) + row_shift_))
+            continue;
+          const glm::vec2 d = LensModelMath{}.lens_distort({r.x + r.z * inv_focus, ideal_y},
+                                                           to_.distortion, to_.projection.w);
           px = to_.projection.x + f * d.x;
           py = to_.projection.y + f * to_.projection.z * d.y;
         } else {

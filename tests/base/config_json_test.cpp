@@ -264,6 +264,13 @@ TEST(ConfigJson, AKeyGivenTwiceInOneObjectIsRefusedOnItsField) {
                      [](const JsonValue &) {}),
             std::string(kFile) +
                 ": l.s[2].p: given twice in one object; only one would count: give it once");
+  // An empty key is named as JSON spells it (the scene fuzzer found a blank
+  // field here).
+  EXPECT_EQ(error_of(R"({"": 1, "": 2})", [](const JsonValue &) {}),
+            std::string(kFile) +
+                ": \"\": given twice in one object; only one would count: give it once");
+  EXPECT_EQ(error_of(R"({"": 1})", [](const JsonValue &v) { v.object({}, {"a"}); }),
+            std::string(kFile) + ": \"\": unknown field");
   // The same key in different objects is no duplicate.
   EXPECT_EQ(error_of(R"({"a": {"k": 1}, "b": {"k": 2}, "c": [{"k": 3}, {"k": 4}]})",
                      [](const JsonValue &) {}),

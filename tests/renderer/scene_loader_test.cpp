@@ -144,6 +144,14 @@ TEST(SceneLoader, AKeyGivenTwiceIsRefusedOnItsField) {
     EXPECT_EQ(e.field(), "materials.a");
     EXPECT_EQ(e.reason(), "given twice in one object; only one would count: give it once");
   }
+  // The fuzzer's: an empty key twice, named as JSON spells it, not blank.
+  try {
+    (void)load_scene(std::filesystem::path(CAMHEAD_SOURCE_DIR) /
+                     "tests/assets/fuzz/scene_empty_key_twice.json");
+    FAIL() << "accepted an empty key given twice";
+  } catch (const SceneError &e) {
+    EXPECT_EQ(e.field(), "\"\"");
+  }
 }
 
 // A camera whose axes the tracer cannot build in float32 is refused, not

@@ -52,12 +52,16 @@ void set_seed(gpu::FrameParams &frame, std::uint32_t seed);
 // norm of the lens's Jacobian (pixels of the image per pixel of the ideal
 // plane) on a grid over the preimage's bounds grown by `margin` (ideal
 // plane units: what lies that far outside the view, a blur circle's rim,
-// still reaches into it), and the smallest singular value there. A
-// pinhole's: the half-diagonal over the focal length, 1 and 1.
+// still reaches into it), and the smallest singular value there; and the
+// most the lens moves a point up or down from where the pinhole of its
+// principal point and focal lengths would put it (the grid's largest, a
+// tenth more), in pixels. A pinhole's: the half-diagonal over the focal
+// length, 1, 1 and 0.
 struct LensExtent {
   double max_tan = 0.0;
   double stretch = 1.0;
   double least_stretch = 1.0;
+  double max_row_shift_px = 0.0;
 };
 [[nodiscard]] LensExtent lens_extent(const gpu::FrameParams &frame, double margin = 0.0);
 [[nodiscard]] glm::uvec2 image_size(const gpu::FrameParams &frame);
