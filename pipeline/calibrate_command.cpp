@@ -153,7 +153,9 @@ What is written:
   The camera point (fx fy cx cy in the views' pixels, k1 k2 p1 p2 k3) at the
   focus distance that FOCUS counts give in PROFILE, on its prime or on the zoom
   point at ZOOM counts; a point there before is replaced. The profile becomes
-  version 3 (lens_control/README.md), which needs the sensor's width once.
+  version 3 (lens_control/README.md), which needs the sensor's width once;
+  the zoom point's breathing table gives way to its camera points' fx, so
+  calibrate at several focus distances to keep the breathing.
 
 Exit status: 0 profile written; 2 bad views, board, profile or --at;
 3 the calibration failed (too few usable views: each one's reason printed);
