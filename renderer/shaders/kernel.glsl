@@ -23,6 +23,16 @@
 
 // ---------------------------------------------------------------- camera
 
+// With a lens model (TRACING_LENS_MODEL): the point of the ideal image plane
+// (normalised, y down) that the lens's distortion takes to the sample
+// position (px, py).
+vec2 lens_preimage(float px, float py) {
+  float fy = frame.lens.z * frame.projection.z;
+  return lens_undistort(
+      vec2((px - frame.projection.x) / frame.lens.z, (py - frame.projection.y) / fy),
+      frame.distortion, frame.projection.w);
+}
+
 // One camera ray through pixel (x, y) for sample s of n (method.md section 1).
 Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   float width = float(frame.image.x);
@@ -48,12 +58,7 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   vec3 forward = vec3(frame.cam_forward);
   vec3 d;
   if (KERNEL_HAS(KERNEL_LENS_MODEL) && (frame.tracing.w & TRACING_LENS_MODEL) != 0u) {
-    // The real lens: the point of the image plane that the lens's
-    // distortion takes to this sample's position (normalised, y down).
-    float fy = frame.lens.z * frame.projection.z;
-    vec2 ideal = lens_undistort(
-        vec2((px - frame.projection.x) / frame.lens.z, (py - frame.projection.y) / fy),
-        frame.distortion, frame.projection.w);
+    vec2 ideal = lens_preimage(px, py); // the real lens
     d = normalize(right * ideal.x - up * ideal.y + forward);
   } else {
     d = normalize(right * (px - 0.5f * width) + up * (0.5f * height - py) +
@@ -341,10 +346,7 @@ bool pixel_misses_scene(uint x, uint y) {
     // Through the lens: the pixel centre's preimage, and its samples' within
     // their distance over the least stretch of the lens there, a tenth more
     // for the stretch's change across a pixel.
-    float fy = frame.lens.z * frame.projection.z;
-    vec2 ideal = lens_undistort(
-        vec2((px - frame.projection.x) / frame.lens.z, (py - frame.projection.y) / fy),
-        frame.distortion, frame.projection.w);
+    vec2 ideal = lens_preimage(px, py);
     float least = lens_least_stretch(ideal, frame.distortion, frame.projection.w);
     if (!(least > 0.05f)) {
       return false; // where the lens folds over: no bound
@@ -352,7 +354,7 @@ bool pixel_misses_scene(uint x, uint y) {
     d = normalize(vec3(frame.cam_right) * ideal.x - vec3(frame.cam_up) * ideal.y +
                   vec3(frame.cam_forward));
     footprint = 1.1f * 0.70710678f * frame.lens.w * frame.lens.y /
-                (min(frame.lens.z, fy) * least);
+                (min(frame.lens.z, frame.lens.z * frame.projection.z) * least);
   } else {
     d = normalize(vec3(frame.cam_right) * (px - 0.5f * float(frame.image.x)) +
                   vec3(frame.cam_up) * (0.5f * float(frame.image.y) - py) +
