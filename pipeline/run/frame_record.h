@@ -31,6 +31,9 @@ struct FrameRecord {
   // distance of the corners used from where the pose puts them (NaN: none).
   int markers_seen = 0;
   double reprojection_px = std::numeric_limits<double>::quiet_NaN();
+  // The tracker's time on the frame, and how long rendering it waited for
+  // the tracker (marker poses; 0 otherwise).
+  double track_s = 0.0, pose_wait_s = 0.0;
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;
   std::uint32_t history_samples = 0;     // samples per pixel the image holds (accumulating; else 0)

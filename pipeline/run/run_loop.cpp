@@ -429,6 +429,8 @@ PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
       markers_->pose_for(sequence, record.exposure_mid_ns, deadline, rest_pose_);
   record.markers_seen = found.markers_seen;
   record.reprojection_px = found.reprojection_px;
+  record.track_s = found.track_s;
+  record.pose_wait_s = found.wait_s;
   return {found.pose, found.fresh};
 }
 

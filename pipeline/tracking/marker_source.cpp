@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "camhead/base/monotonic_clock.h"
 #include "camhead/base/thread_name.h"
 #include "luma.h"
 #include "run/lens_camera.h"
@@ -149,14 +150,16 @@ void MarkerPoseSource::track_loop() {
     const LumaImage luma{slot->luma.data(), format_.width, format_.height,
                          std::ptrdiff_t(format_.width)};
     const CameraModel camera = camera_of(lens);
+    const std::int64_t track_start_ns = base::monotonic_ns();
     MarkerPose found = tracker_->track(luma, camera, previous ? &*previous : nullptr);
+    const double track_s = double(base::monotonic_ns() - track_start_ns) * 1e-9;
     if (found.found) {
       found.pose.position -= found.pose.forward() * pupil_m;
       found.pose = still_.filter(found.pose, camera.fx, board_extent_);
     }
 
     lock.lock();
-    results_[next_result_++ % kResults] = {slot->sequence, true, found};
+    results_[next_result_++ % kResults] = {slot->sequence, true, found, track_s};
     if (found.found)
       (void)found_.push(slot->mid_ns, found.pose);
     slot->state = SlotState::free;
@@ -174,14 +177,17 @@ const MarkerPoseSource::Result *MarkerPoseSource::result_of(std::uint64_t sequen
 
 FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_exposure_ns,
                                      std::int64_t deadline_ns, const CameraPose &rest) {
+  const std::int64_t wait_start_ns = base::monotonic_ns();
   std::unique_lock lock(mutex_);
   const auto deadline =
       std::chrono::steady_clock::time_point(std::chrono::nanoseconds(deadline_ns));
   (void)done_.wait_until(lock, deadline, [&] { return result_of(sequence) != nullptr; });
   FramePose out;
+  out.wait_s = double(base::monotonic_ns() - wait_start_ns) * 1e-9;
   const Result *result = result_of(sequence);
   if (result != nullptr && result->tracked) {
     out.markers_seen = result->pose.markers_seen;
+    out.track_s = result->track_s;
     if (result->pose.found) {
       out.pose = result->pose.pose;
       out.fresh = true;

@@ -56,6 +56,9 @@ struct FramePose {
   bool fresh = false; // found in this very frame
   int markers_seen = 0;
   double reprojection_px = std::numeric_limits<double>::quiet_NaN(); // NaN: not found
+  // The tracker's time on this frame (0: not tracked), and how long the
+  // render thread waited for it in pose_for(): the latency tracking adds.
+  double track_s = 0.0, wait_s = 0.0;
 };
 
 class MarkerPoseSource {
@@ -97,6 +100,7 @@ private:
     std::uint64_t sequence = std::numeric_limits<std::uint64_t>::max();
     bool tracked = false; // false: skipped for a newer frame
     MarkerPose pose;
+    double track_s = 0.0;
   };
 
   void track_loop();
