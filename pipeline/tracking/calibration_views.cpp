@@ -66,35 +66,38 @@ void read_y4m(const fs::path &file, std::size_t most, std::vector<CalibrationPic
   const base::VideoFormat format = hal::video_file::y4m_video_format(*header);
   const std::size_t frame_bytes = hal::video_file::y4m_plane_bytes(format);
   const std::size_t luma_bytes = std::size_t(header->width) * std::size_t(header->height);
-  // The frames: their count from the file's size, then every k-th.
-  const std::streamoff start = in.tellg();
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(file, ec);
-  const std::size_t frame_header = 6; // "FRAME\n", without parameters
-  const std::size_t frames =
-      ec ? 0 : std::size_t((size - std::uintmax_t(start)) / (frame_bytes + frame_header));
-  if (frames == 0)
-    fail(file, "no whole frame after the header");
-  const std::size_t step = std::max<std::size_t>(1, (frames + most - 1) / most);
-  std::vector<std::uint8_t> skip(frame_bytes);
-  for (std::size_t k = 0; k < frames; ++k) {
+  if (ec)
+    fail(file, "cannot be read (" + ec.message() + ")");
+  // The frames, each a FRAME line and its planes, whole; then every k-th
+  // read, so that at most `most` spread over the video.
+  std::vector<std::streamoff> planes;
+  for (;;) {
     if (!std::getline(in, line))
-      break; // frames with parameters in their lines: fewer than counted
+      break;
     if (line.rfind("FRAME", 0) != 0 || line.size() > hal::video_file::kY4mMaxFrameHeaderBytes)
-      fail(file, "frame " + std::to_string(k) + ": no FRAME line");
-    if (k % step != 0) {
-      in.read(reinterpret_cast<char *>(skip.data()), std::streamsize(frame_bytes));
-      continue;
-    }
+      fail(file, "frame " + std::to_string(planes.size()) + ": no FRAME line");
+    const std::streamoff at = in.tellg();
+    if (at < 0 || std::uintmax_t(at) + frame_bytes > size)
+      fail(file, "frame " + std::to_string(planes.size()) + " is cut short");
+    planes.push_back(at);
+    in.seekg(at + std::streamoff(frame_bytes));
+  }
+  if (planes.empty())
+    fail(file, "no frame after the header");
+  most = std::max<std::size_t>(most, 1);
+  const std::size_t step = std::max<std::size_t>(1, (planes.size() + most - 1) / most);
+  in.clear();
+  for (std::size_t k = 0; k < planes.size(); k += step) {
     CalibrationPicture picture{file.filename().string() + " frame " + std::to_string(k),
                                header->width,
                                header->height,
                                {}};
     picture.luma.resize(luma_bytes); // the Y plane comes first
-    in.read(reinterpret_cast<char *>(picture.luma.data()), std::streamsize(luma_bytes));
-    in.read(reinterpret_cast<char *>(skip.data()), std::streamsize(frame_bytes - luma_bytes));
-    if (!in)
-      fail(file, "frame " + std::to_string(k) + " is cut short");
+    in.seekg(planes[k]);
+    if (!in.read(reinterpret_cast<char *>(picture.luma.data()), std::streamsize(luma_bytes)))
+      fail(file, "frame " + std::to_string(k) + " cannot be read");
     out.push_back(std::move(picture));
   }
 }

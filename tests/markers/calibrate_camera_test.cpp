@@ -3,6 +3,7 @@
 // comes back (k1 within 2 %, RMS under 0.1 px); the command writes it into
 // a lens profile that then gives it back; and a run that fails leaves the
 // profile as it was.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -160,6 +161,36 @@ TEST(CalibrateCamera, TheCommandWritesTheCameraIntoTheProfile) {
   EXPECT_NEAR(s.distortion->k1, lens.distortion[0], 0.02 * std::abs(lens.distortion[0]));
   EXPECT_NEAR(s.projection.principal_x, (lens.cx + 0.5) / kWidth, 2.0 / kWidth);
   EXPECT_NEAR(s.projection_focal_length_mm.value, lens.fx * 36.0 / kWidth, 0.003 * 36.0);
+}
+
+// A Y4M video's frames are views too: their luma planes as stored, spread
+// evenly over the views allowed.
+TEST(CalibrateCamera, AVideosFramesAreViews) {
+  const camhead::test::ScratchDir scratch;
+  const std::vector<cv::Mat> &views = views_of_simulated_lens();
+  std::string y4m = "YUV4MPEG2 W" + std::to_string(kWidth) + " H" + std::to_string(kHeight) +
+                    " F25:1 Ip A1:1 C420jpeg\n";
+  const std::string chroma(std::size_t(kWidth / 2) * (kHeight / 2) * 2, char(128));
+  for (const cv::Mat &v : views)
+    y4m += "FRAME\n" + std::string(reinterpret_cast<const char *>(v.data), v.total()) + chroma;
+  const fs::path video = scratch.write("take.y4m", y4m);
+  const std::vector<CalibrationPicture> all = read_calibration_views({video}, 40);
+  ASSERT_EQ(all.size(), views.size());
+  for (std::size_t k = 0; k < views.size(); ++k)
+    EXPECT_TRUE(std::equal(all[k].luma.begin(), all[k].luma.end(), views[k].data)) << k;
+  const std::vector<CalibrationPicture> some = read_calibration_views({video}, 6);
+  ASSERT_EQ(some.size(), 6u);
+  EXPECT_EQ(some[1].name, "take.y4m frame 3");
+  EXPECT_TRUE(std::equal(some[5].luma.begin(), some[5].luma.end(), views[15].data));
+  // Cut short: refused by name.
+  const fs::path cut = scratch.write("cut.y4m", y4m.substr(0, y4m.size() - 1000));
+  try {
+    (void)read_calibration_views({cut}, 40);
+    FAIL() << "read a video cut short";
+  } catch (const CalibrationViewError &e) {
+    EXPECT_NE(std::string(e.what()).find("cut.y4m: frame 17 is cut short"), std::string::npos)
+        << e.what();
+  }
 }
 
 } // namespace
