@@ -205,8 +205,7 @@ Pipeline::Pipeline(const RunOptions &options)
   std::vector<base::VideoFormat> formats;
   for (const auto &sink : sinks_)
     formats.push_back(sink->format());
-  // Prepared with the lens as it is now (at rest until its readings come):
-  // its model decides the kernels that prepare() builds for every frame.
+  // The lens as it is now decides the kernels prepare() builds (its model).
   renderer::FrameRequest first = board_request();
   first.camera = lens_camera(base_camera_, lens_.state_at(base::monotonic_ns()).state);
   renderer_->prepare(first, camera_->format(), formats);

@@ -170,6 +170,25 @@ TEST_P(FrameAllocations, AFocusPullAllocatesNothingFrameAfterFrame) {
   }
 }
 
+// Through a lens model (a barrel with its principal point off centre) the
+// region's hulls go through the lens and the samples move through it: the
+// storage reserved holds them, frame after frame.
+TEST_P(FrameAllocations, APullThroughALensModelAllocatesNothingFrameAfterFrame) {
+  LiveFrames live(GetParam());
+  if (!live.available())
+    GTEST_SKIP() << "no Vulkan device";
+  live.request.camera.lens_model.k1 = -0.2f;
+  live.request.camera.lens_model.k2 = 0.05f;
+  live.request.camera.lens_model.principal_point = {0.52f, 0.47f};
+  const FrameCamera rest = live.request.camera;
+  const auto pull = [&](int k) {
+    live.request.camera.focus_distance_m = 1.0f + 0.05f * float(k % 20);
+    live.request.camera.look_at = rest.look_at + glm::vec3(0.01f * float(k % 7), 0.0f, 0.0f);
+  };
+  live.prepare();
+  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull); }), 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Executors, FrameAllocations,
                          ::testing::Values(Executor::cpu, Executor::gpu),
                          [](const ::testing::TestParamInfo<Executor> &param) {

@@ -4,10 +4,11 @@
 // data a row at a time into the caller's buffer, and every chunk's CRC is
 // checked. The chunks are walked first, so that none that runs past the end
 // of the file reaches libpng: a file cannot make it allocate more than the
-// rows its header states and the chunks it holds, whatever they claim. The caller reads the header first
-// (read_png_info) and checks the size it states before it allocates.
-// Errors are values: the file camera decodes at play time, where nothing may
-// throw. Any thread; libpng's state lives in each call.
+// rows its header states and the chunks it holds, whatever they claim.
+// The caller reads the header first (read_png_info) and checks the size it
+// states before it allocates. Errors are values: the file camera decodes at
+// play time, where nothing may throw. Any thread; libpng's state lives in
+// each call.
 #pragma once
 
 #include <cstdint>
