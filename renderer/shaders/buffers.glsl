@@ -24,6 +24,7 @@ layout(binding = BINDING_PRIMITIVES) uniform usamplerBuffer primitive_texels;
 layout(binding = BINDING_NODES) uniform usamplerBuffer node_texels;
 layout(binding = BINDING_MATERIALS) uniform usamplerBuffer material_texels;
 layout(binding = BINDING_LIGHTS) uniform usamplerBuffer light_texels;
+layout(binding = BINDING_SURFACES) uniform usamplerBuffer surface_texels;
 
 vec4 texel_at(usamplerBuffer texels, uint texel) {
   return uintBitsToFloat(texelFetch(texels, int(texel)));
@@ -50,6 +51,10 @@ Light light_at(uint index) {
   return Light(texel_at(light_texels, texel), texel_at(light_texels, texel + 1u),
                texel_at(light_texels, texel + 2u), texel_at(light_texels, texel + 3u),
                texel_at(light_texels, texel + 4u));
+}
+
+uvec4 surface_texel_at(uint texel) {
+  return texelFetch(surface_texels, int(texel));
 }
 
 layout(std140, binding = BINDING_FRAME) uniform Frame { FrameParams frame; };

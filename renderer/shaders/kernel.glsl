@@ -8,7 +8,8 @@
 // INOUT(T) / OUT(T) for reference parameters, and no names that would hide a
 // glm function inside a C++ class.
 //
-// Expects: primitive_at(), node_at(), material_at(), light_at(), frame (FrameParams).
+// Expects: primitive_at(), node_at(), material_at(), light_at(),
+// surface_texel_at(), frame (FrameParams).
 //
 // Loops test their condition at the bottom (do-while, behind a test for
 // none at all). lavapipe runs every branch masked and ends a loop only when
@@ -20,6 +21,7 @@
 #include "sampling.glsl"
 #include "intersect.glsl"
 #include "lens_model.glsl"
+#include "texture.glsl"
 
 // ---------------------------------------------------------------- camera
 
@@ -174,6 +176,7 @@ struct RealBranch {
   Ray ray;
   vec3 weight;
   uint surface;
+  float travelled; // metres from the lens to ray.origin
   bool pending;
 };
 
@@ -207,11 +210,13 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
   branch.ray = camera;
   branch.weight = vec3(1.0f);
   branch.surface = 1u;
+  branch.travelled = 0.0f;
   branch.pending = false;
 
   Ray ray = camera;
   vec3 weight = vec3(1.0f);
   uint surface = 1u;
+  float travelled = 0.0f; // from the lens to ray.origin, for texture filtering
   bool real_only = false; // segment 2
   bool coupled = true;    // segment 1 before any virtual surface
   uint last_shaded = frame.tracing.x + 1u;
@@ -230,6 +235,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
       branch.ray = ray;
       branch.weight = weight;
       branch.surface = surface;
+      branch.travelled = travelled;
       branch.pending = true;
     }
     bool add_mixed = !real_only;
@@ -250,7 +256,8 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
     uint surface_dim = DIM_SURFACE_BASE + (surface - 1u) * DIM_PER_SURFACE;
     bool path_ends = missed || surface > last_shaded || type == MAT_EMISSION;
     if (!path_ends && type == MAT_DIFFUSE) {
-      vec3 brdf_weight = weight * vec3(material.color) * (1.0f / CAMHEAD_PI);
+      vec3 albedo = surface_albedo(material, surface_prim, p, n, ray.dir, travelled + hit.t);
+      vec3 brdf_weight = weight * albedo * (1.0f / CAMHEAD_PI);
       vec3 dm = vec3(0.0f);
       vec3 dr = vec3(0.0f);
       direct_light(p, n_facing, brdf_weight, surface_dim, s, count, pixel_pattern,
@@ -274,6 +281,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
       ray = branch.ray;
       weight = branch.weight;
       surface = branch.surface;
+      travelled = branch.travelled;
       branch.pending = false;
       real_only = true;
       coupled = false;
@@ -294,6 +302,7 @@ SampleResult trace_sample(Ray camera, uint s, uint count, uint pixel_pattern) {
                          : normalize(refract(ray.dir, n_facing, 1.0f / eta));
       ray.origin = p + (reflects ? n_facing : -n_facing) * eps;
     }
+    travelled += hit.t;
     ++surface;
   }
   return result;

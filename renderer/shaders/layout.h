@@ -15,7 +15,9 @@
 #define PRIM_MATERIAL_MASK 0xffffu
 
 // One primitive, 48 bytes. Triangles store an edge form for Moeller-Trumbore.
-//   triangle: p0.xyz = v0, p1.xyz = v1 - v0, p2.xyz = v2 - v0
+//   triangle: p0.xyz = v0, p1.xyz = v1 - v0, p2.xyz = v2 - v0,
+//             p1.w = uint bits of its texture coordinates' record + 1
+//             (BINDING_SURFACES, SURFACE_UV_TEXELS each; 0 = none)
 //   sphere:   p0.xyz = centre, p1.x = radius
 //   p0.w = floatBitsFromUint(material | real << 16 | kind << 24)
 struct Primitive {
@@ -44,11 +46,27 @@ struct BvhNode {
 
 // color.rgb: albedo (diffuse), tint (mirror), radiance (emission), unused (glass)
 // params.x: index of refraction (glass); params.w: type (uint bits)
+// A diffuse material with an albedo texture (texture.glsl): params.y and .z
+// its width and height (uint bits; width 0 = none), color.w the
+// BINDING_SURFACES texel where its level 0 starts (uint bits); the texture
+// is multiplied by color.rgb.
 struct Material {
   vec4 color;
   vec4 params;
 };
 #define MATERIAL_TEXELS 2u // 16-byte texels per Material (BINDING_MATERIALS)
+
+// BINDING_SURFACES holds, in 16-byte texels, the texture coordinates of
+// textured triangles, then the albedo textures:
+// - a triangle's record, SURFACE_UV_TEXELS texels: (u0, v0, u1, v1), (u2, v2,
+//   uv units per metre of surface, 0) for its vertices v0, v1, v2; u to the
+//   image's right, v down it, (0, 0) the image's top-left corner
+// - a texture: its mip levels, level 0 the image, each next one half the
+//   last (rounded down, at least 1) down to 1 x 1; each level row-major from
+//   its top row, starting at a whole texel, two pixels per texel as half
+//   floats: (r, g) and (b, 0) of the even pixel in .x and .y, the odd one's
+//   in .z and .w (linear albedo)
+#define SURFACE_UV_TEXELS 2u
 
 #define LIGHT_POINT 0u
 #define LIGHT_AREA 1u
@@ -126,7 +144,8 @@ struct FrameParams {
 #define KERNEL_CAMERA_SOBOL 64u // ... or SAMPLER_SOBOL
 #define KERNEL_SKIP_EMPTY_PIXELS 128u
 #define KERNEL_LENS_MODEL 256u // frames may have TRACING_LENS_MODEL
-#define KERNEL_ALL 511u
+#define KERNEL_TEXTURES 512u   // a material has an albedo texture
+#define KERNEL_ALL 1023u
 #define KERNEL_HAS(feature) ((KERNEL_FEATURES & (feature)) != 0u)
 
 // The layers resolve.comp writes: specialization constant 1, RESOLVE_LAYERS.
@@ -177,7 +196,8 @@ struct FrameParams {
 #define BINDING_GROUP_LIST 24
 #define GROUP_LIST_TILES 0u
 #define GROUP_LIST_VIDEO(tiles) (1u + (tiles))
-#define BINDING_COUNT 25
+#define BINDING_SURFACES 25 // texture coordinates and albedo textures (Material, above)
+#define BINDING_COUNT 26
 
 // Histogram bins of the adaptive weights: 16 per octave over every
 // non-negative float (adaptive.glsl).

@@ -18,7 +18,9 @@
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+#include <glm/packing.hpp>
 #include <glm/trigonometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "camhead/renderer/bvh.h"
@@ -79,17 +81,61 @@ void add_triangle(std::vector<gpu::Primitive> &out, const glm::vec3 &a, const gl
                                gpu::vec4(e2, 0.0f)});
 }
 
+// Where the triangles of a textured object put their texture coordinates
+// (layout.h, BINDING_SURFACES); null for an untextured one.
+using UvRecords = std::vector<glm::uvec4>;
+
+// The triangle just added (if it was) gets texture coordinates uv[0..2] at
+// its vertices a, b, c.
+void add_uv_record(std::vector<gpu::Primitive> &out, std::size_t before, UvRecords *records,
+                   const std::array<glm::vec2, 3> &uv) {
+  if (!records || out.size() == before)
+    return;
+  gpu::Primitive &p = out.back();
+  const float area_m2 = glm::length(glm::cross(glm::vec3(p.p1), glm::vec3(p.p2)));
+  const glm::vec2 du = uv[1] - uv[0], dv = uv[2] - uv[0];
+  const float area_uv = std::abs(du.x * dv.y - du.y * dv.x);
+  const auto slot = std::uint32_t(records->size() / SURFACE_UV_TEXELS);
+  p.p1.w = glm::uintBitsToFloat(slot + 1u);
+  const auto word = [](float f) { return glm::floatBitsToUint(f); };
+  records->emplace_back(word(uv[0].x), word(uv[0].y), word(uv[1].x), word(uv[1].y));
+  records->emplace_back(word(uv[2].x), word(uv[2].y), word(std::sqrt(area_uv / area_m2)), 0u);
+}
+
 // Quads are split along their first diagonal; vertex order keeps the winding,
-// so cross(p1, p2) is the outward normal.
+// so cross(p1, p2) is the outward normal. `uv`: the corners' texture
+// coordinates, for a textured object.
 void add_quad(std::vector<gpu::Primitive> &out, const std::array<glm::vec3, 4> &q,
-              std::uint32_t bits) {
+              std::uint32_t bits, UvRecords *records = nullptr,
+              const std::array<glm::vec2, 4> &uv = {}) {
+  std::size_t before = out.size();
   add_triangle(out, q[0], q[1], q[2], bits);
+  add_uv_record(out, before, records, {uv[0], uv[1], uv[2]});
+  before = out.size();
   add_triangle(out, q[0], q[2], q[3], bits);
+  add_uv_record(out, before, records, {uv[0], uv[2], uv[3]});
+}
+
+// The texture coordinates of a corner c of the unit cube (-0.5 .. 0.5) on
+// the face whose outward normal is n (Material::albedo_texture): u along the
+// face's right as seen from outside, v down it.
+glm::vec2 box_face_uv(const glm::vec3 &c, const glm::vec3 &n) {
+  glm::vec3 right(1.0f, 0.0f, 0.0f), down(0.0f, 0.0f, 1.0f); // the top face: as a plane
+  if (n.y < -0.5f) {
+    down = glm::vec3(0.0f, 0.0f, -1.0f); // the bottom face, seen from below
+  } else if (n.y < 0.5f) {
+    down = glm::vec3(0.0f, -1.0f, 0.0f);
+    right = glm::cross(-n, glm::vec3(0.0f, 1.0f, 0.0f));
+  }
+  return {glm::dot(c, right) + 0.5f, glm::dot(c, down) + 0.5f};
 }
 
 // `origin`: the compiled frame's zero (CompiledScene::origin), taken off the
 // translation before the vertices are formed, where float has the most bits.
-void add_object(std::vector<gpu::Primitive> &out, const Object &o, const glm::vec3 &origin) {
+// `records`: where a textured object's triangles put their texture
+// coordinates, null for an untextured one.
+void add_object(std::vector<gpu::Primitive> &out, const Object &o, const glm::vec3 &origin,
+                UvRecords *records) {
   const glm::vec3 center = o.center - origin;
   switch (o.type) {
   case ShapeType::plane: {
@@ -98,20 +144,28 @@ void add_object(std::vector<gpu::Primitive> &out, const Object &o, const glm::ve
     add_quad(out,
              {xf({-0.5f, 0.0f, 0.5f}), xf({0.5f, 0.0f, 0.5f}), xf({0.5f, 0.0f, -0.5f}),
               xf({-0.5f, 0.0f, -0.5f})},
-             primitive_bits(o, PRIM_TRIANGLE));
+             primitive_bits(o, PRIM_TRIANGLE), records, {{{0, 1}, {1, 1}, {1, 0}, {0, 0}}});
     break;
   }
   case ShapeType::box: {
     // Corner i has x, y, z = bits 2, 1, 0 of i; faces as add_object() lists them.
     const Transform xf(center, o.rotation_deg, o.size);
-    std::array<glm::vec3, 8> v;
-    for (int i = 0; i < 8; ++i)
-      v[i] = xf(glm::vec3((i >> 2) & 1, (i >> 1) & 1, i & 1) - glm::vec3(0.5f));
+    std::array<glm::vec3, 8> unit, v;
+    for (int i = 0; i < 8; ++i) {
+      unit[i] = glm::vec3((i >> 2) & 1, (i >> 1) & 1, i & 1) - glm::vec3(0.5f);
+      v[i] = xf(unit[i]);
+    }
     constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
                                   {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
     const std::uint32_t bits = primitive_bits(o, PRIM_TRIANGLE);
-    for (const auto &f : kFaces)
-      add_quad(out, {v[f[0]], v[f[1]], v[f[2]], v[f[3]]}, bits);
+    for (const auto &f : kFaces) {
+      const glm::vec3 normal =
+          0.5f * (unit[f[0]] + unit[f[1]] + unit[f[2]] + unit[f[3]]); // the face's centre x 2
+      std::array<glm::vec2, 4> uv;
+      for (int k = 0; k < 4; ++k)
+        uv[k] = box_face_uv(unit[f[k]], normal);
+      add_quad(out, {v[f[0]], v[f[1]], v[f[2]], v[f[3]]}, bits, records, uv);
+    }
     break;
   }
   case ShapeType::sphere:
@@ -140,7 +194,72 @@ void add_object(std::vector<gpu::Primitive> &out, const Object &o, const glm::ve
   }
 }
 
-gpu::Material compile_material(const Material &m) {
+// Where a compiled texture lies in CompiledScene::surfaces.
+struct TexturePlace {
+  std::uint32_t base = 0;
+  std::uint32_t width = 0; // 0: none
+  std::uint32_t height = 0;
+};
+
+// One level of a texture, linear RGB.
+struct TextureLevel {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec3> rgb;
+};
+
+TextureLevel level_zero(const Image &image) {
+  TextureLevel level{image.width, image.height, std::vector<glm::vec3>(image.pixel_count())};
+  for (std::size_t i = 0; i < level.rgb.size(); ++i) {
+    const float *px = &image.data[i * std::size_t(image.channels)];
+    level.rgb[i] = image.channels >= 3 ? glm::vec3(px[0], px[1], px[2]) : glm::vec3(px[0]);
+  }
+  return level;
+}
+
+// The next level: each pixel the mean of the 2 x 2 below it (of the 1 or 2
+// there are at an odd or single-pixel edge).
+TextureLevel half_level(const TextureLevel &src) {
+  TextureLevel out{std::max(src.width / 2, 1), std::max(src.height / 2, 1), {}};
+  out.rgb.resize(std::size_t(out.width) * std::size_t(out.height));
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      glm::vec3 sum(0.0f);
+      int n = 0;
+      for (int sy = 2 * y; sy < std::min(2 * y + 2, src.height); ++sy)
+        for (int sx = 2 * x; sx < std::min(2 * x + 2, src.width); ++sx, ++n)
+          sum += src.rgb[std::size_t(sy) * std::size_t(src.width) + std::size_t(sx)];
+      out.rgb[std::size_t(y) * std::size_t(out.width) + std::size_t(x)] = sum / float(n);
+    }
+  return out;
+}
+
+// Appends `image` and its mip levels to `surfaces` (layout.h).
+TexturePlace add_texture(std::vector<glm::uvec4> &surfaces, const Image &image) {
+  if (image.width <= 0 || image.height <= 0)
+    throw std::invalid_argument("an albedo texture is empty");
+  const TexturePlace place{std::uint32_t(surfaces.size()), std::uint32_t(image.width),
+                           std::uint32_t(image.height)};
+  TextureLevel level = level_zero(image);
+  for (;;) {
+    const std::size_t first = surfaces.size();
+    surfaces.resize(first + (level.rgb.size() + 1) / 2, glm::uvec4(0u));
+    for (std::size_t i = 0; i < level.rgb.size(); ++i) {
+      const glm::vec3 &c = level.rgb[i];
+      glm::uvec4 &word = surfaces[first + i / 2];
+      const glm::uint rg = glm::packHalf2x16(glm::vec2(c.r, c.g));
+      const glm::uint b = glm::packHalf2x16(glm::vec2(c.b, 0.0f));
+      (i % 2 == 0 ? word.x : word.z) = rg;
+      (i % 2 == 0 ? word.y : word.w) = b;
+    }
+    if (level.width == 1 && level.height == 1)
+      break;
+    level = half_level(level);
+  }
+  return place;
+}
+
+gpu::Material compile_material(const Material &m, const TexturePlace &texture) {
   std::uint32_t type = MAT_DIFFUSE;
   switch (m.type) {
   case MaterialType::diffuse:
@@ -156,8 +275,9 @@ gpu::Material compile_material(const Material &m) {
     type = MAT_EMISSION;
     break;
   }
-  return gpu::Material{gpu::vec4(m.color, 0.0f),
-                       gpu::vec4(m.ior, 0.0f, 0.0f, glm::uintBitsToFloat(type))};
+  return gpu::Material{gpu::vec4(m.color, glm::uintBitsToFloat(texture.base)),
+                       gpu::vec4(m.ior, glm::uintBitsToFloat(texture.width),
+                                 glm::uintBitsToFloat(texture.height), glm::uintBitsToFloat(type))};
 }
 
 gpu::Light compile_light(const Light &l, const glm::vec3 &origin) {
@@ -260,10 +380,16 @@ CompiledScene compile_scene(const Scene &scene) {
   // it: at 1 km they lift shadow rays 10 cm off the surface.
   constexpr float kOriginGridM = 64.0f;
   out.origin = glm::round(scene.camera.position / kOriginGridM) * kOriginGridM;
+  const auto textured = [&](const Object &o) {
+    return std::size_t(o.material) < scene.materials.size() &&
+           scene.materials[std::size_t(o.material)].type == MaterialType::diffuse &&
+           scene.materials[std::size_t(o.material)].albedo_texture.image &&
+           (o.type == ShapeType::plane || o.type == ShapeType::box);
+  };
   std::vector<gpu::Primitive> prims;
   for (const Object &o : scene.objects) {
     const std::size_t first = prims.size();
-    add_object(prims, o, out.origin);
+    add_object(prims, o, out.origin, textured(o) ? &out.surfaces : nullptr);
     ObjectBounds bounds;
     if (!primitive_bounds(prims, first, bounds))
       continue;
@@ -287,8 +413,21 @@ CompiledScene compile_scene(const Scene &scene) {
   Bvh bvh = build_bvh(std::move(prims));
   out.primitives = std::move(bvh.primitives);
   out.nodes = std::move(bvh.nodes);
-  for (const Material &m : scene.materials)
-    out.materials.push_back(compile_material(m));
+  // The textures after the texture coordinates, each once however many
+  // materials share it.
+  std::vector<std::pair<const Image *, TexturePlace>> textures;
+  for (const Material &m : scene.materials) {
+    TexturePlace place;
+    if (const Image *image = m.albedo_texture.image.get();
+        m.type == MaterialType::diffuse && image) {
+      const auto known = std::find_if(textures.begin(), textures.end(),
+                                      [&](const auto &t) { return t.first == image; });
+      place = known != textures.end()
+                  ? known->second
+                  : textures.emplace_back(image, add_texture(out.surfaces, *image)).second;
+    }
+    out.materials.push_back(compile_material(m, place));
+  }
   for (const Light &l : scene.lights)
     out.lights.push_back(compile_light(l, out.origin));
   if (scene.plate)

@@ -12,6 +12,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/integer.hpp>
+#include <glm/packing.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -40,7 +41,8 @@ struct CpuKernel {
   const BvhNode *nodes = nullptr;
   const Material *materials = nullptr;
   const Light *lights = nullptr;
-  const uint *sample_counts = nullptr; // adaptive second pass only (tracing.y > 0)
+  const glm::uvec4 *surfaces = nullptr; // texture coordinates and textures (layout.h)
+  const uint *sample_counts = nullptr;  // adaptive second pass only (tracing.y > 0)
   FrameParams frame{};
   // Every feature, chosen at run time (layout.h).
   static constexpr uint KERNEL_FEATURES = KERNEL_ALL;
@@ -50,6 +52,7 @@ struct CpuKernel {
   [[nodiscard]] BvhNode node_at(uint index) const { return nodes[index]; }
   [[nodiscard]] Material material_at(uint index) const { return materials[index]; }
   [[nodiscard]] Light light_at(uint index) const { return lights[index]; }
+  [[nodiscard]] glm::uvec4 surface_texel_at(uint texel) const { return surfaces[texel]; }
 
 #include "kernel.glsl"
 };

@@ -53,6 +53,7 @@ cpu::CpuKernel cpu::make_cpu_kernel(const CompiledScene &scene, const gpu::Frame
   static const gpu::Material placeholder_material{};
   kernel.materials = scene.materials.empty() ? &placeholder_material : scene.materials.data();
   kernel.lights = scene.lights.data();
+  kernel.surfaces = scene.surfaces.data(); // read only through a textured material
   cpu::set_cpu_frame(kernel, scene, frame);
   return kernel;
 }

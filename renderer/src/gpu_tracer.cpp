@@ -40,6 +40,7 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   types[BINDING_NODES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_MATERIALS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_LIGHTS] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  types[BINDING_SURFACES] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_VIDEO_IN] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_GROUP_LIST] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   for (const int binding : {BINDING_ACCUM_MIXED, BINDING_ACCUM_REAL, BINDING_ACCUM_AUX,
@@ -74,7 +75,7 @@ vk::BufferCreateInfo binding_buffer(int binding, VkDeviceSize size, VkBufferUsag
 }
 
 // The features of kernel.glsl that `scene` can reach (layout.h, KERNEL_*):
-// its primitive kinds, material types and light types.
+// its primitive kinds, material types, textures and light types.
 std::uint32_t scene_kernel_features(const CompiledScene &scene) {
   const auto bits = [](float word) { return std::bit_cast<std::uint32_t>(word); };
   std::uint32_t features = 0;
@@ -85,6 +86,8 @@ std::uint32_t scene_kernel_features(const CompiledScene &scene) {
       features |= KERNEL_MIRRORS;
     if (bits(m.params.w) == MAT_GLASS)
       features |= KERNEL_GLASS;
+    if (bits(m.params.w) == MAT_DIFFUSE && bits(m.params.y) != 0u)
+      features |= KERNEL_TEXTURES;
   }
   for (const gpu::Light &l : scene.lights)
     if (bits(l.position.w) == LIGHT_AREA)
@@ -188,6 +191,11 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
     throw GpuError("GpuTracer::load: plate has " + std::to_string(scene.plate.size()) +
                    " pixels, the image " + std::to_string(pixels));
   check_image_limits(device, scene.width, scene.height);
+  if (scene.surfaces.size() > device.limits().maxTexelBufferElements)
+    throw GpuError("the scene's textures and their texture coordinates take " +
+                   std::to_string(scene.surfaces.size()) + " texels; device '" + device.name() +
+                   "' allows " + std::to_string(device.limits().maxTexelBufferElements) +
+                   " (maxTexelBufferElements)");
   const VkDeviceSize layer_bytes = pixels * sizeof(gpu::vec4);
 
   loaded = false; // until every buffer below exists
@@ -211,6 +219,8 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
   upload(BINDING_NODES, bytes_of(nodes), sizeof(gpu::BvhNode), "BVH nodes");
   upload(BINDING_MATERIALS, bytes_of(scene.materials), sizeof(gpu::Material), "materials");
   upload(BINDING_LIGHTS, bytes_of(scene.lights), sizeof(gpu::Light), "lights");
+  upload(BINDING_SURFACES, bytes_of(scene.surfaces), sizeof(glm::uvec4),
+         "texture coordinates and textures");
   // Full size even without a plate: a live frame's camera image goes there.
   upload(BINDING_PLATE, bytes_of(scene.plate), layer_bytes, "plate");
   uploader.flush(commands);

@@ -179,10 +179,18 @@ void check_tiles(const std::filesystem::path &path, std::span<const unsigned cha
 // Refuses an image whose header says another size than the caller needs.
 void check_size(const std::filesystem::path &path, long long w, long long h,
                 const std::optional<ImageSize> &expected) {
-  if (expected && (w != expected->width || h != expected->height))
+  if (!expected)
+    return;
+  if (expected->or_smaller) {
+    if (w > expected->width || h > expected->height)
+      fail(path, "is " + std::to_string(w) + "x" + std::to_string(h) + ", larger than the " +
+                     std::to_string(expected->width) + "x" + std::to_string(expected->height) +
+                     " allowed");
+  } else if (w != expected->width || h != expected->height) {
     fail(path, "is " + std::to_string(w) + "x" + std::to_string(h) + ", not the " +
                    std::to_string(expected->width) + "x" + std::to_string(expected->height) +
                    " needed");
+  }
 }
 
 // The chunks a scanline image of `lines` lines has, for the codecs read.

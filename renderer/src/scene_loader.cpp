@@ -145,7 +145,7 @@ private:
     return out;
   }
 
-  static std::vector<Material> materials(const JsonValue &M) {
+  std::vector<Material> materials(const JsonValue &M) {
     if (!M.json().is_object() || M.json().empty())
       M.fail("must be a non-empty object");
     std::vector<Material> out;
@@ -154,9 +154,16 @@ private:
       mat.name = name;
       const std::string t = m.at("type").string({"diffuse", "mirror", "glass", "emission"});
       if (t == "diffuse") {
-        m.object({"type", "albedo"});
+        m.object({"type"}, {"albedo", "albedo_texture"});
         mat.type = MaterialType::diffuse;
-        mat.color = v3(vec(m.at("albedo"), 3, Range::within(0.0, 1.0)));
+        if (!m.has("albedo") && !m.has("albedo_texture"))
+          m.fail_member("albedo", "missing (or an albedo_texture)");
+        // With a texture, albedo tints it: white unless given.
+        mat.color =
+            m.has("albedo") ? v3(vec(m.at("albedo"), 3, Range::within(0.0, 1.0))) : glm::vec3(1.0f);
+        if (m.has("albedo_texture")) {
+          mat.albedo_texture = {texture(m.at("albedo_texture")), m.at("albedo_texture").path()};
+        }
       } else if (t == "mirror") {
         m.object({"type"}, {"tint"});
         mat.type = MaterialType::mirror;
@@ -205,6 +212,10 @@ private:
         o.at("material").fail("no material named " + material);
       ob.material = int(m - scene.materials.begin());
       ob.real = o.has("real") && o.at("real").boolean();
+      if (m->albedo_texture.image && (t == "sphere" || t == "mesh"))
+        o.at("material")
+            .fail("'" + material + "' has an albedo_texture, and a " + t +
+                  " has no texture coordinates (planes and boxes have)");
       if (t == "plane") {
         const Vec size = vec(o.at("size"), 2, Range::at_least(1e-9));
         ob.size = glm::vec3(float(size[0]), 1.0f, float(size[1]));
@@ -275,6 +286,31 @@ private:
     }
   }
 
+  // An albedo image, read once however many materials name it. Its albedo
+  // must be physical (within [0, 1]), as a colour's is.
+  std::shared_ptr<const Image> texture(const JsonValue &file) {
+    (void)file.string();
+    const std::filesystem::path path = file.path();
+    if (const auto known = textures_.find(path); known != textures_.end())
+      return known->second;
+    Image image;
+    try {
+      image = read_image(path, ImageSize{kLargestTexture, kLargestTexture, true});
+    } catch (const ImageError &e) {
+      file.fail(e.what());
+    }
+    for (std::size_t i = 0; i < image.data.size(); ++i)
+      if (!(image.data[i] >= 0.0f && image.data[i] <= 1.0f)) {
+        const std::size_t px = i / std::size_t(image.channels);
+        file.fail(path.string() + ": pixel (" + std::to_string(px % std::size_t(image.width)) +
+                  ", " + std::to_string(px / std::size_t(image.width)) + ") has " +
+                  std::to_string(image.data[i]) + ", and an albedo must be within [0, 1]");
+      }
+    auto shared = std::make_shared<const Image>(std::move(image));
+    textures_.emplace(path, shared);
+    return shared;
+  }
+
   static Image load_plate(const JsonValue &file, const RenderSettings &r) {
     const std::filesystem::path path = file.path();
     Image plate;
@@ -292,6 +328,9 @@ private:
 
   std::filesystem::path source_;
   std::map<std::filesystem::path, std::shared_ptr<const TriangleMesh>> meshes_;
+  std::map<std::filesystem::path, std::shared_ptr<const Image>> textures_;
+  // 4096 x 4096: 200 MB of floats read, 180 MB of texels with its levels.
+  static constexpr int kLargestTexture = 4096;
 };
 
 } // namespace

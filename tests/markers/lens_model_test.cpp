@@ -54,7 +54,7 @@ renderer::Scene empty_scene() {
   scene.render.height = 240;
   scene.camera.focal_length_mm = 40.0f;
   scene.camera.sensor_width_mm = 36.0f;
-  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
   return scene;
 }
 

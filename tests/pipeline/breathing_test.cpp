@@ -54,7 +54,7 @@ TEST(Breathing, ThePicturesScaleFollowsTheProjectionFocalLengthThroughAPull) {
   scene.render.width = kWidth;
   scene.render.height = kHeight;
   scene.camera.sensor_width_mm = 36.0f;
-  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
   // 1.2 m apart across the view at 3 m: about 90 px at 35 mm.
   scene.objects = {square({-0.6f, 0.1f, -3.0f}), square({0.6f, -0.1f, -3.0f})};
   const renderer::CompiledScene compiled = renderer::compile_scene(scene);

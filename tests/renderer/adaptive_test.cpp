@@ -199,7 +199,7 @@ renderer::Scene virtual_wall_in_soft_shadow() {
   scene.camera.look_at = {0.0f, 0.0f, -1.0f};
   scene.camera.f_number = 2.0f;
   scene.camera.focus_distance_m = 2.0f;
-  scene.materials = {{"white", renderer::MaterialType::diffuse, glm::vec3(0.8f), 1.5f}};
+  scene.materials = {{"white", renderer::MaterialType::diffuse, glm::vec3(0.8f), 1.5f, {}}};
   renderer::Object wall;
   wall.name = "wall";
   wall.type = renderer::ShapeType::plane;

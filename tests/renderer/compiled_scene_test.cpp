@@ -45,10 +45,10 @@ void expect_near(const glm::vec3 &got, const glm::vec3 &want, float tol = 1e-5f)
 
 Scene scene_with(std::vector<Object> objects) {
   Scene s;
-  s.materials = {{"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f},
-                 {"chrome", MaterialType::mirror, glm::vec3(0.9f, 0.8f, 0.7f), 1.5f},
-                 {"glass", MaterialType::glass, glm::vec3(1.0f), 1.33f},
-                 {"lamp", MaterialType::emission, glm::vec3(2.0f, 1.0f, 0.5f), 1.5f}};
+  s.materials = {{"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}},
+                 {"chrome", MaterialType::mirror, glm::vec3(0.9f, 0.8f, 0.7f), 1.5f, {}},
+                 {"glass", MaterialType::glass, glm::vec3(1.0f), 1.33f, {}},
+                 {"lamp", MaterialType::emission, glm::vec3(2.0f, 1.0f, 0.5f), 1.5f, {}}};
   s.objects = std::move(objects);
   return s;
 }

@@ -63,8 +63,9 @@ Scene shadow_scene() {
   scene.render.height = 120;
   scene.camera.position = {0.0f, 1.0f, 3.0f};
   scene.camera.look_at = {0.0f, 0.3f, 0.0f};
-  scene.materials.push_back({"ground", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
-  scene.materials.push_back({"paint", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
+  scene.materials.push_back({"ground", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
+  scene.materials.push_back(
+      {"paint", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f, {}});
   scene.objects = {test::plane("ground", glm::vec3(0.0f), 20.0f, 0, true),
                    test::box("virtual_box", {0.0f, 0.5f, 0.0f}, glm::vec3(0.4f), 1, false)};
   Light key;
@@ -119,8 +120,9 @@ TEST(DifferentialRendering, VirtualMirrorReflectsTheRealProxy) {
   Scene scene = shadow_scene();
   scene.camera.position = {0.0f, 0.5f, 2.0f};
   scene.camera.look_at = {0.0f, 0.5f, 0.0f};
-  scene.materials.push_back({"red", MaterialType::diffuse, glm::vec3(0.8f, 0.05f, 0.05f), 1.5f});
-  scene.materials.push_back({"chrome", MaterialType::mirror, glm::vec3(0.9f), 1.5f});
+  scene.materials.push_back(
+      {"red", MaterialType::diffuse, glm::vec3(0.8f, 0.05f, 0.05f), 1.5f, {}});
+  scene.materials.push_back({"chrome", MaterialType::mirror, glm::vec3(0.9f), 1.5f, {}});
   Object &box = scene.objects[1]; // now a real red box out of view, right of the camera
   box.material = 2;
   box.real = true;

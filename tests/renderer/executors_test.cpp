@@ -59,7 +59,7 @@ TEST(Executors, SceneWithoutNodesShowsTheWorldColour) {
   scene.render.width = 8;
   scene.render.height = 4;
   scene.render.world_color = glm::vec3(0.25f, 0.5f, 0.75f);
-  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  scene.materials.push_back({"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
   renderer::CompiledScene compiled = renderer::compile_scene(scene);
   compiled.nodes.clear();
   const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, 2);

@@ -41,7 +41,7 @@ namespace {
 // frame has work.
 Scene ball_scene() {
   Scene scene = test::empty_scene("allocations", 1.4f, 0.8f, 96, 64);
-  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
   scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
   scene.objects.push_back(test::sphere("ball", {-0.2f, -0.25f, -1.5f}, 0.25f, 0, false));
   scene.lights.push_back(test::point_light({-1.0f, 2.0f, -1.0f}, 200.0f));

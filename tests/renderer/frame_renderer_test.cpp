@@ -52,7 +52,7 @@ std::vector<std::uint8_t> noise_frame(const VideoFormat &f, unsigned seed) {
 // A scene with nothing virtual: every pixel must pass through.
 Scene real_only(int w, int h) {
   Scene scene = test::empty_scene("real only", 2.0f, 2.0f, w, h);
-  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
+  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
   scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
   scene.objects.push_back(test::box("crate", {0.3f, -0.3f, -2.0f}, glm::vec3(0.3f), 0, true));
   scene.lights.push_back(test::point_light({-1.0f, 2.0f, -1.0f}, 200.0f));
@@ -163,8 +163,8 @@ TEST_P(FramePassThrough, YuyvToNv12IsWithinOneCodeValue) {
 Scene scene_with_ball(int w, int h, glm::vec3 ball) {
   Scene scene = real_only(w, h);
   scene.lights.clear();
-  scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
-  scene.materials.push_back({"glow", MaterialType::emission, glm::vec3(2.0f), 1.5f});
+  scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f, {}});
+  scene.materials.push_back({"glow", MaterialType::emission, glm::vec3(2.0f), 1.5f, {}});
   scene.objects.push_back(test::sphere("ball", ball, 0.2f, 2, false));
   return scene;
 }
@@ -214,7 +214,7 @@ TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
   light.normal = glm::normalize(glm::vec3(0.3f, -1.0f, -0.3f));
   light.power_W = 300.0f;
   scene.lights.push_back(light);
-  scene.materials.push_back({"mirror", MaterialType::mirror, glm::vec3(0.9f), 1.5f});
+  scene.materials.push_back({"mirror", MaterialType::mirror, glm::vec3(0.9f), 1.5f, {}});
   scene.objects.push_back(test::box("mirror", {0.9f, 0.2f, -3.5f}, {0.5f, 0.8f, 0.05f},
                                     int(scene.materials.size()) - 1, true, {0.0f, -30.0f, 0.0f}));
   auto renderer = make_renderer(GetParam(), scene);

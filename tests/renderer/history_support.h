@@ -28,8 +28,8 @@ inline constexpr int kHeight = 48;
 // a point light: blur, a shadow on the proxy, and a depth edge.
 inline Scene ball_scene() {
   Scene scene = test::empty_scene("history", 2.0f, 2.0f, kWidth, kHeight);
-  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
-  scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
+  scene.materials.push_back({"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
+  scene.materials.push_back({"blue", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f, {}});
   scene.objects.push_back(test::plane("floor", {0.0f, -0.5f, -3.0f}, 20.0f, 0, true));
   scene.objects.push_back(test::box("crate", {0.3f, -0.3f, -3.0f}, glm::vec3(0.4f), 0, true));
   scene.objects.push_back(test::sphere("ball", {-0.2f, -0.25f, -1.2f}, 0.2f, 1, false));

@@ -109,7 +109,7 @@ TEST(InfluenceRegion, BlurAndFilterReachBitForBit) {
                         Case{"wide blur, f/0.7", 0.7f, 0.3f, 3.0f, 1.0f, 2, 0.05f}}) {
     Scene scene = test::empty_scene(c.name, c.f_number, c.focus_m, 160, 120);
     scene.render.pixel_filter_width_px = c.filter_px;
-    scene.materials = {{"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
+    scene.materials = {{"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f, {}}};
     for (int i = 0; i < c.balls; ++i) {
       const float x = (float(i % 4) - 1.37f) * 0.23f * c.depth_m;
       const float y = (float(i / 4) - 0.91f) * 0.19f * c.depth_m;
@@ -137,7 +137,7 @@ TEST(InfluenceRegion, SphereAndShadowBoundsBitForBit) {
     Scene scene = test::empty_scene("spheres", 0.0f, 1.0f, 320, 240);
     scene.camera.position = glm::vec3(0.0f, 1.2f, 0.0f);
     scene.camera.look_at = glm::vec3(0.0f, 0.0f, -4.0f);
-    scene.materials = {{"grey", renderer::MaterialType::diffuse, glm::vec3(0.6f), 1.5f}};
+    scene.materials = {{"grey", renderer::MaterialType::diffuse, glm::vec3(0.6f), 1.5f, {}}};
     scene.objects.push_back(test::plane("floor", glm::vec3(0.0f, 0.0f, -4.0f), 12.0f, 0, true));
     for (int i = 0; i < 15; ++i) {
       const glm::vec3 centre((float(i % 5) - 2.13f) * 0.71f, 0.15f + 0.07f * float(i % 4),
@@ -198,7 +198,7 @@ TEST(InfluenceRegion, ThroughALensModelBitForBit) {
           << c.differing_pixel / scene.render.width << ") differs; region " << c.fraction;
     }
     Scene scene = test::empty_scene("corners", 1.4f, 0.8f, 160, 120);
-    scene.materials = {{"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
+    scene.materials = {{"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f, {}}};
     for (int i = 0; i < 20; ++i) {
       const float x = (float(i % 5) - 2.0f) * 0.36f * 2.5f;
       const float y = (float(i / 5) - 1.5f) * 0.3f * 2.5f;
@@ -222,7 +222,7 @@ TEST(InfluenceRegion, ThroughALensModelBitForBit) {
 TEST(InfluenceRegion, SmallObjectSmallRegionGrowingWithBlur) {
   const auto fraction = [](float f_number) {
     Scene scene = test::empty_scene("small sphere", f_number, 0.5f, 320, 240);
-    scene.materials = {{"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f}};
+    scene.materials = {{"grey", renderer::MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}}};
     scene.objects.push_back(test::sphere("ball", glm::vec3(0.0f, 0.0f, -4.0f), 0.1f, 0, false));
     renderer::Light sun;
     sun.type = renderer::LightType::sun;

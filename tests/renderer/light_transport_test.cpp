@@ -44,8 +44,8 @@ glm::vec3 centre_pixel(const Image &image) {
 TEST(LightTransport, MirrorReflectsEmitterScaledByTintWithoutFresnel) {
   CAMHEAD_REQUIRE_VULKAN();
   Scene scene = empty_scene();
-  scene.materials = {{"mirror", MaterialType::mirror, {0.9f, 0.8f, 0.7f}, 1.5f},
-                     {"lamp", MaterialType::emission, {1.0f, 0.5f, 0.25f}, 1.5f}};
+  scene.materials = {{"mirror", MaterialType::mirror, {0.9f, 0.8f, 0.7f}, 1.5f, {}},
+                     {"lamp", MaterialType::emission, {1.0f, 0.5f, 0.25f}, 1.5f, {}}};
   scene.objects = {facing_plane("mirror", -2.0f, true, 0, 10.0f),
                    facing_plane("lamp_behind_camera", 2.0f, false, 1, 10.0f)};
   const glm::vec3 c = centre_pixel(test::render_gpu(scene, 4).mixed);
@@ -60,7 +60,7 @@ TEST(LightTransport, AreaLightIsSeenInMirrorsOnlyAndFromTheFront) {
   CAMHEAD_REQUIRE_VULKAN();
   Scene scene = empty_scene();
   scene.render.world_color = glm::vec3(0.125f);
-  scene.materials = {{"mirror", MaterialType::mirror, {0.9f, 0.8f, 0.7f}, 1.5f}};
+  scene.materials = {{"mirror", MaterialType::mirror, {0.9f, 0.8f, 0.7f}, 1.5f, {}}};
   Light panel;
   panel.name = "panel";
   panel.type = LightType::area;
@@ -99,8 +99,8 @@ TEST(LightTransport, GlassBallTransmitsFresnelWeightedEmitter) {
   CAMHEAD_REQUIRE_VULKAN();
   Scene scene = empty_scene();
   scene.render.max_bounces = 4;
-  scene.materials = {{"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f},
-                     {"lamp", MaterialType::emission, glm::vec3(1.0f), 1.5f}};
+  scene.materials = {{"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f, {}},
+                     {"lamp", MaterialType::emission, glm::vec3(1.0f), 1.5f, {}}};
   Object ball;
   ball.name = "ball";
   ball.type = ShapeType::sphere;

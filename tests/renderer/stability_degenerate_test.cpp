@@ -129,7 +129,7 @@ TEST(Degenerate, SpheresOfNoSizeRenderFinite) {
   for (float radius : {0.0f, 1e-30f}) {
     Scene scene = test::empty_scene("axis", 0.0f, 0.0f, 1, 1);
     scene.render.pixel_filter_width_px = 0.0f;
-    scene.materials.push_back({"white", MaterialType::diffuse, glm::vec3(0.8f), 1.5f});
+    scene.materials.push_back({"white", MaterialType::diffuse, glm::vec3(0.8f), 1.5f, {}});
     scene.objects.push_back(test::sphere("point", {0.0f, 0.0f, -2.0f}, radius, 0, false));
     scene.lights.push_back(point_light({0.0f, 1.0f, 0.0f}, 100.0f));
     const RenderResult r = test::render_cpu(scene, 1);
@@ -196,7 +196,7 @@ TEST(Degenerate, CameraInsideAClosedBoxSeesOnlyWhatIsInside) {
 TEST(Degenerate, CameraInsideGlassMirrorAndOnASurfaceRendersFinite) {
   Scene scene = base_scene();
   scene.render.max_bounces = 16;
-  scene.materials.push_back({"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f});
+  scene.materials.push_back({"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f, {}});
   const int glass = int(scene.materials.size()) - 1;
   // Inside a virtual glass ball.
   Scene in_glass = scene;

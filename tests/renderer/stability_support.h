@@ -22,7 +22,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 // Adds an emission material of grey radiance `radiance`; returns its index.
 inline int add_emitter(renderer::Scene &scene, const std::string &name, float radiance) {
-  scene.materials.push_back({name, renderer::MaterialType::emission, glm::vec3(radiance), 1.5f});
+  scene.materials.push_back(
+      {name, renderer::MaterialType::emission, glm::vec3(radiance), 1.5f, {}});
   return int(scene.materials.size()) - 1;
 }
 
@@ -61,10 +62,12 @@ inline renderer::Scene shaded_scene(int width, int height) {
   scene.camera.sensor_width_mm = 36.0f;
   scene.camera.f_number = 2.8f;
   scene.camera.focus_distance_m = 3.5f;
-  scene.materials.push_back({"ground", MaterialType::diffuse, glm::vec3(0.5f), 1.5f});
-  scene.materials.push_back({"crate", MaterialType::diffuse, glm::vec3(0.6f, 0.5f, 0.4f), 1.5f});
-  scene.materials.push_back({"paint", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f});
-  scene.materials.push_back({"chrome", MaterialType::mirror, glm::vec3(0.9f), 1.5f});
+  scene.materials.push_back({"ground", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}});
+  scene.materials.push_back(
+      {"crate", MaterialType::diffuse, glm::vec3(0.6f, 0.5f, 0.4f), 1.5f, {}});
+  scene.materials.push_back(
+      {"paint", MaterialType::diffuse, glm::vec3(0.2f, 0.4f, 0.7f), 1.5f, {}});
+  scene.materials.push_back({"chrome", MaterialType::mirror, glm::vec3(0.9f), 1.5f, {}});
   scene.objects = {
       test::plane("ground", glm::vec3(0.0f), 20.0f, 0, true),
       test::box("crate", {0.8f, 0.25f, -0.5f}, glm::vec3(0.5f), 1, true, {0.0f, 30.0f, 0.0f}),

@@ -74,7 +74,7 @@ renderer::Light point_light(glm::vec3 position, float power_W) {
 renderer::Scene edge_scene(float f_number, float focus_m, float depth_m, int width, int height) {
   using namespace renderer;
   Scene scene = empty_scene("edge_scene", f_number, focus_m, width, height);
-  scene.materials.push_back({"emitter", MaterialType::emission, glm::vec3(1.0f), 1.5f});
+  scene.materials.push_back({"emitter", MaterialType::emission, glm::vec3(1.0f), 1.5f, {}});
   // An XZ plane turned to face the camera, reaching from x = 0 far to the
   // right and far up and down, so that only its left edge is in view.
   const float extent = 1000.0f * depth_m;
@@ -163,11 +163,11 @@ renderer::Scene random_scene(std::uint32_t seed) {
   scene.render.pixel_filter_width_px = chance(0.5f) ? 1.0f : uniform(0.5f, 2.5f);
   scene.render.world_color = glm::vec3(uniform(0.0f, 0.3f));
   using renderer::MaterialType;
-  scene.materials = {{"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f},
-                     {"red", MaterialType::diffuse, glm::vec3(0.8f, 0.1f, 0.1f), 1.5f},
-                     {"mirror", MaterialType::mirror, glm::vec3(0.9f), 1.5f},
-                     {"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f},
-                     {"lamp", MaterialType::emission, glm::vec3(2.0f), 1.5f}};
+  scene.materials = {{"grey", MaterialType::diffuse, glm::vec3(0.5f), 1.5f, {}},
+                     {"red", MaterialType::diffuse, glm::vec3(0.8f, 0.1f, 0.1f), 1.5f, {}},
+                     {"mirror", MaterialType::mirror, glm::vec3(0.9f), 1.5f, {}},
+                     {"glass", MaterialType::glass, glm::vec3(1.0f), 1.5f, {}},
+                     {"lamp", MaterialType::emission, glm::vec3(2.0f), 1.5f, {}}};
   const auto material = [&] {
     const float u = uniform(0.0f, 1.0f);
     return u < 0.55f ? pick(2) : u < 0.75f ? 2 : u < 0.92f ? 3 : 4;
@@ -235,8 +235,8 @@ renderer::Scene random_scene(std::uint32_t seed) {
 renderer::Scene glass_ball_before_lamp(float f_number, float focus_m) {
   renderer::Scene scene = empty_scene("glass ball", f_number, focus_m, 32, 32);
   scene.render.max_bounces = 4;
-  scene.materials = {{"glass", renderer::MaterialType::glass, glm::vec3(1.0f), 1.5f},
-                     {"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f}};
+  scene.materials = {{"glass", renderer::MaterialType::glass, glm::vec3(1.0f), 1.5f, {}},
+                     {"lamp", renderer::MaterialType::emission, glm::vec3(1.0f), 1.5f, {}}};
   scene.objects = {
       sphere("ball", glm::vec3(0.0f, 0.0f, -4.0f), 0.3f, 0, false),
       box("lamp", glm::vec3(0.0f, 0.0f, -8.0f), glm::vec3(100.0f, 100.0f, 0.1f), 1, true)};

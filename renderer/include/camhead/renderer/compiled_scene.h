@@ -1,5 +1,6 @@
 // The scene flattened into the buffers that the tracers read (layout.h):
-// primitives in BVH order, BVH nodes, materials, lights and the plate.
+// primitives in BVH order, BVH nodes, materials, lights, textures and the
+// plate.
 #pragma once
 
 #include <cstdint>
@@ -40,6 +41,9 @@ struct CompiledScene {
   std::vector<gpu::BvhNode> nodes;        // nodes[0] is the root
   std::vector<gpu::Material> materials;
   std::vector<gpu::Light> lights;
+  // Textured triangles' texture coordinates, then the albedo textures with
+  // their mip levels (layout.h, BINDING_SURFACES); empty without textures.
+  std::vector<glm::uvec4> surfaces;
   std::vector<glm::vec4> plate; // width x height, rgb; empty when the scene has none
   int width = 0;
   int height = 0;
@@ -54,7 +58,8 @@ struct CompiledScene {
 };
 
 // Flattens the objects (planes and boxes into triangles, meshes transformed
-// into the world frame, spheres analytic) and builds the BVH.
+// into the world frame, spheres analytic), builds the BVH and the textures'
+// mip levels.
 [[nodiscard]] CompiledScene compile_scene(const Scene &scene);
 
 // Frame parameters from the scene's camera and settings; samples <= 0 takes

@@ -19,12 +19,14 @@ public:
 struct ImageSize {
   int width = 0;
   int height = 0;
+  bool or_smaller = false; // a limit on each side rather than the size itself
 };
 
 // EXR: RGB (or Y) channels as linear float. PNG: 8/16-bit sRGB decoded to
 // linear. Returns a 3-channel image. Throws ImageError naming the file.
-// With `expected`, an image of another size is refused from its header,
-// before anything is decoded: a small file can claim a vast image.
+// With `expected`, an image of another size (or, or_smaller, a larger one)
+// is refused from its header, before anything is decoded: a small file can
+// claim a vast image.
 // Files over 1 GiB are refused unread.
 [[nodiscard]] Image read_image(const std::filesystem::path &path,
                                std::optional<ImageSize> expected = std::nullopt);

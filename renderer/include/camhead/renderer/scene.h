@@ -38,12 +38,25 @@ struct CameraDesc {
 
 enum class MaterialType { diffuse, mirror, glass, emission };
 
+struct Texture {
+  std::shared_ptr<const Image> image; // none: no texture
+  std::filesystem::path file;         // where it was read from
+};
+
 struct Material {
   std::string name;
   MaterialType type = MaterialType::diffuse;
   // albedo (diffuse), tint (mirror), radiance (emission); unused for glass
   glm::vec3 color{0.5f};
   float ior = 1.5f; // glass only
+  // Diffuse only: an albedo image (linear, within [0, 1]) that `color`
+  // multiplies, spread once over each face of a plane or box: its top-left
+  // corner at a plane's own (-x, -z) corner, its top row along +x, seen from
+  // above (+y) before the plane's rotation; upright on a box's sides seen
+  // from outside, its top and bottom as a plane's (the bottom's seen from
+  // below). Spheres and meshes have no texture coordinates (the scene
+  // loader refuses a textured material on them).
+  Texture albedo_texture;
 };
 
 // Triangles in the mesh's own frame, before scale / rotation / translation.
