@@ -17,6 +17,7 @@ void add_devices_command(CLI::App &app);   // camhead devices
 void add_bench_command(CLI::App &app);     // camhead bench
 void add_calibrate_command(CLI::App &app); // camhead calibrate
 void add_lens_command(CLI::App &app);      // camhead lens monitor | record
+void add_markers_command(CLI::App &app);   // camhead markers draw
 void add_run_command(CLI::App &app);       // camhead run
 
 // A command-line path held to the rule every path camhead takes from a user

@@ -24,6 +24,7 @@ int main(int argc, char **argv) {
   camhead::cli::add_bench_command(app);
   camhead::cli::add_calibrate_command(app);
   camhead::cli::add_lens_command(app);
+  camhead::cli::add_markers_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &e) {

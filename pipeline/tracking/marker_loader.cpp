@@ -91,4 +91,12 @@ CameraCalibration calibrate_camera(const MarkerBoard &board, const std::vector<L
   return out;
 }
 
+BoardPage draw_board_page(const MarkerBoard &board, int pixels_per_square) {
+  std::string error;
+  BoardPage out;
+  if (!module().draw(board, pixels_per_square, out, error))
+    throw MarkerModuleError(board.file.string() + ": " + error);
+  return out;
+}
+
 } // namespace camhead::pipeline

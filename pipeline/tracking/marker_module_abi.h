@@ -12,7 +12,7 @@
 
 namespace camhead::pipeline::marker_module {
 
-inline constexpr int kAbiVersion = 3;
+inline constexpr int kAbiVersion = 4;
 inline constexpr const char *kFactorySymbol = "camhead_markers_module";
 
 class Module {
@@ -22,6 +22,9 @@ public:
   // calibrate_camera() (marker_tracker.h): false with `error` saying why.
   virtual bool calibrate(const MarkerBoard &board, const std::vector<LumaImage> &views,
                          CameraCalibration &out, std::string &error) = 0;
+  // draw_board_page() (marker_tracker.h): false with `error` saying why.
+  virtual bool draw(const MarkerBoard &board, int pixels_per_square, BoardPage &out,
+                    std::string &error) = 0;
 
 protected:
   ~Module() = default; // the module owns its one instance

@@ -88,6 +88,16 @@ struct CameraCalibration {
   std::vector<CalibrationView> views;
 };
 
+// A ChArUco board's printed page, as OpenCV 4.6 draws it (the layout its
+// detector expects, even row counts included: opencv_contrib issue 3291):
+// 8-bit grey, black 0 and white 255, row-major from the top; its top-left
+// corner is the board's origin and its edges are the board's outer edges
+// (marker_board.h), each square `pixels_per_square` pixels.
+struct BoardPage {
+  std::vector<std::uint8_t> grey;
+  int width = 0, height = 0;
+};
+
 // Opens the module (once per process) and makes a tracker for `board`.
 // Throws MarkerModuleError saying what is missing: the module, OpenCV's
 // packages, or a build for another camhead.
@@ -100,6 +110,11 @@ struct CameraCalibration {
 // is not ChArUco, or too few usable views (each view's reason given).
 [[nodiscard]] CameraCalibration calibrate_camera(const MarkerBoard &board,
                                                  const std::vector<LumaImage> &views);
+
+// Draws the page of the ChArUco board `board`. Throws MarkerModuleError:
+// the module missing, a marker field (its markers are printed one by one),
+// or a page too large (over 16384 pixels a side).
+[[nodiscard]] BoardPage draw_board_page(const MarkerBoard &board, int pixels_per_square);
 
 // "libcamhead_markers.so".
 [[nodiscard]] const char *marker_module_name();

@@ -453,6 +453,33 @@ private:
   }
 };
 
+// draw_board_page() (marker_tracker.h).
+bool draw_page(const MarkerBoard &board, int pixels_per_square, BoardPage &out,
+               std::string &error) {
+  constexpr long kLargestSide = 16384;
+  if (board.type != MarkerBoardType::charuco) {
+    error = "a marker field has no page: its markers are printed one by one";
+    return false;
+  }
+  const long width = long(board.squares_x) * pixels_per_square;
+  const long height = long(board.squares_y) * pixels_per_square;
+  if (pixels_per_square < 1 || width > kLargestSide || height > kLargestSide) {
+    error = std::to_string(pixels_per_square) + " pixels a square make a page of " +
+            std::to_string(width) + "x" + std::to_string(height) + "; at most " +
+            std::to_string(kLargestSide) + " a side, at least 1 a square";
+    return false;
+  }
+  const auto charuco = cv::aruco::CharucoBoard::create(
+      board.squares_x, board.squares_y, float(board.square_m), float(board.marker_m),
+      cv::aruco::getPredefinedDictionary(board.dictionary));
+  cv::Mat page;
+  charuco->draw(cv::Size(int(width), int(height)), page, 0, 1);
+  out.width = page.cols;
+  out.height = page.rows;
+  out.grey.assign(page.datastart, page.dataend);
+  return true;
+}
+
 class OpenCvModule final : public marker_module::Module {
 public:
   std::unique_ptr<MarkerTracker> open(const MarkerBoard &board, std::string &error) override {
@@ -468,6 +495,16 @@ public:
                  CameraCalibration &out, std::string &error) override {
     try {
       return Calibrator().run(board, views, out, error);
+    } catch (const std::exception &e) {
+      error = std::string("OpenCV: ") + e.what();
+      return false;
+    }
+  }
+
+  bool draw(const MarkerBoard &board, int pixels_per_square, BoardPage &out,
+            std::string &error) override {
+    try {
+      return draw_page(board, pixels_per_square, out, error);
     } catch (const std::exception &e) {
       error = std::string("OpenCV: ") + e.what();
       return false;
