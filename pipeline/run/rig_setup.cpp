@@ -143,11 +143,27 @@ std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Sce
 // every state of its looped trace, and meanwhile delivers fewer frames than
 // its rate, which the run counts as camera drops. And when the loop's
 // frames cannot all be kept, or never repeat, it says so and why.
+// With a camera path, its loop and the lens's repeat together only where
+// one is a whole number of the other.
 void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &format,
-                         const std::optional<TraceLens> &truth, const WorldPictures &cache) {
+                         const std::optional<TraceLens> &truth,
+                         const std::optional<PoseTrace> &path, const WorldPictures &cache) {
   if (!truth || !truth->loop_period_s())
     return;
-  const double period_s = *truth->loop_period_s();
+  double period_s = *truth->loop_period_s();
+  if (path) {
+    const double path_s = double(path->rows().back().t_ns - path->rows().front().t_ns) * 1e-9;
+    const double longer = std::max(period_s, path_s), shorter = std::min(period_s, path_s);
+    const double ratio = longer / shorter;
+    if (std::abs(ratio - std::round(ratio)) > 1e-6) {
+      std::fprintf(stderr,
+                   "camhead run: the simulated camera renders its world for every frame: its "
+                   "path's loop (%.3f s) and its lens's (%.3f s) do not repeat together\n",
+                   path_s, period_s);
+      return;
+    }
+    period_s = longer;
+  }
   const double frames = period_s * sim.fps;
   const long states = std::lround(frames);
   if (sim.cache_mb == 0 || states < 1)
@@ -164,10 +180,10 @@ void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &fo
   const long kept = long(std::min<std::size_t>(std::size_t(states), cache.holds(picture)));
   std::fprintf(stderr,
                "camhead run: the simulated camera renders its world anew for each of the %ld "
-               "lens states of its %.1f s loop, then replays them; until then, where a picture "
+               "%s of its %.1f s loop, then replays them; until then, where a picture "
                "takes longer than a frame to render, it delivers fewer than %g frames a second "
                "(counted as camera drops)\n",
-               states, period_s, sim.fps);
+               states, path ? "poses and lens states" : "lens states", period_s, sim.fps);
   if (kept < states)
     std::fprintf(stderr,
                  "camhead run: the simulated camera keeps %ld of them in camera.cache_mb = %u "
@@ -195,10 +211,10 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
   options.disconnect_silently = sim.disconnect_silently;
   const std::uint32_t samples = sim.samples;
   auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
-  explain_world_cache(sim, format, truth, *cache);
   std::optional<PoseTrace> path;
   if (sim.path)
     path = load_pose_trace(*sim.path);
+  explain_world_cache(sim, format, truth, path, *cache);
   auto generator = [world, cache, format, pose, rest = pose_of(pose), samples, &lens,
                     truth = std::move(truth),
                     path = std::move(path)](std::int64_t start_ns, std::int64_t exposure_ns,
