@@ -74,18 +74,6 @@ double degrees_between(const glm::dvec3 &a, const glm::dvec3 &b) {
          std::numbers::pi;
 }
 
-glm::dvec3 recorded(const std::string &line, const std::string &key) {
-  const std::size_t at = line.find("\"" + key + "\":[");
-  EXPECT_NE(at, std::string::npos) << key << " in " << line;
-  const char *p = line.c_str() + at + key.size() + 4;
-  char *end = nullptr;
-  glm::dvec3 v;
-  v.x = std::strtod(p, &end);
-  v.y = std::strtod(end + 1, &end);
-  v.z = std::strtod(end + 1, &end);
-  return v;
-}
-
 class RunMarkers : public RunLoop {
 protected:
   // The take, its lens and scene, and a board that finds its pose in it;
@@ -192,8 +180,8 @@ TEST_P(RunMarkersLens, EachFramesPoseIsFoundInThatFrame) {
       continue;
     EXPECT_NE(line.find("\"pose_source\":\"marker:floor\""), std::string::npos) << line;
     const int k = int(json_number(line, "sequence"));
-    const glm::dvec3 position = recorded(line, "position");
-    const glm::dvec3 forward = recorded(line, "forward");
+    const glm::dvec3 position = json_vec3(line, "position");
+    const glm::dvec3 forward = json_vec3(line, "forward");
     if (k < kBoardFrames) {
       const CameraPose truth = truth_at(k);
       const double mm = 1000.0 * glm::length(position - truth.position);
@@ -254,7 +242,7 @@ TEST_F(RunMarkers, ALockedOffCamerasPoseHoldsStillEnoughToAccumulate) {
     if (line.find("\"kind\":\"composite\"") != std::string::npos) {
       history.push_back(json_number(line, "history_samples"));
       worst_mm = std::max(worst_mm,
-                          1000.0 * glm::length(recorded(line, "position") - truth_at(0).position));
+                          1000.0 * glm::length(json_vec3(line, "position") - truth_at(0).position));
     }
   ASSERT_EQ(history.size(), std::size_t(kBoardFrames + kEmptyFrames));
   std::printf("locked off: history %g samples after %zu frames, worst %.3f mm\n", history.back(),

@@ -49,18 +49,6 @@ glm::dvec2 project(const glm::dvec3 &p, const glm::dvec3 &forward, const glm::dv
           kHeight / 2.0 - kFocalPx * glm::dot(d, u) / glm::dot(d, f)};
 }
 
-glm::dvec3 recorded(const std::string &line, const std::string &key) {
-  const std::size_t at = line.find("\"" + key + "\":[");
-  EXPECT_NE(at, std::string::npos) << key << " in " << line;
-  const char *p = line.c_str() + at + key.size() + 4;
-  char *end = nullptr;
-  glm::dvec3 v;
-  v.x = std::strtod(p, &end);
-  v.y = std::strtod(end + 1, &end);
-  v.z = std::strtod(end + 1, &end);
-  return v;
-}
-
 TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) {
   ASSERT_TRUE(kModuleFound);
   const fs::path markers = write("board.json", R"({"format": "camhead-markers", "version": 1,
@@ -130,8 +118,8 @@ TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) 
     EXPECT_GE(json_number(line, "markers_seen"), 4.0) << line;
     const CameraPose pose = truth.at(std::int64_t(json_number(line, "exposure_mid_ns")));
     const glm::dvec3 up = pose.orientation * glm::dvec3(0.0, 1.0, 0.0);
-    const glm::dvec3 at = recorded(line, "position"), forward = recorded(line, "forward"),
-                     seen_up = recorded(line, "up");
+    const glm::dvec3 at = json_vec3(line, "position"), forward = json_vec3(line, "forward"),
+                     seen_up = json_vec3(line, "up");
     double off = 0.0;
     for (const glm::dvec3 &p : points)
       off = std::max(off, glm::length(project(at, forward, seen_up, p) -

@@ -4,11 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "board.h"
 
@@ -119,6 +122,21 @@ inline double json_number(const std::string &line, const std::string &field) {
   // The record writes a focus at infinity as null (JSON has no infinity).
   const std::string value = line.substr(at + key.size());
   return value.rfind("null", 0) == 0 ? std::numeric_limits<double>::infinity() : std::stod(value);
+}
+
+// A record's three-number array `field` (the pose's position, forward, up).
+inline glm::dvec3 json_vec3(const std::string &line, const std::string &field) {
+  const std::size_t at = line.find("\"" + field + "\":[");
+  EXPECT_NE(at, std::string::npos) << field << " missing in " << line;
+  if (at == std::string::npos)
+    return glm::dvec3(0.0);
+  const char *p = line.c_str() + at + field.size() + 4;
+  char *end = nullptr;
+  glm::dvec3 v;
+  v.x = std::strtod(p, &end);
+  v.y = std::strtod(end + 1, &end);
+  v.z = std::strtod(end + 1, &end);
+  return v;
 }
 
 // The composites of a --record-stats file, with every field checked there;
