@@ -75,7 +75,8 @@ TEST(Board, AnUnknownNameListsTheBoardsThereAre) {
   } catch (const BoardError &e) {
     const std::string message = e.what();
     EXPECT_EQ(message.rfind("simm: (board name): no board of that name in ", 0), 0u) << message;
-    EXPECT_NE(message.find("(there: example-rig, sim, sim-devices, sim-moving)"), std::string::npos) << message;
+    EXPECT_NE(message.find("(there: example-rig, sim, sim-devices, sim-moving)"), std::string::npos)
+        << message;
   }
 }
 
