@@ -74,6 +74,21 @@ constexpr const char *kFacingPlane =
 constexpr const char *kBox =
     R"({"type": "box", "center": [0, 0, -2.5], "size": [1, 1, 1], "material": "page",
         "real": true})";
+// The same box turned so that each other face looks at the camera: its own
+// -x side, its back, its +x side, its top and its bottom. Each is upright
+// seen from outside (a side), or as a plane turned up to face the camera
+// (the top; the bottom seen from below).
+constexpr const char *kTurnedBoxes[] = {
+    R"({"type": "box", "center": [0, 0, -2.5], "size": [1, 1, 1], "rotation_deg": [0, 90, 0],
+        "material": "page", "real": true})",
+    R"({"type": "box", "center": [0, 0, -2.5], "size": [1, 1, 1], "rotation_deg": [0, 180, 0],
+        "material": "page", "real": true})",
+    R"({"type": "box", "center": [0, 0, -2.5], "size": [1, 1, 1], "rotation_deg": [0, -90, 0],
+        "material": "page", "real": true})",
+    R"({"type": "box", "center": [0, 0, -2.5], "size": [1, 1, 1], "rotation_deg": [90, 0, 0],
+        "material": "page", "real": true})",
+    R"({"type": "box", "center": [0, 0, -2.5], "size": [1, 1, 1], "rotation_deg": [-90, 0, 0],
+        "material": "page", "real": true})"};
 
 std::vector<RenderResult> render_both(const Scene &scene, int rpp) {
   std::vector<RenderResult> results{test::render_cpu(scene, rpp)};
@@ -133,8 +148,42 @@ TEST_P(Texture, IsTintedByTheAlbedo) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Shapes, Texture, ::testing::Values(kFacingPlane, kBox),
-                         [](const auto &shape) { return shape.index == 0 ? "Plane" : "Box"; });
+std::string shape_name(const ::testing::TestParamInfo<const char *> &shape) {
+  constexpr const char *kNames[] = {"Plane",        "BoxFront", "BoxLeftSide", "BoxBack",
+                                    "BoxRightSide", "BoxTop",   "BoxBottom"};
+  return kNames[shape.index];
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, Texture,
+                         ::testing::Values(kFacingPlane, kBox, kTurnedBoxes[0], kTurnedBoxes[1],
+                                           kTurnedBoxes[2], kTurnedBoxes[3], kTurnedBoxes[4]),
+                         shape_name);
+
+// Materials that name one file share one image, and the compiled scene
+// holds its texels once.
+TEST(TextureSharing, AFileNamedTwiceIsReadAndStoredOnce) {
+  test::ScratchDir dir;
+  renderer::write_image(dir.path() / "page.png", quarters(64));
+  const std::string json = R"({
+    "render": {"width": 8, "height": 8, "samples": 1},
+    "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0],
+               "focal_length_mm": 36, "sensor_width_mm": 36},
+    "materials": {"one": {"type": "diffuse", "albedo_texture": "page.png"},
+                  "other": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5],
+                            "albedo_texture": "./page.png"}},
+    "objects": [
+      {"type": "plane", "center": [0, 0, -2], "size": [1, 1], "material": "one"},
+      {"type": "plane", "center": [0, 0, -3], "size": [1, 1], "material": "other"}]})";
+  const Scene scene = renderer::parse_scene(json, dir.path() / "scene.json");
+  ASSERT_EQ(scene.materials.size(), 2u);
+  EXPECT_EQ(scene.materials[0].albedo_texture.image, scene.materials[1].albedo_texture.image);
+  const renderer::CompiledScene both = renderer::compile_scene(scene);
+  Scene one = scene;
+  one.objects.pop_back();
+  one.materials.pop_back();
+  // Two planes' uv records (2 triangles, 2 texels each) more, the texture not again.
+  EXPECT_EQ(both.surfaces.size(), renderer::compile_scene(one).surfaces.size() + 4u);
+}
 
 // A checker of 1-texel squares, 8 texels to a pixel, seen with one ray per
 // pixel: sampled at points it would be a random black or white pixel each;
