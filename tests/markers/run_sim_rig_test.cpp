@@ -38,17 +38,6 @@ const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_TEST_MARKERS_
 constexpr int kWidth = 640, kHeight = 360;
 constexpr double kFocalPx = 35.0 / 36.0 * kWidth;
 
-// Where a camera at position p looking along `forward` with `up` puts a
-// world point, pixels (centres at +0.5).
-glm::dvec2 project(const glm::dvec3 &p, const glm::dvec3 &forward, const glm::dvec3 &up,
-                   const glm::dvec3 &point) {
-  const glm::dvec3 f = glm::normalize(forward), r = glm::normalize(glm::cross(f, up)),
-                   u = glm::cross(r, f);
-  const glm::dvec3 d = point - p;
-  return {kWidth / 2.0 + kFocalPx * glm::dot(d, r) / glm::dot(d, f),
-          kHeight / 2.0 - kFocalPx * glm::dot(d, u) / glm::dot(d, f)};
-}
-
 TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) {
   ASSERT_TRUE(kModuleFound);
   const fs::path markers = write("board.json", R"({"format": "camhead-markers", "version": 1,
@@ -116,14 +105,12 @@ TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) 
         line.find("\"pose_fresh\":true") == std::string::npos)
       continue;
     EXPECT_GE(json_number(line, "markers_seen"), 4.0) << line;
-    const CameraPose pose = truth.at(std::int64_t(json_number(line, "exposure_mid_ns")));
-    const glm::dvec3 up = pose.orientation * glm::dvec3(0.0, 1.0, 0.0);
-    const glm::dvec3 at = json_vec3(line, "position"), forward = json_vec3(line, "forward"),
-                     seen_up = json_vec3(line, "up");
+    const CameraPose truth_pose = truth.at(std::int64_t(json_number(line, "exposure_mid_ns")));
+    const CameraPose seen = json_pose(line);
     double off = 0.0;
     for (const glm::dvec3 &p : points)
-      off = std::max(off, glm::length(project(at, forward, seen_up, p) -
-                                      project(pose.position, pose.forward(), up, p)));
+      off = std::max(off, glm::length(pinhole_pixel(seen, p, kWidth, kHeight, kFocalPx) -
+                                      pinhole_pixel(truth_pose, p, kWidth, kHeight, kFocalPx)));
     EXPECT_LT(off, 1.0) << "output frame " << json_number(line, "output_frame") << ": " << line;
     worst = std::max(worst, off);
     ++found;

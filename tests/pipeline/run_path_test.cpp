@@ -33,8 +33,7 @@ const glm::dvec3 kSquare(-0.3, 1.0, -3.0), kBall(0.3, 1.0, -3.0);
 
 // Where a camera at `pose` puts a world point, pixels (centres at +0.5).
 glm::dvec2 project(const CameraPose &pose, const glm::dvec3 &point) {
-  const glm::dvec3 p = glm::inverse(pose.orientation) * (point - pose.position);
-  return {kWidth / 2.0 + kFocalPx * p.x / -p.z, kHeight / 2.0 - kFocalPx * p.y / -p.z};
+  return pinhole_pixel(pose, point, kWidth, kHeight, kFocalPx);
 }
 
 TEST_F(RunLoop, AVirtualObjectStaysWhereTheMovingCameraSeesItsRealNeighbour) {

@@ -11,9 +11,14 @@
 #include <string>
 #include <vector>
 
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "board.h"
+#include "tracking/camera_pose.h"
 
 #include <gtest/gtest.h>
 
@@ -137,6 +142,22 @@ inline glm::dvec3 json_vec3(const std::string &line, const std::string &field) {
   v.y = std::strtod(end + 1, &end);
   v.z = std::strtod(end + 1, &end);
   return v;
+}
+
+// A record's camera pose ("pose": position, forward, up).
+inline CameraPose json_pose(const std::string &line) {
+  const glm::dvec3 forward = glm::normalize(json_vec3(line, "forward"));
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, json_vec3(line, "up")));
+  const glm::dmat3 axes(right, glm::cross(right, forward), -forward); // right, up, back
+  return {json_vec3(line, "position"), glm::normalize(glm::quat_cast(axes))};
+}
+
+// Where a centred pinhole of `focal_px` at `pose` puts a world point in a
+// width x height picture, pixels (centres at +0.5).
+inline glm::dvec2 pinhole_pixel(const CameraPose &pose, const glm::dvec3 &point, int width,
+                                int height, double focal_px) {
+  const glm::dvec3 p = glm::inverse(pose.orientation) * (point - pose.position);
+  return {width / 2.0 + focal_px * p.x / -p.z, height / 2.0 - focal_px * p.y / -p.z};
 }
 
 // The composites of a --record-stats file, with every field checked there;

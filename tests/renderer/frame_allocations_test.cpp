@@ -133,18 +133,22 @@ TEST_P(FrameAllocations, AHeldShotAllocatesNothingFrameAfterFrame) {
   EXPECT_EQ(live.allocations_in([&] { live.frames(20); }), 0u);
 }
 
+// Frame k of a focus pull with a pan from `rest`: every frame beyond the
+// tolerance, a new history and region each time.
+auto pull_and_pan(LiveFrames &live, const FrameCamera &rest) {
+  return [&live, rest](int k) {
+    live.request.camera.focus_distance_m = 1.0f + 0.05f * float(k % 20);
+    live.request.camera.look_at = rest.look_at + glm::vec3(0.01f * float(k % 7), 0.0f, 0.0f);
+  };
+}
+
 TEST_P(FrameAllocations, AFocusPullWithAPanAllocatesNothingFrameAfterFrame) {
   LiveFrames live(GetParam());
   if (!live.available())
     GTEST_SKIP() << "no Vulkan device";
   const FrameCamera rest = live.request.camera;
-  const auto pull = [&](int k) {
-    // Every frame beyond the tolerance: a new history and region each time.
-    live.request.camera.focus_distance_m = 1.0f + 0.05f * float(k % 20);
-    live.request.camera.look_at = rest.look_at + glm::vec3(0.01f * float(k % 7), 0.0f, 0.0f);
-  };
   live.prepare();
-  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull); }), 0u);
+  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull_and_pan(live, rest)); }), 0u);
 
   // The count works: a camera gone far beyond the scene's objects from its
   // origin builds the region's world-space part again (influence_region.h).
@@ -181,12 +185,8 @@ TEST_P(FrameAllocations, APullThroughALensModelAllocatesNothingFrameAfterFrame) 
   live.request.camera.lens_model.k2 = 0.05f;
   live.request.camera.lens_model.principal_point = {0.52f, 0.47f};
   const FrameCamera rest = live.request.camera;
-  const auto pull = [&](int k) {
-    live.request.camera.focus_distance_m = 1.0f + 0.05f * float(k % 20);
-    live.request.camera.look_at = rest.look_at + glm::vec3(0.01f * float(k % 7), 0.0f, 0.0f);
-  };
   live.prepare();
-  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull); }), 0u);
+  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull_and_pan(live, rest)); }), 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Executors, FrameAllocations,
