@@ -16,8 +16,9 @@
 
 // One primitive, 48 bytes. Triangles store an edge form for Moeller-Trumbore.
 //   triangle: p0.xyz = v0, p1.xyz = v1 - v0, p2.xyz = v2 - v0,
-//             p1.w = uint bits of its texture coordinates' record + 1
-//             (BINDING_SURFACES, SURFACE_UV_TEXELS each; 0 = none)
+//             p1.w = uint bits of the index of its texture coordinates'
+//             record + 1 (BINDING_SURFACES, SURFACE_UV_TEXELS texels each;
+//             0 = none)
 //   sphere:   p0.xyz = centre, p1.x = radius
 //   p0.w = floatBitsFromUint(material | real << 16 | kind << 24)
 struct Primitive {

@@ -85,8 +85,8 @@ void add_triangle(std::vector<gpu::Primitive> &out, const glm::vec3 &a, const gl
 // (layout.h, BINDING_SURFACES); null for an untextured one.
 using UvRecords = std::vector<glm::uvec4>;
 
-// The triangle just added (if it was) gets texture coordinates uv[0..2] at
-// its vertices a, b, c.
+// The triangle just added, if `out` grew past `before` (a degenerate one is
+// dropped), gets the texture coordinates uv[0..2] at its three vertices.
 void add_uv_record(std::vector<gpu::Primitive> &out, std::size_t before, UvRecords *records,
                    const std::array<glm::vec2, 3> &uv) {
   if (!records || out.size() == before)
@@ -217,8 +217,10 @@ TextureLevel level_zero(const Image &image) {
   return level;
 }
 
-// The next level: each pixel the mean of the 2 x 2 below it (of the 1 or 2
-// there are at an odd or single-pixel edge).
+// The next level, half the size rounded down (at least 1): each pixel the
+// mean of the 2 x 2 below it (of the 2 along a side 1 pixel long). An odd
+// side's last row or column is left out, as GPUs' own mip levels do: it
+// shifts that level's picture by at most half a texel.
 TextureLevel half_level(const TextureLevel &src) {
   TextureLevel out{std::max(src.width / 2, 1), std::max(src.height / 2, 1), {}};
   out.rgb.resize(std::size_t(out.width) * std::size_t(out.height));
