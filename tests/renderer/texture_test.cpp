@@ -3,6 +3,7 @@
 // finer than the pixels is seen as its mean (no aliasing), and that a wrong
 // texture is refused with the file and field named.
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -208,6 +209,46 @@ TEST(TextureFiltering, APatternFinerThanThePixelsIsSeenAsItsMean) {
     const double sd = std::sqrt(std::max(0.0, squares / n - mean * mean));
     EXPECT_NEAR(mean, 0.5, 0.01);
     EXPECT_LT(sd, 0.02) << "the checker aliases";
+  }
+}
+
+// Texture coordinates far outside the page, or not numbers at all, read its
+// edge (texture.glsl clamps before converting to an integer, which would
+// otherwise be undefined: the sanitizer build, with float-cast-overflow,
+// holds that). Every textured
+// triangle's coordinates are overwritten here: huge u and hugely negative v
+// read the top-right quarter, NaN the top-left one.
+TEST(TextureFiltering, CoordinatesFarOutsideThePageReadItsEdge) {
+  test::ScratchDir dir;
+  renderer::write_image(dir.path() / "page.png", quarters(64));
+  const Scene scene = renderer::parse_scene(
+      scene_json(kFacingPlane, R"({"type": "diffuse", "albedo_texture": "page.png"})"),
+      dir.path() / "scene.json");
+  struct Case {
+    float u, v;
+    glm::vec3 colour;
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (const Case &c : {Case{1e30f, -1e30f, {0, 1, 0}}, Case{nan, nan, {1, 0, 0}}}) {
+    renderer::CompiledScene compiled = renderer::compile_scene(scene);
+    const auto word = [](float f) { return glm::floatBitsToUint(f); };
+    for (std::size_t r = 0; r < 4; r += SURFACE_UV_TEXELS) { // the plane's two triangles
+      compiled.surfaces[r] = glm::uvec4(word(c.u), word(c.v), word(c.u), word(c.v));
+      compiled.surfaces[r + 1].x = word(c.u);
+      compiled.surfaces[r + 1].y = word(c.v);
+    }
+    const renderer::gpu::FrameParams frame = renderer::make_frame_params(scene, 1);
+    std::vector<RenderResult> results{renderer::render_cpu(compiled, frame)};
+    if (test::have_vulkan()) {
+      renderer::GpuTracer tracer;
+      tracer.load(compiled);
+      results.push_back(tracer.render(frame));
+    }
+    for (const RenderResult &r : results) {
+      const glm::vec3 seen = pixel(r.composite, 32, 32);
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(seen[k], c.colour[k], 2e-3) << "u " << c.u << " channel " << k;
+    }
   }
 }
 
