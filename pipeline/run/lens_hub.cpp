@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 
+#include "camhead/base/monotonic_clock.h"
 #include "camhead/base/thread_name.h"
 
 namespace camhead::pipeline {
@@ -65,6 +66,17 @@ LensSnapshot LensHub::state_at(std::int64_t t_ns) const {
   const auto delay_ns = std::llround(lens.config().delay_ms * 1e6);
   snapshot.awaited = (snapshot.connected || !polled_) && (!last || last->t_ns - delay_ns < t_ns);
   return snapshot;
+}
+
+LensSnapshot LensHub::state_when_covered(std::int64_t t_ns, std::int64_t give_up_ns,
+                                         const std::atomic<bool> *stop) const {
+  LensSnapshot lens = state_at(t_ns);
+  while (!lens.fresh && lens.awaited && !(stop != nullptr && *stop) &&
+         base::monotonic_ns() < give_up_ns) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    lens = state_at(t_ns);
+  }
+  return lens;
 }
 
 PoseSnapshot LensHub::pose_at(std::int64_t t_ns, const CameraPose &rest) const {

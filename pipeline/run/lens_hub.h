@@ -52,6 +52,17 @@ public:
   // The lens at CLOCK_MONOTONIC instant t_ns: a lost source holds its last
   // state, flagged not fresh.
   [[nodiscard]] LensSnapshot state_at(std::int64_t t_ns) const;
+  // The same once the readings that cover t_ns have come. A source hands
+  // its readings over a little after they happen (its own delay, the lens
+  // thread's poll), and a run's first frame can come before the first of
+  // them: then the state is the profile's rest state or an extrapolation,
+  // a lens the rig never had. Waits (polling each millisecond) while they
+  // can still come (LensSnapshot::awaited: not for a lost source, nor for
+  // an instant before its history or inside a dropout, which no wait
+  // mends), until CLOCK_MONOTONIC `give_up_ns` or `*stop`. The renderer and
+  // the marker tracker both see a frame through its lens this way.
+  [[nodiscard]] LensSnapshot state_when_covered(std::int64_t t_ns, std::int64_t give_up_ns,
+                                                const std::atomic<bool> *stop = nullptr) const;
   // Whether the board's pose comes from a tracker.
   [[nodiscard]] bool tracks_pose() const { return pose_channel_.has_value(); }
   // The tracker's pose at CLOCK_MONOTONIC instant t_ns; `rest` (not fresh)

@@ -367,11 +367,12 @@ std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int 
 std::unique_ptr<MarkerPoseSource> open_marker_source(const Board &board,
                                                      const base::VideoFormat &format,
                                                      const renderer::FrameCamera &base,
-                                                     const LensHub &lens, bool every_frame) {
+                                                     const LensHub &lens, bool every_frame,
+                                                     std::int64_t lens_wait_ns) {
   if (!board.pose || board.pose->type != PoseType::marker)
     return nullptr;
   return std::make_unique<MarkerPoseSource>(load_marker_board(board.pose->file), format, base, lens,
-                                            every_frame);
+                                            every_frame, lens_wait_ns);
 }
 
 double camera_fps(const CameraSource &camera) {

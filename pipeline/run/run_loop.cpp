@@ -66,6 +66,9 @@ constexpr int kSlots = 3; // frames between render and output
 // interval (the latency it adds), a take composited offline (nothing live
 // waits on it) at most this long.
 constexpr std::int64_t kOfflineLensWaitNs = 1'000'000'000;
+std::int64_t lens_wait_ns(bool lossless, double fps) {
+  return lossless ? kOfflineLensWaitNs : std::llround(0.5e9 / fps);
+}
 
 class Pipeline {
 public:
@@ -171,8 +174,9 @@ Pipeline::Pipeline(const RunOptions &options)
     : options_(options), board_(checked_board(options)), scene_(load_run_scene(board_)),
       base_camera_(base_camera(board_, scene_)), rest_pose_(pose_of(base_camera_)), lens_(board_),
       camera_(open_camera(board_, scene_, base_camera_, lens_, options.threads)),
-      markers_(
-          open_marker_source(board_, camera_->format(), base_camera_, lens_, offline_take(board_))),
+      markers_(open_marker_source(board_, camera_->format(), base_camera_, lens_,
+                                  offline_take(board_),
+                                  lens_wait_ns(offline_take(board_), camera_fps(*camera_)))),
       pose_trace_(board_.pose && board_.pose->type == PoseType::trace
                       ? std::optional<PoseTrace>(load_pose_trace(board_.pose->file))
                       : std::nullopt),
@@ -385,24 +389,12 @@ void Pipeline::render_loop() {
 }
 
 LensSnapshot Pipeline::lens_at(std::int64_t mid_exposure_ns, FrameRecord &record) {
-  LensSnapshot lens = lens_.state_at(mid_exposure_ns);
-  // A source hands its readings over a little after they happen (its own
-  // delay, the lens thread's poll), and a run's first frame can come before
-  // the first of them: then the state is the profile's rest state or an
-  // extrapolation, a lens the rig never had. Such a frame waits for the
-  // readings that would cover it, while they can still come (`awaited`):
-  // not for a source that is lost, nor for an instant before its history
-  // or inside a dropout, which no wait mends.
-  const std::int64_t start = base::monotonic_ns();
-  const std::int64_t give_up =
-      start + (lossless_ ? kOfflineLensWaitNs : std::llround(0.5e9 / fps_));
+  // A frame waits for the readings that cover it (LensHub::state_when_covered).
   // A stop asked for by the user ends the wait; a take played to its end
   // does not (its last frames still get their lens).
-  const auto asked_to_stop = [this] { return options_.stop != nullptr && *options_.stop; };
-  while (!lens.fresh && lens.awaited && !asked_to_stop() && base::monotonic_ns() < give_up) {
-    std::this_thread::sleep_for(1ms);
-    lens = lens_.state_at(mid_exposure_ns);
-  }
+  const std::int64_t start = base::monotonic_ns();
+  const LensSnapshot lens = lens_.state_when_covered(
+      mid_exposure_ns, start + lens_wait_ns(lossless_, fps_), options_.stop);
   record.lens_wait_s = double(base::monotonic_ns() - start) * 1e-9;
   if (!lens.fresh)
     ++counters_.lens_late;
@@ -422,8 +414,7 @@ PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
     return {pose_trace_->at(record.exposure_mid_ns), true};
   if (!markers_)
     return lens_.pose_at(record.exposure_mid_ns, rest_pose_);
-  const std::int64_t deadline =
-      record.delivered_ns + (lossless_ ? kOfflineLensWaitNs : std::llround(0.5e9 / fps_));
+  const std::int64_t deadline = record.delivered_ns + lens_wait_ns(lossless_, fps_);
   const FramePose found =
       markers_->pose_for(sequence, record.exposure_mid_ns, deadline, rest_pose_);
   record.markers_seen = found.markers_seen;

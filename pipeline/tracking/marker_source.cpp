@@ -36,10 +36,11 @@ std::vector<glm::dvec3> extent_of(const MarkerBoard &board) {
 
 MarkerPoseSource::MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
                                    const renderer::FrameCamera &base, const LensHub &lens,
-                                   bool every_frame)
+                                   bool every_frame, std::int64_t lens_wait_ns)
     : tracker_(open_marker_tracker(board)), format_(format), sensor_width_mm_(base.sensor_width_mm),
-      lens_(lens), every_frame_(every_frame), name_("marker:" + board.name), slots_(kSlots),
-      results_(kResults), board_extent_(extent_of(board)) {
+      lens_(lens), every_frame_(every_frame), lens_wait_ns_(lens_wait_ns),
+      name_("marker:" + board.name), slots_(kSlots), results_(kResults),
+      board_extent_(extent_of(board)) {
   for (Slot &slot : slots_)
     slot.luma.resize(std::size_t(format.width) * std::size_t(format.height));
 }
@@ -91,6 +92,7 @@ void MarkerPoseSource::submit(const hal::camera::CapturedFrame &frame) {
     const std::lock_guard lock(mutex_);
     slot->sequence = frame.sequence;
     slot->mid_ns = hal::camera::mid_exposure_ns(frame);
+    slot->submitted_ns = base::monotonic_ns();
     slot->state = SlotState::waiting;
   }
   work_.notify_one();
@@ -143,7 +145,9 @@ void MarkerPoseSource::track_loop() {
     // The markers see from the entrance pupil; the renderer's camera, the
     // still filter and the history of poses are the lens's reference plane,
     // which stays put while focusing moves the pupil.
-    const lens_control::LensState lens = lens_.state_at(slot->mid_ns).state;
+    const lens_control::LensState lens =
+        lens_.state_when_covered(slot->mid_ns, slot->submitted_ns + lens_wait_ns_ / 2, &stop_)
+            .state;
     const double pupil_m = lens.entrance_pupil_offset_mm.value / 1000.0;
     if (previous)
       previous->position += previous->forward() * pupil_m;

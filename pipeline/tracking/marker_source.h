@@ -28,6 +28,7 @@
 // allocates as it detects: it holds no frame and no output waits on it.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <limits>
@@ -68,9 +69,17 @@ public:
   // projects onto (its width in millimetres). `every_frame`: a take
   // composited offline, where every frame is rendered: each is tracked, in
   // order, and submit() waits for a free slot; live, a tracker that falls
-  // behind tracks the newest frame and leaves the ones before it.
+  // behind tracks the newest frame and leaves the ones before it. Each
+  // frame is tracked through the lens of its mid-exposure, waited for as
+  // the renderer waits (LensHub::state_when_covered): a frame tracked
+  // through a lens the rig did not have (the profile's rest state, before
+  // the first readings) is a pose off by the lens's breathing and pupil
+  // shift. `lens_wait_ns`: how long the render thread waits for the lens
+  // and for the pose after a frame is handed over; the tracker waits for
+  // the lens half of it at most, leaving the rest for the tracking.
   MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
-                   const renderer::FrameCamera &base, const LensHub &lens, bool every_frame);
+                   const renderer::FrameCamera &base, const LensHub &lens, bool every_frame,
+                   std::int64_t lens_wait_ns);
   ~MarkerPoseSource();
   MarkerPoseSource(const MarkerPoseSource &) = delete;
   MarkerPoseSource &operator=(const MarkerPoseSource &) = delete;
@@ -94,6 +103,7 @@ private:
     SlotState state = SlotState::free;
     std::uint64_t sequence = 0;
     std::int64_t mid_ns = 0;
+    std::int64_t submitted_ns = 0; // CLOCK_MONOTONIC, when the frame was handed over
     std::vector<std::uint8_t> luma;
   };
   struct Result {
@@ -113,6 +123,7 @@ private:
   const double sensor_width_mm_;
   const LensHub &lens_;
   const bool every_frame_;
+  const std::int64_t lens_wait_ns_;
   std::string name_;
 
   std::mutex mutex_;
@@ -123,7 +134,7 @@ private:
   PoseTimeline found_; // the poses found: the tracker's guide, and frames without one
   StillPoseFilter still_;
   std::vector<glm::dvec3> board_extent_; // for the still filter
-  bool stop_ = false;
+  std::atomic<bool> stop_{false};        // set under mutex_; read unlocked by the lens wait
   std::thread thread_;
 };
 

@@ -14,16 +14,21 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <glm/geometric.hpp>
 #include <pthread.h>
 
+#include "camhead/base/monotonic_clock.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "counting_new.h"
+#include "run/lens_hub.h"
+#include "run/rig_setup.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
 #include "synthetic_view.h"
+#include "tracking/marker_source.h"
 #include "tracking/still_pose.h"
 
 #include <gtest/gtest.h>
@@ -190,7 +195,7 @@ TEST_P(RunMarkersLens, EachFramesPoseIsFoundInThatFrame) {
       worst_deg = std::max(worst_deg, deg);
       EXPECT_NE(line.find("\"pose_fresh\":true"), std::string::npos) << "frame " << k;
       EXPECT_GT(json_number(line, "markers_seen"), 15.0) << "frame " << k;
-      EXPECT_LT(mm, 2.0) << "frame " << k;
+      EXPECT_LT(mm, 2.0) << "frame " << k << ": " << line;
       EXPECT_LT(deg, 0.1) << "frame " << k;
       ++checked;
     } else {
@@ -226,6 +231,39 @@ INSTANTIATE_TEST_SUITE_P(Lenses, RunMarkersLens, testing::Bool(),
 // with the sensor's noise by more than the renderer's history allows a
 // still view to move; held while still (still_pose.h), it lets the
 // picture's history grow frame after frame as it does on a static pose.
+// The tracker sees a frame through the lens of its mid-exposure, as the
+// renderer does: a frame that reaches it before the lens readings covering
+// that instant have come waits for them (LensHub::state_when_covered). Solved
+// through the profile's rest state (10 m: another projection focal length
+// and pupil) this frame's pose was 30 mm off; under load that happened to
+// the first frame of a run (seen once in about ten full test runs).
+TEST_F(RunMarkers, AFrameReadyBeforeItsLensReadingsWaitsForThem) {
+  const Board board = take_board(false, false, true);
+  const std::string take = y4m_frames(dir_ / "take.y4m", std::size_t(kWidth) * kHeight * 2)[0];
+  std::vector<std::uint8_t> nv12(std::size_t(kWidth) * kHeight * 3 / 2, 128);
+  std::copy(take.begin(), take.begin() + std::ptrdiff_t(kWidth) * kHeight, nv12.begin());
+  const base::VideoFormat format{base::PixelFormat::nv12, kWidth, kHeight};
+
+  LensHub lens(board); // not started: no reading yet
+  const renderer::Scene scene = load_run_scene(board);
+  const std::unique_ptr<MarkerPoseSource> markers =
+      open_marker_source(board, format, base_camera(board, scene), lens, true, 5'000'000'000);
+  markers->start();
+  hal::camera::CapturedFrame frame;
+  frame.format = format;
+  frame.bytes = nv12;
+  // A frame whose exposure the lens readings will cover 0.4 s after they
+  // start.
+  frame.timestamp_ns = base::monotonic_ns() + 600'000'000;
+  markers->submit(frame);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200)); // the tracker has the frame
+  lens.start();
+  const FramePose found =
+      markers->pose_for(0, frame.timestamp_ns, base::monotonic_ns() + 5'000'000'000, CameraPose{});
+  ASSERT_TRUE(found.fresh);
+  EXPECT_LT(1000.0 * glm::length(found.pose.position - truth_at(0).position), 2.0);
+}
+
 TEST_F(RunMarkers, ALockedOffCamerasPoseHoldsStillEnoughToAccumulate) {
   RunOptions options;
   options.board = take_board(false, true);
