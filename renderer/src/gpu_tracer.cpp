@@ -475,8 +475,11 @@ int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t first,
   // next one rewrites it.
   int submissions = 0;
   std::uint32_t done = first;
+  const std::uint32_t most = device.quirks().max_samples_per_dispatch;
   do {
-    const std::uint32_t batch = std::min(sizer.next(), end - done);
+    std::uint32_t batch = std::min(sizer.next(), end - done);
+    if (most > 0)
+      batch = std::min(batch, most);
     frame.sampling.x = done;
     frame.sampling.y = done + batch;
     std::memcpy(frame_uniform.mapped(), &frame, sizeof frame);

@@ -37,7 +37,8 @@ inline double seconds_since(GpuClock::time_point start) {
 // display-driver watchdogs (about 2 s) and report progress often, while the
 // per-submission overhead stays negligible. A sizer lives as long as the
 // loaded scene, so that a live frame of a few samples, once one frame has
-// been measured, is one submission.
+// been measured, is one submission (on lavapipe, of at most 16 samples a
+// pixel: DriverQuirks::max_samples_per_dispatch).
 class BatchSizer {
 public:
   static constexpr double kTargetSeconds = 0.25;
@@ -93,7 +94,8 @@ struct GpuTracer::Impl {
   // Records commands into a command buffer.
   using Recorder = FunctionRef<void(VkCommandBuffer)>;
   // Adds samples [first, end) of `frame` to the accumulators in batches
-  // sized by `sizer`, one submission each, each batch recorded by `trace`
+  // sized by `sizer` (and no larger than the device's
+  // DriverQuirks::max_samples_per_dispatch), one submission each, each batch recorded by `trace`
   // once frame.sampling holds its samples; `prologue` records commands into
   // the first submission, before its batch, and `epilogue` into the last,
   // after it (both submitted also when there are none). `report` gets the

@@ -54,8 +54,9 @@ DriverQuirks detect_quirks(const VkPhysicalDeviceProperties &properties) {
   // Mesa lavapipe ("llvmpipe (LLVM ...)") and SwiftShader run the kernels on
   // the host CPU and say so through the device type.
   quirks.software_device = properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  quirks.indirect_dispatch_keeps_base =
-      std::string_view(properties.deviceName).starts_with("llvmpipe");
+  const bool llvmpipe = std::string_view(properties.deviceName).starts_with("llvmpipe");
+  quirks.indirect_dispatch_keeps_base = llvmpipe;
+  quirks.max_samples_per_dispatch = llvmpipe ? 16u : 0u;
   return quirks;
 }
 

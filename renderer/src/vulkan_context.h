@@ -93,6 +93,15 @@ struct DriverQuirks {
   // An empty vkCmdDispatchBase at base 0 before it resets that
   // (vk::dispatch_indirect).
   bool indirect_dispatch_keeps_base = false;
+  // The most samples per pixel one dispatch of the trace kernel may take, 0
+  // for no bound. Mesa's llvmpipe (gallivm, lp_bld_limits.h) stops every
+  // loop of a shader invocation, silently, once all its loops together have
+  // run LP_MAX_TGSI_LOOP_ITERATIONS (65535) times: the rest of a pixel's
+  // samples are never traced. The demo's paths take 100-350 iterations of
+  // the kernel's loops a sample (its adaptive shares lost samples from about
+  // 200 on: bench/RESULTS.md, "lavapipe stops a long shader"); 16 samples
+  // leave room for paths twelve times as long.
+  std::uint32_t max_samples_per_dispatch = 0;
 };
 
 struct PhysicalDevice {

@@ -274,6 +274,40 @@ TEST(AdaptiveSecondPass, TracesEachPixelsShareExactlyOnce) {
     }
 }
 
+// A device may stop a shader invocation's loops after so many iterations
+// (lavapipe: 65535 of all its loops together, vulkan_context.h,
+// max_samples_per_dispatch), silently leaving the rest of its samples
+// untraced. On a frame this small the batch sizer soon gives one dispatch
+// thousands of samples a pixel, uniform or in the adaptive second pass
+// (whose shares here reach thousands); every camera ray meets the wall, so
+// the mask of a pixel is 1 (to rounding) when every one of its samples was
+// traced.
+// Without the bound, lavapipe left every pixel short uniform and 23 of 64
+// adaptive (the largest share 6445).
+TEST(GpuBatches, EverySampleOfALongBatchIsTraced) {
+  CAMHEAD_REQUIRE_VULKAN();
+  renderer::Scene scene = virtual_wall_in_soft_shadow();
+  scene.render.width = 8;
+  scene.render.height = 8;
+  const renderer::CompiledScene compiled = renderer::compile_scene(scene);
+  renderer::GpuTracer tracer;
+  tracer.load(compiled);
+  // One sample short of a share of at most 40000 takes 2.5e-5 off the mask;
+  // the resolve's division rounds by 6e-8.
+  const auto untraced = [](const renderer::RenderResult &r) {
+    int pixels = 0;
+    for (const float m : r.mask.data)
+      pixels += m < 1.0f - 1e-5f ? 1 : 0;
+    return pixels;
+  };
+  const renderer::RenderResult uniform = tracer.render(renderer::make_frame_params(scene, 40000));
+  EXPECT_EQ(untraced(uniform), 0) << "of 64 pixels at 40000 samples, uniform";
+  const renderer::RenderResult adaptive =
+      tracer.render_adaptive(renderer::make_frame_params(scene, 2500));
+  EXPECT_GT(*std::max_element(adaptive.sample_counts.begin(), adaptive.sample_counts.end()), 4000u);
+  EXPECT_EQ(untraced(adaptive), 0) << "of 64 pixels, adaptive";
+}
+
 // The quality claim at small scale: relative RMSE against a converged
 // reference at equal total rays, uniform and adaptive, and the adaptive
 // budget that matches uniform 49 rpp.
