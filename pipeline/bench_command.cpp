@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/frame_budget.h"
@@ -38,11 +39,20 @@ struct BenchArgs {
   bool cpu_peer = false;
   bool all_layers = false;
   bool adaptive = false;
+  renderer::AdaptiveSampling adaptive_settings; // --adaptive-cap sets max_factor
   bool skip_empty = false;
   double frame_ms = 0.0;      // > 0: follow this frame-time target instead of --rpp
   bool region = false;        // compare the influence region with every pixel
   bool every_feature = false; // the trace kernel with every feature (set_kernel_specialization)
 };
+
+std::string sampling_name(const BenchArgs &args) {
+  if (!args.adaptive)
+    return "uniform";
+  char cap[32];
+  std::snprintf(cap, sizeof cap, "%g", double(args.adaptive_settings.max_factor));
+  return std::string("adaptive (rpp = mean rays per pixel, shares capped at ") + cap + "x it)";
+}
 
 double paper_fps(int rpp) {
   switch (rpp) {
@@ -111,9 +121,9 @@ int run_frame_target(const BenchArgs &args, renderer::GpuTracer &tracer,
     const std::uint32_t rpp = budget.rpp();
     gpu::FrameParams frame = make_frame_params(scene, int(rpp));
     set_skip_empty_pixels(frame, args.skip_empty);
-    const RenderResult r =
-        args.adaptive ? tracer.render_adaptive(frame, {}, {}, LayerSelection::display_only())
-                      : tracer.render(frame, {}, LayerSelection::display_only());
+    const RenderResult r = args.adaptive ? tracer.render_adaptive(frame, args.adaptive_settings, {},
+                                                                  LayerSelection::display_only())
+                                         : tracer.render(frame, {}, LayerSelection::display_only());
     const double seconds = r.timings.device_s > 0.0 ? r.timings.device_s : r.seconds;
     budget.measured(rpp, seconds);
     std::printf("| %5d | %3u | %17.2f |%s\n", i, rpp, seconds * 1e3,
@@ -139,7 +149,7 @@ int run_region_bench(const BenchArgs &args, renderer::GpuTracer &tracer,
   const LayerSelection layers =
       args.all_layers ? LayerSelection::all() : LayerSelection::display_only();
   std::printf("median of %d frames after %d warm-up frames; sampling: %s\n\n", args.frames,
-              args.warmup, args.adaptive ? "adaptive (rpp = mean rays per pixel)" : "uniform");
+              args.warmup, sampling_name(args).c_str());
   std::printf("| rpp | pixels traced | GPU every pixel ms | GPU region ms | GPU speed-up |%s\n",
               args.cpu_peer ? " CPU every pixel ms | CPU region ms | CPU speed-up |" : "");
   std::printf("|-----|---------------|--------------------|---------------|--------------|%s\n",
@@ -150,7 +160,8 @@ int run_region_bench(const BenchArgs &args, renderer::GpuTracer &tracer,
     const auto gpu = [&](const InfluenceRegion *r) {
       return median_frame(args,
                           [&] {
-                            return args.adaptive ? tracer.render_adaptive(frame, {}, {}, layers, r)
+                            return args.adaptive ? tracer.render_adaptive(
+                                                       frame, args.adaptive_settings, {}, layers, r)
                                                  : tracer.render(frame, {}, layers, r);
                           })
           .total_s;
@@ -163,7 +174,8 @@ int run_region_bench(const BenchArgs &args, renderer::GpuTracer &tracer,
         return median_frame(args,
                             [&] {
                               return args.adaptive
-                                         ? render_cpu_adaptive(compiled, frame, {}, {}, 0, r)
+                                         ? render_cpu_adaptive(compiled, frame,
+                                                               args.adaptive_settings, {}, 0, r)
                                          : render_cpu(compiled, frame, {}, 0, r);
                             })
             .total_s;
@@ -207,7 +219,7 @@ int run_bench(const BenchArgs &args) {
       return run_region_bench(args, tracer, scene, compiled);
     std::printf("median of %d frames after %d warm-up frames; read back: %s; sampling: %s\n\n",
                 args.frames, args.warmup, args.all_layers ? "all layers" : "8-bit display image",
-                args.adaptive ? "adaptive (rpp = mean rays per pixel)" : "uniform");
+                sampling_name(args).c_str());
     std::printf("| rpp | camera rays/frame | frame ms (median) | fps   | M camera rays/s | "
                 "paper fps (GTX 590) |%s\n",
                 args.cpu_peer ? " CPU reference ms | GPU speed / CPU |" : "");
@@ -221,7 +233,7 @@ int run_bench(const BenchArgs &args) {
       gpu::FrameParams frame = make_frame_params(scene, rpp);
       set_skip_empty_pixels(frame, args.skip_empty);
       const FrameMedians gpu = median_frame(args, [&] {
-        return args.adaptive ? tracer.render_adaptive(frame, {}, {}, layers)
+        return args.adaptive ? tracer.render_adaptive(frame, args.adaptive_settings, {}, layers)
                              : tracer.render(frame, {}, layers);
       });
       breakdown.push_back(gpu.phases);
@@ -234,10 +246,11 @@ int run_bench(const BenchArgs &args) {
       if (args.cpu_peer) {
         // The same kernel on the same frame, compiled as C++: a peer in the
         // same process, so the ratio holds even on a noisy machine.
-        const double cpu = median_frame(args, [&] {
-                             return args.adaptive ? render_cpu_adaptive(compiled, frame)
-                                                  : render_cpu(compiled, frame);
-                           }).total_s;
+        const double cpu =
+            median_frame(args, [&] {
+              return args.adaptive ? render_cpu_adaptive(compiled, frame, args.adaptive_settings)
+                                   : render_cpu(compiled, frame);
+            }).total_s;
         std::printf(" %16.2f | %15.2f |", cpu * 1e3, cpu / frame_s);
       }
       std::printf("\n");
@@ -293,6 +306,11 @@ void add_bench_command(CLI::App &app) {
   cmd->add_flag("--adaptive", args->adaptive,
                 "Adaptive ray budget per pixel (a pilot, then shares by variance and blur) at\n"
                 "the same mean rays per pixel");
+  cmd->add_option("--adaptive-cap", args->adaptive_settings.max_factor,
+                  "With --adaptive: no pixel gets more than this many times the mean rays\n"
+                  "per pixel (on a GPU the largest share is the second pass's longest thread)")
+      ->check(CLI::Range(1.0f, 1024.0f))
+      ->capture_default_str();
   cmd->add_option("--frame-ms", args->frame_ms,
                   "Follow a frame-time target instead of --rpp: each frame's rays per pixel\n"
                   "from the device time of the frames before (renderer frame_budget.h)")

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/dof_gather.h"
@@ -162,15 +163,30 @@ Measurement run_pinhole_gather(ChartContext &c, int rpp) {
 }
 
 // 3. Adaptive ray budget (renderer adaptive.h): `rpp` rays per pixel on
-//    average, a pilot then each pixel's share by its variance and blur.
-Measurement run_adaptive(ChartContext &c, int rpp) {
+//    average, a pilot then each pixel's share by its variance and blur, no
+//    share over `max_factor` times the mean.
+Measurement run_adaptive_capped(ChartContext &c, int rpp, float max_factor) {
   const gpu::FrameParams frame = make_frame_params(c.scene, rpp);
+  AdaptiveSampling settings;
+  settings.max_factor = max_factor;
   Measurement m;
   m.frame_s = median_seconds(c.args, [&] {
-    return frame_seconds(c.tracer.render_adaptive(frame, {}, {}, LayerSelection::display_only()));
+    return frame_seconds(
+        c.tracer.render_adaptive(frame, settings, {}, LayerSelection::display_only()));
   });
-  m.composite = c.tracer.render_adaptive(frame).composite;
+  m.composite = c.tracer.render_adaptive(frame, settings).composite;
   return m;
+}
+
+Measurement run_adaptive(ChartContext &c, int rpp) {
+  return run_adaptive_capped(c, rpp, AdaptiveSampling{}.max_factor);
+}
+
+// 3b. The same with no share over 4x the mean: on a GPU the second pass
+//     lasts as long as its longest invocation, one pixel's whole share
+//     (bench/RESULTS.md, "Adaptive on a GPU: the longest share").
+Measurement run_adaptive_cap4(ChartContext &c, int rpp) {
+  return run_adaptive_capped(c, rpp, 4.0f);
 }
 
 // The method table: a new sampler (low-discrepancy, adaptive) is one more
@@ -201,6 +217,12 @@ const std::vector<Method> &methods() {
        {44, 160, 44},
        chart::Marker::diamond,
        run_adaptive},
+      {"adaptive-cap4",
+       "adaptive, no pixel over 4x the mean rays (a GPU's longest thread 4x shorter)",
+       {4, 9, 16, 25, 49},
+       {148, 103, 189},
+       chart::Marker::diamond,
+       run_adaptive_cap4},
   };
   return table;
 }

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Issue 24's GPU figures in one run, sized for a lent GPU machine's minutes
+# after bench/gpu_check.sh: the renderer's tests on the GPU (every kernel
+# against the CPU reference on that driver), the adaptive second pass's
+# longest thread (the same mean rays with the largest share capped lower),
+# the live frame (the sim rig's frame renderer, and `camhead run` on the
+# sim rig for 30 s with its record), and the speed-accuracy chart of
+# uniform and adaptive sampling timed on the GPU. Prints Markdown; the log,
+# the record and the chart (CSV, PNGs) go to OUT_DIR.
+#
+#   bench/gpu_live_check.sh BIN_DIR [OUT_DIR]
+#
+# BIN_DIR holds camhead, camhead_benchmarks and test_renderer built here
+# (stripped, they travel in a few MiB). The tests look for their assets under the source directory
+# they were built in (CAMHEAD_SOURCE_DIR); SOURCE_DIR names it so that a
+# link to this checkout can stand there. The chart's 1024-rpp references
+# are rendered on the machine's CPU cores (about a minute on 16).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+bin=${1:?BIN_DIR}
+out=${2:-.}
+mkdir -p "$out"
+log=$out/gpu_live_check.md
+: >"$log"
+say() { echo "$@" | tee -a "$log"; }
+step() {
+  say
+  say "    $*"
+  say
+  "$@" 2>&1 | tee -a "$log"
+}
+
+if [ -n "${SOURCE_DIR:-}" ] && [ ! -e "$SOURCE_DIR" ]; then
+  mkdir -p "$(dirname "$SOURCE_DIR")"
+  ln -s "$PWD" "$SOURCE_DIR"
+fi
+
+say "# Issue 24 on a GPU, $(date -u +%Y-%m-%d)"
+
+# Every renderer test, the GPU ones on this machine's driver.
+step "$bin/test_renderer" --gtest_brief=1
+
+# The second pass's longest thread: the same mean rays, the largest share
+# at 16x (the default), 4x and 2x the mean; uniform 9 and 49 beside them.
+for cap in 16 4 2; do
+  step "$bin/camhead" bench --scene scenes/ar_demo.json --rpp 9 --adaptive --adaptive-cap "$cap" \
+    --frames 21 --warmup 3
+done
+step "$bin/camhead" bench --scene scenes/ar_demo.json --rpp 9,49 --frames 21 --warmup 3
+
+# The live frame: the sim rig's frame renderer alone, then the whole rig.
+step "$bin/camhead_benchmarks" --benchmark_filter='LiveFrame/gpu'
+step "$bin/camhead" run --board sim --executor gpu --duration 30 --output null \
+  --record-stats "$out/run_gpu.jsonl"
+
+# Speed against accuracy, timed on the GPU.
+# The references stay behind in the chart's cache; the CSV and the charts
+# come back.
+step "$bin/camhead" bench chart tests/assets/reference/ar_basic.json scenes/ar_demo.json \
+  --scale 0.5 --methods uniform,adaptive -o /tmp/gpu_chart
+cp /tmp/gpu_chart/chart*.csv /tmp/gpu_chart/chart*.png "$out"/
