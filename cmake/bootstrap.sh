@@ -1,21 +1,48 @@
 #!/usr/bin/env bash
-# Installs camhead's build and test dependencies (Debian 12 packages only),
-# configures and builds. Idempotent: a second run only rebuilds what changed.
+# Installs camhead's dependencies (Debian 12 packages only), configures and
+# builds. Idempotent: a second run only rebuilds what changed.
 #
-#   cmake/bootstrap.sh [BUILD_DIR] [extra cmake -D options...]
+#   cmake/bootstrap.sh [--run] [BUILD_DIR] [extra cmake -D options...]
+#
+# --run: only what `camhead run` needs (README command 1): the packages that
+#   build camhead, and camhead alone; no tests, benchmarks, hardware lab or
+#   optional modules (the marker tracker's OpenCV, libcamera), which a later
+#   run without --run adds to the same build folder.
+# Without it, everything (README command 2, CI): the test suite, the
+#   benchmarks, the hardware lab's QEMU guest and kernel modules, and the
+#   modules of the boards that need OpenCV or libcamera.
 #
 # Environment: CAMHEAD_SKIP_APT=1 skips apt-get (packages already present).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build_dir=${1:-build}
-shift || true
+run_only=0
+if [ "${1:-}" = --run ]; then
+  run_only=1
+  shift
+fi
+build_dir=build
+if [ $# -gt 0 ] && [[ $1 != -* ]]; then
+  build_dir=$1
+  shift
+fi
 
-packages=(
-  build-essential cmake ninja-build pkg-config git clang-format
-  libvulkan-dev mesa-vulkan-drivers glslang-tools vulkan-tools
+# What building camhead takes.
+run_packages=(
+  build-essential cmake ninja-build pkg-config
+  libvulkan-dev mesa-vulkan-drivers glslang-tools
   libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev libpng-dev
-  libtinyobjloader-dev libstb-dev libtinyexr-dev glmark2-data
+  libtinyobjloader-dev libstb-dev libtinyexr-dev
   libgpiod-dev libusb-1.0-0-dev
+  # hal/output/drm: the kernel's DRM uapi headers (drm.h, drm_mode.h), which
+  # Debian ships in libdrm-dev only; nothing links libdrm.
+  libdrm-dev
+)
+# What the tests, benchmarks, tools and optional modules add.
+test_packages=(
+  git clang-format vulkan-tools
+  # The demo scene's bunny (scenes/ar_demo.json), which tests and
+  # benchmarks render.
+  glmark2-data
   # The marker pose source's module (pipeline/tracking/opencv): OpenCV 4.6
   # with contrib's aruco; camhead itself opens the module at run time.
   libopencv-dev libopencv-contrib-dev
@@ -38,10 +65,9 @@ packages=(
   # (camhead itself opens the module at run time), and the vimc IPA module
   # the lab's libcamera check packs (tests/vm/libcamera_vimc.sh).
   libcamera-dev libcamera-ipa
-  # hal/output/drm: the kernel's DRM uapi headers (drm.h, drm_mode.h), which
-  # Debian ships in libdrm-dev only; nothing links libdrm.
-  libdrm-dev
 )
+packages=("${run_packages[@]}")
+[ "$run_only" = 1 ] || packages+=("${test_packages[@]}")
 
 if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then
   missing=()
@@ -56,5 +82,14 @@ if [ "${CAMHEAD_SKIP_APT:-0}" != 1 ]; then
   fi
 fi
 
-cmake -S . -B "$build_dir" -G Ninja "$@" >/dev/null
-cmake --build "$build_dir" -j "$(nproc)"
+# The profile is set on every run (the options stay in the build folder's
+# cache otherwise); options given after BUILD_DIR still win.
+if [ "$run_only" = 1 ]; then
+  cmake -S . -B "$build_dir" -G Ninja -DCAMHEAD_BUILD_TESTS=OFF -DCAMHEAD_BUILD_BENCH=OFF "$@" \
+    >/dev/null
+  cmake --build "$build_dir" -j "$(nproc)" --target camhead
+else
+  cmake -S . -B "$build_dir" -G Ninja -DCAMHEAD_BUILD_TESTS=ON -DCAMHEAD_BUILD_BENCH=ON "$@" \
+    >/dev/null
+  cmake --build "$build_dir" -j "$(nproc)"
+fi

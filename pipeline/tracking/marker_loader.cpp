@@ -53,11 +53,12 @@ marker_module::Module &module() {
   }
   if (!last_error.empty())
     throw MarkerModuleError("marker tracking: " + last_error);
-  throw MarkerModuleError(std::string("marker tracking: ") + kModuleName + " is not in " +
-                          search.searched +
-                          ": camhead builds it where libopencv-contrib-dev is installed, and it "
-                          "needs the Debian package " +
-                          kOpenCvPackage + " to run");
+  throw MarkerModuleError(
+      std::string("marker tracking: ") + kModuleName + " is not in " + search.searched +
+      ": camhead builds it where libopencv-contrib-dev is installed (cmake/bootstrap.sh "
+      "without --run installs it), and it "
+      "needs the Debian package " +
+      kOpenCvPackage + " to run");
 }
 
 } // namespace

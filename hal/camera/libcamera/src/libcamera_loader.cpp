@@ -63,11 +63,12 @@ libcamera_module::Module &module() {
   }
   if (!last_error.empty())
     throw LibcameraCameraError("libcamera backend: " + last_error);
-  throw LibcameraCameraError(std::string("libcamera backend: ") + kModuleName + " is not in " +
-                             search.searched +
-                             ": camhead builds it where libcamera-dev is installed, and it "
-                             "needs the Debian package " +
-                             kLibcameraPackage + " to run");
+  throw LibcameraCameraError(
+      std::string("libcamera backend: ") + kModuleName + " is not in " + search.searched +
+      ": camhead builds it where libcamera-dev is installed (cmake/bootstrap.sh "
+      "without --run installs it), and it "
+      "needs the Debian package " +
+      kLibcameraPackage + " to run");
 }
 
 } // namespace
