@@ -26,8 +26,6 @@ public:
   TraceCurve(const hal::lens::LensTrace &trace, Axis axis, std::optional<double> period_s);
 
   [[nodiscard]] bool empty() const { return points_.empty(); }
-  // Seconds from the first row to the last that carries the axis.
-  [[nodiscard]] double span_s() const { return points_.empty() ? 0.0 : points_.back().t; }
   // The counts at `t` seconds of trace time; 0 for an axis the trace lacks.
   [[nodiscard]] double at(double t) const;
 

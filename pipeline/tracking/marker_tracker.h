@@ -1,6 +1,6 @@
-// The camera's pose from the markers in its own picture (issue 25): a
-// ChArUco board or a marker field (marker_board.h) found in the luma plane
-// of the frame that is rendered, with that frame's lens.
+// The camera's pose from the markers in its own picture: a ChArUco board or
+// a marker field (marker_board.h) found in the luma plane of the frame that
+// is rendered, with that frame's lens.
 //
 // The detection and the pose solve are OpenCV's (aruco, calib3d), in a
 // module opened at run time (libcamhead_markers.so, built where Debian's

@@ -125,7 +125,6 @@ Instance::Instance(const InstanceCreateInfo &info) {
   if (info.validation) {
     if (layer_available(kValidationLayer)) {
       layers.push_back(kValidationLayer);
-      validation_ = true;
     } else {
       // Asked for explicitly, so silence would hide why no messages appear.
       std::fprintf(stderr, "camhead: CAMHEAD_VULKAN_VALIDATION=1 but %s is not installed\n",

@@ -130,14 +130,12 @@ public:
   Instance &operator=(const Instance &) = delete;
 
   [[nodiscard]] VkInstance get() const { return instance_; }
-  [[nodiscard]] bool validation_enabled() const { return validation_; }
   // Devices with Vulkan 1.1 and a compute queue, in enumeration order; their
   // info.index is the position in this list.
   [[nodiscard]] std::vector<PhysicalDevice> compute_devices() const;
 
 private:
   VkInstance instance_ = VK_NULL_HANDLE;
-  bool validation_ = false;
 };
 
 // The devices' GpuDeviceInfo, in order.

@@ -35,10 +35,6 @@ void DeviceClockMapper::reset() {
   intercept_ = slope_ = 0.0;
 }
 
-std::int64_t DeviceClockMapper::offset_ns() const {
-  return primed_ ? estimate_at(device_us_) : 0;
-}
-
 std::int64_t DeviceClockMapper::estimate_at(std::int64_t device_us) const {
   if (!fitted_) {
     std::int64_t lowest = current_.d_ns;

@@ -1,4 +1,4 @@
-// Adaptive ray budget per pixel (issue 4, "Model no more than a scene needs").
+// Adaptive ray budget per pixel: rays where the noise is.
 //
 // A frame of frame.sampling.z samples per pixel on average: a pilot of
 // `pilot` samples per pixel, then the rest of the frame budget

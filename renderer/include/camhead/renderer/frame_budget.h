@@ -1,5 +1,5 @@
 // Rays per pixel for a frame-time target: the budget a live frame spends,
-// uniform or adaptive (issue 4, "with a frame-time target").
+// uniform or adaptive, for a frame-time target.
 //
 // The cost of a frame grows with its rays per pixel, and the rate changes
 // with the scene, the lens (a wide aperture spreads rays over more of the
@@ -42,8 +42,6 @@ public:
   // A frame of `rpp` rays per pixel (a mean: an accumulating frame shares
   // its rays unevenly) took `seconds`; ignored unless both > 0.
   void measured(double rpp, double seconds);
-  // The average seconds per ray per pixel so far (0 before any frame).
-  [[nodiscard]] double seconds_per_rpp() const { return seconds_per_rpp_; }
 
 private:
   FrameBudgetSettings settings_;

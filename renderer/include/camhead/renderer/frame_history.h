@@ -1,7 +1,7 @@
-// Accumulation while nothing changes (issue 24): a camera head often holds a
-// shot, and while the pose, the lens and the scene stay put each live frame's
-// samples add to those of the frames before, so that the virtual image
-// converges to the reference instead of showing one frame's noise.
+// Accumulation while nothing changes: a camera head often holds a shot, and
+// while the pose, the lens and the scene stay put each live frame's samples
+// add to those of the frames before, so that the virtual image converges to
+// the reference instead of showing one frame's noise.
 //
 // A history is a render of one camera (the frame that started it): its
 // samples are indices [0, n) of one progressive pattern (Owen-scrambled

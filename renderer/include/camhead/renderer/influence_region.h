@@ -1,6 +1,6 @@
 // The influence region: the pixels of a frame where the virtual objects can
-// change the composite (issue 11, "a frame costs what the virtual objects
-// touch"). Everywhere else I_m == I_r and M == 0, so equation 4 returns the
+// change the composite, so that a frame costs what the virtual objects
+// touch. Everywhere else I_m == I_r and M == 0, so equation 4 returns the
 // camera image bit for bit (kernel.glsl, resolve_pixel) and nothing needs to
 // be traced.
 //

@@ -74,7 +74,6 @@ public:
   void poll(std::chrono::milliseconds timeout, std::vector<EncoderReading> &out) override;
   [[nodiscard]] EncoderStatus status() const override;
 
-  [[nodiscard]] bool has_axis(LensAxis axis) const { return axes_[index(axis)]; }
   [[nodiscard]] const QuadratureDecoder &decoder(LensAxis axis) const {
     return decoders_[index(axis)];
   }

@@ -55,10 +55,8 @@ public:
   // Start over: the next report is a first one (call on every reconnect).
   void reset();
 
-  // The estimate, for monitoring and tests: host minus device time at the
-  // newest report (ns), and the fitted drift of the device clock (ppm,
+  // The fitted drift of the device clock, for monitoring and tests (ppm,
   // positive when the device clock runs slow against the host's).
-  [[nodiscard]] std::int64_t offset_ns() const;
   [[nodiscard]] double skew_ppm() const { return slope_ * 1000.0; }
   [[nodiscard]] std::int64_t unwrapped_us() const { return device_us_; }
   [[nodiscard]] std::uint64_t resyncs() const { return resyncs_; }
