@@ -40,6 +40,9 @@ run_packages=(
 # What the tests, benchmarks, tools and optional modules add.
 test_packages=(
   git clang-format vulkan-tools
+  # The service unit's tests: systemd-analyze scores its hardening,
+  # systemd-sysusers makes its user in a scratch root (tests/CMakeLists.txt).
+  systemd
   # The demo scene's bunny (scenes/ar_demo.json), which tests and
   # benchmarks render.
   glmark2-data

@@ -22,6 +22,7 @@
 #include "run/output_uri.h"
 #include "run/run_loop.h"
 #include "run/run_paths.h"
+#include "service/service_notifier.h"
 
 namespace camhead::cli {
 namespace {
@@ -117,6 +118,9 @@ int run(const RunArgs &args) {
   options.threads = args.threads;
   options.influence_region = !args.no_influence_region;
   options.stop = &stop_requested;
+  // Under systemd (systemd/camhead@.service): its notification socket.
+  const pipeline::ServiceNotifier service = pipeline::ServiceNotifier::from_environment();
+  options.service = &service;
 
   stop_requested = false;
   for (const int signal : kStopSignals)

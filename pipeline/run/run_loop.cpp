@@ -31,6 +31,8 @@
 #include "rig_setup.h"
 #include "run_paths.h"
 #include "run_status.h"
+#include "service/output_watchdog.h"
+#include "service/service_notifier.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
 #include "tracking/pose_trace.h"
@@ -84,6 +86,7 @@ private:
   void render_loop();
   void output_loop();
   void status_loop();
+  [[nodiscard]] OutputProgress output_progress() const;
   // A frame's request as the board and the options make it.
   [[nodiscard]] renderer::FrameRequest board_request() const;
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
@@ -305,13 +308,20 @@ void Pipeline::render_loop() {
   budget_settings.max_rpp = board_.render.max_rays_per_pixel;
   renderer::FrameBudget budget(budget_settings);
   std::optional<std::uint64_t> last_sequence;
+  std::uint64_t rendered = 0;
   for (;;) {
+    if (options_.stall_render_after_frames && rendered >= *options_.stall_render_after_frames) {
+      while (!should_stop()) // stuck, as in a driver that never returns
+        std::this_thread::sleep_for(10ms);
+      break;
+    }
     std::optional<Delivered> delivered = captured_.pop(100ms);
     if (!delivered) {
       if (captured_.drained())
         break;
       continue;
     }
+    ++rendered;
     const CapturedFrame &frame = delivered->frame.frame();
     std::optional<int> slot_index = free_slots_.pop(200ms);
     while (lossless_ && !slot_index && !free_slots_.closed())
@@ -482,10 +492,30 @@ void Pipeline::output_loop() {
   }
 }
 
-// The status line (run_status.h), a line a second.
+OutputProgress Pipeline::output_progress() const {
+  return {.composites = counters_.frames_out,
+          .placeholders = counters_.placeholders,
+          .camera_lost = counters_.camera_lost,
+          .renderer_lost = counters_.renderer_lost};
+}
+
+// The status line (run_status.h), a line a second, and what systemd hears
+// (RunOptions::service).
 void Pipeline::status_loop() {
   if (status_)
     status_->start();
+  const ServiceNotifier *service =
+      options_.service != nullptr && options_.service->active() ? options_.service : nullptr;
+  bool ready = false;
+  // WATCHDOG=1 at half systemd's timeout, as sd_watchdog_enabled(3) advises.
+  const std::int64_t watchdog_ns =
+      service != nullptr && service->watchdog_timeout()
+          ? std::chrono::duration_cast<std::chrono::nanoseconds>(*service->watchdog_timeout())
+                    .count() /
+                2
+          : 0;
+  OutputProgress watched = output_progress();
+  std::int64_t watched_ns = start_ns_;
   std::uint64_t last_in = 0, last_out = 0;
   std::int64_t last_ns = start_ns_;
   // Awake often, so that a run ends as soon as its last frame is out (it
@@ -493,14 +523,31 @@ void Pipeline::status_loop() {
   while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
     std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
+    if (service != nullptr && !ready &&
+        counters_.frames_out + counters_.placeholders + counters_.repeats > 0) {
+      ready = service->notify("READY=1");
+      watched = output_progress();
+      watched_ns = now;
+    }
+    if (ready && watchdog_ns > 0 && now - watched_ns >= watchdog_ns) {
+      const OutputProgress progress = output_progress();
+      if (output_advanced(watched, progress))
+        (void)service->notify("WATCHDOG=1");
+      watched = progress;
+      watched_ns = now;
+    }
     if (!status_ || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
     status_->second(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out);
+    if (service != nullptr)
+      (void)service->notify("STATUS=" + status_->last_line());
     last_in = in;
     last_out = out;
     last_ns = now;
   }
+  if (service != nullptr)
+    (void)service->notify("STOPPING=1");
   if (status_)
     status_->end();
 }

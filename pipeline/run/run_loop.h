@@ -33,6 +33,8 @@
 
 namespace camhead::pipeline {
 
+class ServiceNotifier;
+
 struct RunOptions {
   Board board;
   std::vector<std::string> outputs; // URIs; empty: the board's
@@ -50,6 +52,15 @@ struct RunOptions {
   double repeat_after_s = 0.5;
   std::FILE *status = stderr; // the status line; null: none
   const std::atomic<bool> *stop = nullptr;
+  // systemd's notification socket (service/service_notifier.h): READY=1
+  // once the first frame is out, the status line as STATUS=, WATCHDOG=1
+  // while the output advances (service/output_watchdog.h), STOPPING=1 at
+  // the end. Null or inactive: none.
+  const ServiceNotifier *service = nullptr;
+  // A fault for tests: the render thread stops after taking this many
+  // camera frames and hangs until the run is stopped, as one stuck in a
+  // driver would (the output repeats the last composite meanwhile).
+  std::optional<std::uint64_t> stall_render_after_frames;
 };
 
 // What one output took.

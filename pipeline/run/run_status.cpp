@@ -46,17 +46,20 @@ void RunStatus::second(std::int64_t now_ns, double dt, std::uint64_t in, std::ui
   char lens_late[64] = "";
   if (const std::uint64_t late = counters_.lens_late; late > 0)
     std::snprintf(lens_late, sizeof lens_late, " (%" PRIu64 " frames without it)", late);
-  std::fprintf(out_,
-               "%sin %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
-               " (camera %" PRIu64 ", render busy %" PRIu64 ", output busy %" PRIu64
-               ")  focus %s f/%.1f %.0f mm%s%s%s  latency %.0f ms%s%s%s",
-               tty_ ? "\r\033[K" : "", double(in) / dt, double(out) / dt, counters_.rpp.load(),
-               0.1 * counters_.traced_permille.load(),
-               cam.dropped + counters_.render_busy + counters_.output_busy, cam.dropped,
-               counters_.render_busy.load(), counters_.output_busy.load(), focus,
-               lens.state.f_number.value, lens.state.focal_length_mm.value,
-               lens.fresh ? "" : " (stale)", lens_late, pose,
-               1e-6 * double(counters_.latency_ns.load()), alarm, output_errors, tty_ ? "" : "\n");
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "in %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
+                " (camera %" PRIu64 ", render busy %" PRIu64 ", output busy %" PRIu64
+                ")  focus %s f/%.1f %.0f mm%s%s%s  latency %.0f ms%s%s",
+                double(in) / dt, double(out) / dt, counters_.rpp.load(),
+                0.1 * counters_.traced_permille.load(),
+                cam.dropped + counters_.render_busy + counters_.output_busy, cam.dropped,
+                counters_.render_busy.load(), counters_.output_busy.load(), focus,
+                lens.state.f_number.value, lens.state.focal_length_mm.value,
+                lens.fresh ? "" : " (stale)", lens_late, pose,
+                1e-6 * double(counters_.latency_ns.load()), alarm, output_errors);
+  last_line_ = line;
+  std::fprintf(out_, "%s%s%s", tty_ ? "\r\033[K" : "", line, tty_ ? "" : "\n");
   std::fflush(out_);
 }
 

@@ -31,6 +31,9 @@ public:
   // A second's line (frames in and out since the last, over `dt` seconds),
   // after a line for each camera or output failure since the last.
   void second(std::int64_t now_ns, double dt, std::uint64_t in, std::uint64_t out);
+  // The last second's line as second() wrote it, without the terminal's
+  // control codes (the service's STATUS=); empty before the first.
+  [[nodiscard]] const std::string &last_line() const { return last_line_; }
   // Ends the line being redrawn; from here every line is a line of its own.
   void end();
   // A line for each output that failed since the last look (also after end()).
@@ -50,6 +53,7 @@ private:
   std::vector<std::uint64_t> sink_errors_seen_; // reported so far
   std::string camera_detail_seen_;              // reported last
   std::uint64_t camera_errors_seen_ = 0;        // reported so far
+  std::string last_line_;
 };
 
 } // namespace camhead::pipeline
