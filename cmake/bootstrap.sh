@@ -41,8 +41,9 @@ run_packages=(
 test_packages=(
   git clang-format vulkan-tools
   # The service unit's tests: systemd-analyze scores its hardening,
-  # systemd-sysusers makes its user in a scratch root (tests/CMakeLists.txt).
-  systemd
+  # systemd-sysusers makes its user in a scratch root (tests/CMakeLists.txt);
+  # lintian checks the Debian package (tests/package/deb_package.sh).
+  systemd lintian
   # The demo scene's bunny (scenes/ar_demo.json), which tests and
   # benchmarks render.
   glmark2-data
