@@ -1,8 +1,10 @@
 // Board files: the bundled ones load, and every kind of mistake is named by
 // file and field without loading anything half-way.
 #include <string>
+#include <vector>
 
 #include "board.h"
+#include "run/output_uri.h"
 
 #include <gtest/gtest.h>
 
@@ -36,6 +38,42 @@ TEST(Board, SimulatedRigLoadsWithATraceAndAProfileThatExist) {
   EXPECT_TRUE(std::filesystem::exists(trace->file)) << trace->file;
   ASSERT_TRUE(board.lens.profile.has_value());
   EXPECT_TRUE(std::filesystem::exists(*board.lens.profile)) << *board.lens.profile;
+}
+
+// The two real boards beside the simulated rig load whole: their files
+// exist, their camera and outputs are what their descriptions promise, and
+// their output URIs parse (nothing is opened: there is no Pi here).
+TEST(Board, TheRealBoardsLoadWithTheirCamerasAndOutputs) {
+  const Board pi = load_board(resolve_board("rpi5-libcamera-hdmi"));
+  ASSERT_TRUE(pi.camera.has_value());
+  EXPECT_NE(std::get_if<LibcameraCameraConfig>(&pi.camera->kind), nullptr);
+  EXPECT_EQ(pi.camera->format, base::PixelFormat::nv12);
+  EXPECT_EQ(pi.camera->width, 1920);
+  EXPECT_EQ(pi.camera->height, 1080);
+  ASSERT_EQ(pi.outputs, std::vector<std::string>{"drm:card1:HDMI-A-1"});
+  ASSERT_EQ(pi.lens.sources.size(), 1u);
+  EXPECT_NE(std::get_if<GpioSourceConfig>(&pi.lens.sources[0].kind), nullptr);
+  ASSERT_TRUE(pi.lens.profile.has_value());
+  EXPECT_TRUE(std::filesystem::exists(*pi.lens.profile)) << *pi.lens.profile;
+  ASSERT_TRUE(pi.scene.has_value());
+  EXPECT_TRUE(std::filesystem::exists(*pi.scene)) << *pi.scene;
+
+  const Board pc = load_board(resolve_board("x86-uvc-webcam"));
+  ASSERT_TRUE(pc.camera.has_value());
+  const auto *webcam = std::get_if<V4l2CameraConfig>(&pc.camera->kind);
+  ASSERT_NE(webcam, nullptr);
+  EXPECT_TRUE(webcam->mjpeg);
+  EXPECT_EQ(webcam->fps, 30.0);
+  EXPECT_EQ(pc.camera->sensor_width_mm, 4.8);
+  EXPECT_EQ(pc.outputs, std::vector<std::string>{"v4l2:/dev/video10"});
+  ASSERT_EQ(pc.lens.sources.size(), 1u);
+  const auto *fixed = std::get_if<TraceSourceConfig>(&pc.lens.sources[0].kind);
+  ASSERT_NE(fixed, nullptr);
+  EXPECT_TRUE(std::filesystem::exists(fixed->file)) << fixed->file;
+  ASSERT_TRUE(pc.scene.has_value());
+  EXPECT_TRUE(std::filesystem::exists(*pc.scene)) << *pc.scene;
+  for (const Board *board : {&pi, &pc})
+    EXPECT_NO_THROW(static_cast<void>(parse_output_uris(board->outputs))) << board->name;
 }
 
 TEST(Board, ExampleRigHasEveryKindOfSource) {
@@ -75,7 +113,9 @@ TEST(Board, AnUnknownNameListsTheBoardsThereAre) {
   } catch (const BoardError &e) {
     const std::string message = e.what();
     EXPECT_EQ(message.rfind("simm: (board name): no board of that name in ", 0), 0u) << message;
-    EXPECT_NE(message.find("(there: example-rig, sim, sim-devices, sim-moving)"), std::string::npos)
+    EXPECT_NE(message.find("(there: example-rig, rpi5-libcamera-hdmi, sim, sim-devices, "
+                           "sim-moving, x86-uvc-webcam)"),
+              std::string::npos)
         << message;
   }
 }
