@@ -10,7 +10,9 @@
 #   bench/gpu_check.sh [BUILD_DIR] [OUT_DIR]
 #
 # The machine needs a Vulkan driver and loader, nothing else: build here and
-# carry BUILD_DIR/camhead (RESULTS, "Frame rate on an NVIDIA H100"). FRAMES
+# carry BUILD_DIR/camhead (RESULTS, "Frame rate on an NVIDIA H100"), and the
+# demo's bunny at /usr/share/glmark2/models/bunny.obj (glmark2-data; RESULTS,
+# "On a GPU at last", has the commands). FRAMES
 # and WARMUP (21 and 3) set the frames timed per setting. On lavapipe,
 # QUICK=1 FRAMES=1 WARMUP=0 checks the script in two minutes (720x576 only).
 set -euo pipefail
