@@ -144,6 +144,15 @@ DofGatherResult DofGather::Impl::apply(const RenderResult &pinhole, const gpu::F
       max_radius = std::max(max_radius, coc_radius_px(lens, z));
   }
   max_radius = std::clamp(max_radius, 0.5f, 256.0f);
+  // dof_gather.comp visits (2 reach + 1)^2 neighbours and 2 reach + 1 rows;
+  // a device that stops a shader's loops after so many iterations would
+  // gather part of the window, silently: the reach stays within them, and
+  // the result says which it was.
+  if (const std::uint32_t most = device.quirks().max_loop_iterations; most > 0) {
+    // The widest window side s with s^2 + s <= most (255 on llvmpipe: 127).
+    const double side = std::floor((std::sqrt(1.0 + 4.0 * double(most)) - 1.0) / 2.0);
+    max_radius = std::min(max_radius, float(std::floor((side - 1.0) / 2.0)));
+  }
 
   allocate(pixels);
   std::vector<glm::vec4> mixed(pixels), real(pixels);

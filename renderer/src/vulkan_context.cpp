@@ -57,6 +57,7 @@ DriverQuirks detect_quirks(const VkPhysicalDeviceProperties &properties) {
   const bool llvmpipe = std::string_view(properties.deviceName).starts_with("llvmpipe");
   quirks.indirect_dispatch_keeps_base = llvmpipe;
   quirks.max_samples_per_dispatch = llvmpipe ? 16u : 0u;
+  quirks.max_loop_iterations = llvmpipe ? 65535u : 0u;
   return quirks;
 }
 

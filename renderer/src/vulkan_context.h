@@ -102,6 +102,10 @@ struct DriverQuirks {
   // 200 on: bench/RESULTS.md, "lavapipe stops a long shader"); 16 samples
   // leave room for paths twelve times as long.
   std::uint32_t max_samples_per_dispatch = 0;
+  // The most loop iterations a shader invocation may run, all its loops
+  // together (LP_MAX_TGSI_LOOP_ITERATIONS on llvmpipe); 0 for no bound. The
+  // depth-of-field gather's reach comes from it (dof_gather.cpp).
+  std::uint32_t max_loop_iterations = 0;
 };
 
 struct PhysicalDevice {

@@ -3,6 +3,7 @@
 // method.md section 1, and the depth-aware weights keep a sharp foreground's
 // silhouette while a blurred foreground spreads over what lies behind it.
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "camhead/renderer/dof_gather.h"
@@ -156,6 +157,43 @@ TEST(DofGather, CompositesBlurredLayersWithThePlate) {
   const float m = out.image.mask.at(kWidth / 2, y)[0];
   EXPECT_GT(m, 0.2f);
   EXPECT_LT(m, 0.8f);
+}
+
+// A device may stop a shader's loops after so many iterations (lavapipe:
+// 65535 of all of them together, vulkan_context.h); a gather whose window
+// needs more would take part of it, silently, and the blur would lose its
+// symmetry. A 4x200 strip at one depth, blurred far wider than itself, with
+// one bright pixel at one end: the pixel at the other end must see exactly
+// what the bright one sees of it from the other end. (lavapipe, before the
+// reach was bounded: the bottom pixel saw the top one, not the reverse.)
+TEST(DofGather, ALongWindowIsGatheredWholeOrNotAtAll) {
+  constexpr int w = 4, h = 200;
+  renderer::gpu::FrameParams wide{};
+  wide.lens = renderer::gpu::vec4(1.0f, kFocus, 500.0f, 1.0f); // 500 px of blur at 0.5 m
+  const auto strip = [&](int bright_y) {
+    RenderResult r;
+    r.mixed = renderer::Image(w, h, 3);
+    r.real = renderer::Image(w, h, 3);
+    r.mask = renderer::Image(w, h, 1);
+    r.depth = renderer::Image(w, h, 1);
+    for (float &z : r.depth.data)
+      z = 0.5f;
+    for (int c = 0; c < 3; ++c)
+      r.mixed.at(1, bright_y)[c] = r.real.at(1, bright_y)[c] = 1.0f;
+    return r;
+  };
+  DofGather gather;
+  const renderer::DofGatherResult bottom_lit =
+      gather.apply(strip(h - 1), wide, {}, {.max_radius_px = 200.0f});
+  const renderer::DofGatherResult top_lit =
+      gather.apply(strip(0), wide, {}, {.max_radius_px = 200.0f});
+  EXPECT_EQ(bottom_lit.max_radius_px, top_lit.max_radius_px);
+  const float top_sees = bottom_lit.image.mixed.at(1, 0)[0];
+  const float bottom_sees = top_lit.image.mixed.at(1, h - 1)[0];
+  std::printf("reach %.0f px: the top pixel sees %.3g of the bottom one, the bottom %.3g of the "
+              "top\n",
+              bottom_lit.max_radius_px, top_sees, bottom_sees);
+  EXPECT_FLOAT_EQ(top_sees, bottom_sees);
 }
 
 } // namespace
