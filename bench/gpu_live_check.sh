@@ -11,10 +11,14 @@
 #   bench/gpu_live_check.sh BIN_DIR [OUT_DIR]
 #
 # BIN_DIR holds camhead, camhead_benchmarks and test_renderer built here
-# (stripped, they travel in a few MiB). The tests look for their assets under the source directory
-# they were built in (CAMHEAD_SOURCE_DIR); SOURCE_DIR names it so that a
-# link to this checkout can stand there. The chart's 1024-rpp references
-# are rendered on the machine's CPU cores (about a minute on 16).
+# (stripped, they travel in a few MiB; camhead_benchmarks also needs
+# libbenchmark.so.1debian on LD_LIBRARY_PATH). The tests look for their
+# assets under the source directory they were built in
+# (CAMHEAD_SOURCE_DIR); SOURCE_DIR names it so that a link to this checkout
+# can stand there. The chart's 1024-rpp references are rendered on the
+# machine's CPU cores (about a minute on 16). The chart's GPU timings are
+# not to be trusted (bench/RESULTS.md, "On a GPU at last"): its errors are.
+# The commands that ran it on an H200 are in that section.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:?BIN_DIR}
