@@ -24,7 +24,8 @@ dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./|/|' >"$scratch/contents"
 for path in /usr/bin/camhead /usr/lib/systemd/system/camhead@.service \
   /usr/lib/sysusers.d/camhead.conf /usr/share/camhead/board/sim.json \
   /usr/share/camhead/scenes/sim_rig.json /usr/share/camhead/scenes/lenses/example_35mm.json \
-  /usr/share/doc/camhead/copyright; do
+  /usr/share/doc/camhead/copyright /usr/lib/udev/rules.d/70-camhead-lens.rules \
+  /usr/lib/modprobe.d/camhead-v4l2loopback.conf /usr/lib/modules-load.d/camhead.conf; do
   grep -qx "$path" "$scratch/contents" || fail "$path is not in the package"
 done
 if grep -q '^/usr/local/' "$scratch/contents"; then fail "files under /usr/local"; fi

@@ -2,9 +2,11 @@
 # Guest: the V4L2 loopback sink and the camera on v4l2loopback
 # (camhead_v4l2_loopback_check). The module, built from Debian's
 # v4l2loopback-dkms source (build_v4l2loopback.sh), is loaded here with the
-# options Chrome needs (exclusive_caps=1) and unloaded at the end. Where the
-# build machine had no v4l2loopback source the module is not in the lab and
-# the results skip.
+# options camhead's package gives it (systemd/camhead-v4l2loopback.conf,
+# packed into the lab at its source path: /dev/video10, named "camhead",
+# exclusive_caps=1 as Chrome needs) and unloaded at the end. Where the build
+# machine had no v4l2loopback source the module is not in the lab and the
+# results skip.
 results="v4l2_loopback_open v4l2_loopback_round_trip v4l2_loopback_close v4l2_loopback_nv12 v4l2_loopback_mjpeg v4l2_loopback_v4l2ctl"
 say() {
   for name in $results; do
@@ -16,12 +18,24 @@ if [ ! -e "/lib/modules/$(uname -r)/extra/v4l2loopback.ko" ]; then
   say "SKIP v4l2loopback.ko is not in the lab (install v4l2loopback-dkms: cmake/bootstrap.sh)"
   exit 0
 fi
-if ! modprobe v4l2loopback video_nr=10 exclusive_caps=1 card_label=camhead; then
-  say "FAIL modprobe v4l2loopback failed"
+conf=$(find / -xdev -name camhead-v4l2loopback.conf 2>/dev/null | head -n 1)
+options=$(sed -n 's/^options v4l2loopback //p' "$conf" 2>/dev/null)
+if [ -z "$options" ]; then
+  say "FAIL no options line in camhead-v4l2loopback.conf ('$conf')"
+  exit 1
+fi
+# shellcheck disable=SC2086 # the options are words
+if ! modprobe v4l2loopback $options; then
+  say "FAIL modprobe v4l2loopback $options failed"
   exit 1
 fi
 [ -c /dev/video10 ] || {
-  say "FAIL v4l2loopback loaded but /dev/video10 is missing"
+  say "FAIL v4l2loopback loaded with '$options' but /dev/video10 is missing"
+  exit 1
+}
+name=$(cat /sys/class/video4linux/video10/name 2>/dev/null)
+[ "$name" = camhead ] || {
+  say "FAIL /dev/video10 is named '$name', not camhead ('$options')"
   exit 1
 }
 
