@@ -19,7 +19,6 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -27,7 +26,6 @@
 #include <string>
 #include <vector>
 
-#include "camhead/renderer/adaptive.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/dof_gather.h"
@@ -36,6 +34,7 @@
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/scene_loader.h"
 #include "chart_errors.h"
+#include "chart_methods.h"
 #include "chart_plot.h"
 #include "commands.h"
 #include "progress.h"
@@ -58,174 +57,6 @@ struct ChartArgs {
   std::string device;
   std::vector<std::string> methods; // empty = all
 };
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
-// Median of `frames` timed calls after `warmup` untimed ones; `frame` returns
-// the seconds of one call.
-double median_seconds(const ChartArgs &args, const std::function<double()> &frame) {
-  std::vector<double> times;
-  for (int i = 0; i < args.warmup + args.frames; ++i) {
-    const double s = frame();
-    if (i >= args.warmup)
-      times.push_back(s);
-  }
-  return median(times);
-}
-
-// A frame's time as the chart counts it: the device's own timestamps where
-// it has them (a host clock adds the latency of submitting and waiting,
-// which is most of a frame under 3 ms on an H100 and the same for every
-// method), else the wall time of the call.
-double frame_seconds(const RenderResult &r) {
-  return r.timings.device_s > 0.0 ? r.timings.device_s : r.seconds;
-}
-
-// ---------------------------------------------------------------- methods
-
-// What a method needs to make frames of one scene.
-struct ChartContext {
-  const Scene &scene;
-  GpuTracer &tracer;
-  DofGather &gather;
-  const ChartArgs &args;
-  std::span<const glm::vec4> plate; // I_c for the gather's composite; empty without
-  float max_blur_radius_px = 0.0f;  // of the scene's depth range, for the gather
-};
-
-struct Measurement {
-  Image composite;
-  double frame_s = 0.0;
-  double post_s = std::numeric_limits<double>::quiet_NaN(); // image-space pass, part of frame_s
-};
-
-struct Method {
-  const char *name;         // CSV and legend
-  const char *description;  // --help
-  std::vector<int> budgets; // rays per pixel
-  chart::Rgb color;
-  chart::Marker marker;
-  Measurement (*run)(ChartContext &, int rpp);
-};
-
-// The tracer's frame at `rpp` with camera sampler `sampler`.
-Measurement run_traced(ChartContext &c, int rpp, CameraSampler sampler) {
-  gpu::FrameParams frame = make_frame_params(c.scene, rpp);
-  set_camera_sampler(frame, sampler);
-  Measurement m;
-  m.frame_s = median_seconds(c.args, [&] {
-    return frame_seconds(c.tracer.render(frame, {}, LayerSelection::display_only()));
-  });
-  m.composite = c.tracer.render(frame).composite;
-  return m;
-}
-
-// 1. The tracer as it is: stratified jittered pixel and lens samples
-//    (method.md section 2).
-Measurement run_uniform(ChartContext &c, int rpp) {
-  return run_traced(c, rpp, CameraSampler::cmj);
-}
-
-// 1b. The same budgets with the low-discrepancy sampler: pixel and aperture
-//     jointly from Owen-scrambled Sobol' (sampling.glsl).
-Measurement run_sobol(ChartContext &c, int rpp) {
-  return run_traced(c, rpp, CameraSampler::sobol);
-}
-
-// 2. Image-space depth of field: a pinhole render (aperture radius 0) at
-//    `rpp` for antialiasing, blurred by dof_gather.comp. Frame time = the
-//    pinhole frame (up to the display image in host memory) + the gather
-//    kernel with its input on the device, which is what a frame that ran
-//    both on one GPU would take; the host round trip the gather gets its
-//    input through here is not counted.
-Measurement run_pinhole_gather(ChartContext &c, int rpp) {
-  gpu::FrameParams pinhole = make_frame_params(c.scene, rpp);
-  set_pinhole(pinhole);
-  const gpu::FrameParams lens = make_frame_params(c.scene, rpp);
-  const double trace_s = median_seconds(c.args, [&] {
-    return frame_seconds(c.tracer.render(pinhole, {}, LayerSelection::display_only()));
-  });
-  const RenderResult layers = c.tracer.render(pinhole);
-  DofGatherSettings settings;
-  settings.max_radius_px = c.max_blur_radius_px;
-  Measurement m;
-  const double gather_s = median_seconds(c.args, [&] {
-    DofGatherResult r = c.gather.apply(layers, lens, c.plate, settings);
-    m.composite = std::move(r.image.composite);
-    return r.device_s > 0.0 ? r.device_s : r.gather_s;
-  });
-  m.frame_s = trace_s + gather_s;
-  m.post_s = gather_s;
-  return m;
-}
-
-// 3. Adaptive ray budget (renderer adaptive.h): `rpp` rays per pixel on
-//    average, a pilot then each pixel's share by its variance and blur, no
-//    share over `max_factor` times the mean.
-Measurement run_adaptive_capped(ChartContext &c, int rpp, float max_factor) {
-  const gpu::FrameParams frame = make_frame_params(c.scene, rpp);
-  AdaptiveSampling settings;
-  settings.max_factor = max_factor;
-  Measurement m;
-  m.frame_s = median_seconds(c.args, [&] {
-    return frame_seconds(
-        c.tracer.render_adaptive(frame, settings, {}, LayerSelection::display_only()));
-  });
-  m.composite = c.tracer.render_adaptive(frame, settings).composite;
-  return m;
-}
-
-Measurement run_adaptive(ChartContext &c, int rpp) {
-  return run_adaptive_capped(c, rpp, AdaptiveSampling{}.max_factor);
-}
-
-// 3b. The same with no share over 4x the mean: on a GPU the second pass
-//     lasts as long as its longest invocation, one pixel's whole share
-//     (bench/RESULTS.md, "Adaptive on a GPU: the longest share").
-Measurement run_adaptive_cap4(ChartContext &c, int rpp) {
-  return run_adaptive_capped(c, rpp, 4.0f);
-}
-
-// The method table: a new sampler (low-discrepancy, adaptive) is one more
-// entry here with its own run function; the chart, CSV and legend follow.
-const std::vector<Method> &methods() {
-  static const std::vector<Method> table = {
-      {"uniform",
-       "thin-lens tracer, stratified jittered sampling (method.md 2)",
-       {1, 4, 9, 16, 25, 49, 100},
-       {31, 119, 180},
-       chart::Marker::circle,
-       run_uniform},
-      {"sobol",
-       "thin-lens tracer, Owen-scrambled Sobol' pixel and lens samples (sampling.glsl)",
-       {1, 4, 9, 16, 25, 49, 100},
-       {255, 127, 14},
-       chart::Marker::triangle,
-       run_sobol},
-      {"pinhole+gather",
-       "pinhole render + depth-aware gather blur (dof_gather.comp)",
-       {1, 4, 16},
-       {214, 39, 40},
-       chart::Marker::square,
-       run_pinhole_gather},
-      {"adaptive",
-       "thin-lens tracer, adaptive ray budget per pixel from a pilot (renderer adaptive.h)",
-       {4, 9, 16, 25, 49},
-       {44, 160, 44},
-       chart::Marker::diamond,
-       run_adaptive},
-      {"adaptive-cap4",
-       "adaptive, no pixel over 4x the mean rays (a GPU's longest thread 4x shorter)",
-       {4, 9, 16, 25, 49},
-       {148, 103, 189},
-       chart::Marker::diamond,
-       run_adaptive_cap4},
-  };
-  return table;
-}
 
 // ---------------------------------------------------------------- reference
 
@@ -365,7 +196,7 @@ std::string fmt(double v, const char *format = "%.6g") {
   return buf;
 }
 
-void write_chart(const SceneRun &run, const std::vector<const Method *> &chosen,
+void write_chart(const SceneRun &run, const std::vector<const chart::Method *> &chosen,
                  const std::string &device, const fs::path &png) {
   std::vector<chart::Panel> panels(2);
   panels[0].title = "all pixels";
@@ -375,7 +206,7 @@ void write_chart(const SceneRun &run, const std::vector<const Method *> &chosen,
     panel.x_label = "frame time (ms)";
     panel.y_label = "relative RMSE";
   }
-  for (const Method *method : chosen) {
+  for (const chart::Method *method : chosen) {
     for (std::size_t p = 0; p < panels.size(); ++p) {
       chart::Series s;
       s.name = method->name;
@@ -407,14 +238,14 @@ int run_chart(const ChartArgs &args) {
     if (!(args.scale > 0.0) || std::abs(k * args.scale - 1.0) > 1e-6)
       throw std::runtime_error("--scale " + fmt(args.scale) +
                                " must be 1/k for a whole k (1, 0.5, 0.25, ...)");
-    std::vector<const Method *> chosen;
-    for (const Method &m : methods())
+    std::vector<const chart::Method *> chosen;
+    for (const chart::Method &m : chart::methods())
       if (args.methods.empty() ||
           std::find(args.methods.begin(), args.methods.end(), m.name) != args.methods.end())
         chosen.push_back(&m);
     for (const std::string &name : args.methods)
-      if (std::none_of(methods().begin(), methods().end(),
-                       [&](const Method &m) { return name == m.name; }))
+      if (std::none_of(chart::methods().begin(), chart::methods().end(),
+                       [&](const chart::Method &m) { return name == m.name; }))
         throw std::runtime_error("--methods: no method '" + name + "'");
 
     const fs::path out_dir = args.out_dir;
@@ -436,7 +267,7 @@ int run_chart(const ChartArgs &args) {
     for (const std::string &file : args.scenes) {
       scenes.push_back(load_scaled(file, args.scale));
       const double pixels = double(scenes.back().render.width) * scenes.back().render.height;
-      for (const Method *m : chosen)
+      for (const chart::Method *m : chosen)
         for (int rpp : m->budgets)
           rays_total += pixels * rpp * (args.warmup + args.frames + 1);
     }
@@ -481,11 +312,12 @@ int run_chart(const ChartArgs &args) {
 
       tracer.load(compiled);
       const std::vector<glm::vec4> plate = plate_vec4(scene);
-      ChartContext context{scene, tracer, gather, args, plate, max_radius};
-      for (const Method *method : chosen)
+      chart::Context context{
+          scene, tracer, gather, {.frames = args.frames, .warmup = args.warmup}, plate, max_radius};
+      for (const chart::Method *method : chosen)
         for (int rpp : method->budgets) {
           const Clock::time_point start = Clock::now();
-          Measurement m = method->run(context, rpp);
+          chart::Measurement m = method->run(context, rpp);
           timed_s += std::chrono::duration<double>(Clock::now() - start).count();
           rays_done += double(run.width) * run.height * rpp * (args.warmup + args.frames + 1);
           Row row{method->name,
@@ -565,7 +397,7 @@ int run_chart(const ChartArgs &args) {
 void add_bench_chart_command(CLI::App &bench) {
   auto args = std::make_shared<ChartArgs>();
   std::string method_list;
-  for (const Method &m : methods()) {
+  for (const chart::Method &m : chart::methods()) {
     std::string budgets;
     for (int rpp : m.budgets)
       budgets += (budgets.empty() ? "" : ", ") + std::to_string(rpp);
