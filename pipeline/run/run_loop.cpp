@@ -31,8 +31,7 @@
 #include "rig_setup.h"
 #include "run_paths.h"
 #include "run_status.h"
-#include "service/output_watchdog.h"
-#include "service/service_notifier.h"
+#include "service/service_heartbeat.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
 #include "tracking/pose_trace.h"
@@ -86,7 +85,6 @@ private:
   void render_loop();
   void output_loop();
   void status_loop();
-  [[nodiscard]] OutputProgress output_progress() const;
   // A frame's request as the board and the options make it.
   [[nodiscard]] renderer::FrameRequest board_request() const;
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
@@ -492,30 +490,12 @@ void Pipeline::output_loop() {
   }
 }
 
-OutputProgress Pipeline::output_progress() const {
-  return {.composites = counters_.frames_out,
-          .placeholders = counters_.placeholders,
-          .camera_lost = counters_.camera_lost,
-          .renderer_lost = counters_.renderer_lost};
-}
-
 // The status line (run_status.h), a line a second, and what systemd hears
 // (RunOptions::service).
 void Pipeline::status_loop() {
   if (status_)
     status_->start();
-  const ServiceNotifier *service =
-      options_.service != nullptr && options_.service->active() ? options_.service : nullptr;
-  bool ready = false;
-  // WATCHDOG=1 at half systemd's timeout, as sd_watchdog_enabled(3) advises.
-  const std::int64_t watchdog_ns =
-      service != nullptr && service->watchdog_timeout()
-          ? std::chrono::duration_cast<std::chrono::nanoseconds>(*service->watchdog_timeout())
-                    .count() /
-                2
-          : 0;
-  OutputProgress watched = output_progress();
-  std::int64_t watched_ns = start_ns_;
+  ServiceHeartbeat heartbeat(options_.service, counters_);
   std::uint64_t last_in = 0, last_out = 0;
   std::int64_t last_ns = start_ns_;
   // Awake often, so that a run ends as soon as its last frame is out (it
@@ -523,31 +503,17 @@ void Pipeline::status_loop() {
   while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
     std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
-    if (service != nullptr && !ready &&
-        counters_.frames_out + counters_.placeholders + counters_.repeats > 0) {
-      ready = service->notify("READY=1");
-      watched = output_progress();
-      watched_ns = now;
-    }
-    if (ready && watchdog_ns > 0 && now - watched_ns >= watchdog_ns) {
-      const OutputProgress progress = output_progress();
-      if (output_advanced(watched, progress))
-        (void)service->notify("WATCHDOG=1");
-      watched = progress;
-      watched_ns = now;
-    }
+    heartbeat.tick(now);
     if (!status_ || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
     status_->second(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out);
-    if (service != nullptr)
-      (void)service->notify("STATUS=" + status_->last_line());
+    heartbeat.status(status_->last_line());
     last_in = in;
     last_out = out;
     last_ns = now;
   }
-  if (service != nullptr)
-    (void)service->notify("STOPPING=1");
+  heartbeat.stopping();
   if (status_)
     status_->end();
 }
