@@ -56,8 +56,9 @@ DriverQuirks detect_quirks(const VkPhysicalDeviceProperties &properties) {
   quirks.software_device = properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const bool llvmpipe = std::string_view(properties.deviceName).starts_with("llvmpipe");
   quirks.indirect_dispatch_keeps_base = llvmpipe;
-  quirks.max_samples_per_dispatch = llvmpipe ? 16u : 0u;
   quirks.max_loop_iterations = llvmpipe ? 65535u : 0u;
+  constexpr std::uint32_t kLoopIterationsPerSample = 4000; // DriverQuirks
+  quirks.max_samples_per_dispatch = quirks.max_loop_iterations / kLoopIterationsPerSample;
   return quirks;
 }
 

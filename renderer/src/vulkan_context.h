@@ -93,19 +93,19 @@ struct DriverQuirks {
   // An empty vkCmdDispatchBase at base 0 before it resets that
   // (vk::dispatch_indirect).
   bool indirect_dispatch_keeps_base = false;
-  // The most samples per pixel one dispatch of the trace kernel may take, 0
-  // for no bound. Mesa's llvmpipe (gallivm, lp_bld_limits.h) stops every
-  // loop of a shader invocation, silently, once all its loops together have
-  // run LP_MAX_TGSI_LOOP_ITERATIONS (65535) times: the rest of a pixel's
-  // samples are never traced. The demo's paths take 100-350 iterations of
-  // the kernel's loops a sample (its adaptive shares lost samples from about
-  // 200 on: bench/RESULTS.md, "lavapipe stops a long shader"); 16 samples
-  // leave room for paths twelve times as long.
-  std::uint32_t max_samples_per_dispatch = 0;
   // The most loop iterations a shader invocation may run, all its loops
-  // together (LP_MAX_TGSI_LOOP_ITERATIONS on llvmpipe); 0 for no bound. The
-  // depth-of-field gather's reach comes from it (dof_gather.cpp).
+  // together; 0 for no bound. Mesa's llvmpipe (gallivm, lp_bld_limits.h)
+  // stops every loop of an invocation, silently, once they have run
+  // LP_MAX_TGSI_LOOP_ITERATIONS (65535) times. The depth-of-field gather's
+  // reach comes from it (dof_gather.cpp), and so does:
   std::uint32_t max_loop_iterations = 0;
+  // the most samples per pixel one dispatch of the trace kernel may take
+  // (0: no bound), else the rest of a pixel's samples are never traced. The
+  // demo's paths take 100-350 iterations of the kernel's loops a sample (its
+  // adaptive shares lost samples from about 200 on: bench/RESULTS.md,
+  // "lavapipe stops a long shader"); a budget of 4000 a sample leaves room
+  // for paths ten times as long: 16 samples on llvmpipe.
+  std::uint32_t max_samples_per_dispatch = 0;
 };
 
 struct PhysicalDevice {
