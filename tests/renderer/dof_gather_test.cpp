@@ -29,12 +29,12 @@ renderer::gpu::FrameParams lens() {
 }
 
 // Pinhole layers of constant grey `value`, depth `depth`, no virtual object.
-RenderResult layers(float value, float depth) {
+RenderResult layers(float value, float depth, int width = kWidth, int height = kHeight) {
   RenderResult r;
-  r.mixed = renderer::Image(kWidth, kHeight, 3);
-  r.real = renderer::Image(kWidth, kHeight, 3);
-  r.mask = renderer::Image(kWidth, kHeight, 1);
-  r.depth = renderer::Image(kWidth, kHeight, 1);
+  r.mixed = renderer::Image(width, height, 3);
+  r.real = renderer::Image(width, height, 3);
+  r.mask = renderer::Image(width, height, 1);
+  r.depth = renderer::Image(width, height, 1);
   for (float &v : r.mixed.data)
     v = value;
   r.real.data = r.mixed.data;
@@ -171,15 +171,8 @@ TEST(DofGather, ALongWindowIsGatheredWholeOrNotAtAll) {
   renderer::gpu::FrameParams wide{};
   wide.lens = renderer::gpu::vec4(1.0f, kFocus, 500.0f, 1.0f); // 500 px of blur at 0.5 m
   const auto strip = [&](int bright_y) {
-    RenderResult r;
-    r.mixed = renderer::Image(w, h, 3);
-    r.real = renderer::Image(w, h, 3);
-    r.mask = renderer::Image(w, h, 1);
-    r.depth = renderer::Image(w, h, 1);
-    for (float &z : r.depth.data)
-      z = 0.5f;
-    for (int c = 0; c < 3; ++c)
-      r.mixed.at(1, bright_y)[c] = r.real.at(1, bright_y)[c] = 1.0f;
+    RenderResult r = layers(0.0f, 0.5f, w, h);
+    set_pixel(r, 1, bright_y, 1.0f, 0.5f);
     return r;
   };
   DofGather gather;
