@@ -95,6 +95,24 @@ TEST_F(Service, NotifiesAPathSocketAndAnAbstractOne) {
   EXPECT_EQ(abstract_systemd.receive(), "READY=1");
 }
 
+// systemd drains its socket; one that does not (stopped, or slow) must
+// not hold up the status thread: once the socket's queue is full the
+// messages are lost, at once, never waited for.
+TEST_F(Service, AFullSocketLosesMessagesWithoutWaiting) {
+  const std::string path = (dir_ / "notify").string();
+  const NotifySocket never_read(path);
+  const ServiceNotifier notifier(path);
+  int sent = 0, lost = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 1000; ++i)
+    (notifier.notify("STATUS=in 25.0 fps") ? sent : lost) += 1;
+  const auto took = std::chrono::steady_clock::now() - start;
+  std::printf("%d sent, %d lost in %.1f ms\n", sent, lost,
+              std::chrono::duration<double, std::milli>(took).count());
+  EXPECT_GT(sent, 0);
+  EXPECT_GT(lost, 0) << "the socket's queue never filled";
+}
+
 TEST_F(Service, WithoutASocketNothingIsSent) {
   const ServiceNotifier none;
   EXPECT_FALSE(none.active());
