@@ -303,13 +303,15 @@ void add_bench_command(CLI::App &app) {
   cmd->add_flag("--all-layers", args->all_layers,
                 "Read back every float layer too, not only the 8-bit image a live frame\n"
                 "shows");
-  cmd->add_flag("--adaptive", args->adaptive,
-                "Adaptive ray budget per pixel (a pilot, then shares by variance and blur) at\n"
-                "the same mean rays per pixel");
+  CLI::Option *adaptive =
+      cmd->add_flag("--adaptive", args->adaptive,
+                    "Adaptive ray budget per pixel (a pilot, then shares by variance and blur) at\n"
+                    "the same mean rays per pixel");
   cmd->add_option("--adaptive-cap", args->adaptive_settings.max_factor,
                   "With --adaptive: no pixel gets more than this many times the mean rays\n"
                   "per pixel (on a GPU the largest share is the second pass's longest thread)")
       ->check(CLI::Range(1.0f, 1024.0f))
+      ->needs(adaptive)
       ->capture_default_str();
   cmd->add_option("--frame-ms", args->frame_ms,
                   "Follow a frame-time target instead of --rpp: each frame's rays per pixel\n"
