@@ -16,10 +16,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 run_only=0
-if [ "${1:-}" = --run ]; then
-  run_only=1
-  shift
-fi
+args=()
+for arg in "$@"; do
+  if [ "$arg" = --run ]; then
+    run_only=1
+  else
+    args+=("$arg")
+  fi
+done
+set -- "${args[@]+"${args[@]}"}"
 build_dir=build
 if [ $# -gt 0 ] && [[ $1 != -* ]]; then
   build_dir=$1
