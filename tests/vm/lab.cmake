@@ -89,6 +89,7 @@ get_property(vm_modules DIRECTORY PROPERTY vm_modules)
 get_property(vm_packed_modules DIRECTORY PROPERTY vm_packed_modules)
 get_property(vm_libraries DIRECTORY PROPERTY vm_libraries)
 get_property(vm_files DIRECTORY PROPERTY vm_files)
+get_property(vm_data_files DIRECTORY PROPERTY vm_data_files)
 
 if(vm_missing)
   list(JOIN vm_missing ", " missing_text)
@@ -187,6 +188,10 @@ foreach(file IN LISTS vm_files)
   list(APPEND vm_args --file ${file})
 endforeach()
 list(APPEND vm_extra_depends ${vm_files})
+foreach(file IN LISTS vm_data_files)
+  list(APPEND vm_args --data-file ${file})
+endforeach()
+list(APPEND vm_extra_depends ${vm_data_files})
 add_custom_command(OUTPUT ${lab_dir}/initramfs.cpio.gz
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/make_initramfs.sh
     --out ${lab_dir}/initramfs.cpio.gz --kernel ${vm_kernel}

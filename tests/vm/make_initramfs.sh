@@ -8,7 +8,7 @@
 #       [--module NAME]... [--extra-module FILE.ko]... [--check FILE.sh]...
 #       [--program FILE]... [--library SONAME]...
 #       [--packed-module NAME]... [--packed-extra-module FILE.ko]...
-#       [--file PATH]...
+#       [--file PATH]... [--data-file PATH]...
 #
 # --module and --extra-module are loaded at boot; --packed-module and
 # --packed-extra-module are only packed (with their dependencies), for a
@@ -21,12 +21,16 @@
 # ELF file, the libraries ldd lists: plug-ins and data a library finds by a
 # path it was built with (libcamera's IPA modules and their configuration).
 #
+# --data-file packs a file the checks read into /etc/lab/ under its own name:
+# a fixed place, wherever the checkout is (the guest mounts a tmpfs over
+# /tmp, which would hide a file packed at a path under it).
+#
 # The guest runs the checks in the order given.
 set -euo pipefail
 
 out='' kernel='' busybox='' init=''
 modules=() extra_modules=() checks=() programs=() libraries=()
-packed_modules=() packed_extra_modules=() files=()
+packed_modules=() packed_extra_modules=() files=() data_files=()
 while [ $# -gt 0 ]; do
   case $1 in
   --out) out=$2 ;;
@@ -41,6 +45,7 @@ while [ $# -gt 0 ]; do
   --packed-module) packed_modules+=("$2") ;;
   --packed-extra-module) packed_extra_modules+=("$2") ;;
   --file) files+=("$2") ;;
+  --data-file) data_files+=("$2") ;;
   *)
     echo "make_initramfs.sh: unknown argument $1" >&2
     exit 2
@@ -134,6 +139,9 @@ for file in "${files[@]}"; do
   if [ "$(head -c 4 "$file" | tail -c 3)" = ELF ]; then
     copy_libraries "$file"
   fi
+done
+for file in "${data_files[@]}"; do
+  install -D -m 644 "$file" "$root/etc/lab/$(basename "$file")"
 done
 
 # newc is the format the kernel unpacks; sorted names and fixed times keep

@@ -3,7 +3,7 @@
 # (camhead_v4l2_loopback_check). The module, built from Debian's
 # v4l2loopback-dkms source (build_v4l2loopback.sh), is loaded here with the
 # options camhead's package gives it (systemd/camhead-v4l2loopback.conf,
-# packed into the lab at its source path: /dev/video10, named "camhead",
+# packed into the lab's /etc/lab: /dev/video10, named "camhead",
 # exclusive_caps=1 as Chrome needs) and unloaded at the end. Where the build
 # machine had no v4l2loopback source the module is not in the lab and the
 # results skip.
@@ -18,7 +18,7 @@ if [ ! -e "/lib/modules/$(uname -r)/extra/v4l2loopback.ko" ]; then
   say "SKIP v4l2loopback.ko is not in the lab (install v4l2loopback-dkms: cmake/bootstrap.sh)"
   exit 0
 fi
-conf=$(find / -xdev -name camhead-v4l2loopback.conf 2>/dev/null | head -n 1)
+conf=/etc/lab/camhead-v4l2loopback.conf
 options=$(sed -n 's/^options v4l2loopback //p' "$conf" 2>/dev/null)
 if [ -z "$options" ]; then
   say "FAIL no options line in camhead-v4l2loopback.conf ('$conf')"
