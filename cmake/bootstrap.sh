@@ -47,8 +47,10 @@ test_packages=(
   git clang-format vulkan-tools
   # The service unit's tests: systemd-analyze scores its hardening,
   # systemd-sysusers makes its user in a scratch root (tests/CMakeLists.txt);
-  # lintian checks the Debian package (tests/package/deb_package.sh).
-  systemd lintian
+  # lintian checks the Debian package (tests/package/deb_package.sh);
+  # python3 plays systemd's notification socket for `systemctl reload`
+  # (tests/cli/service_reload.py).
+  systemd lintian python3
   # The demo scene's bunny (scenes/ar_demo.json), which tests and
   # benchmarks render.
   glmark2-data

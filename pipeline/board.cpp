@@ -533,7 +533,9 @@ std::filesystem::path resolve_board(std::string_view name_or_path) {
 Board parse_board(std::string_view json_text, const std::filesystem::path &file) {
   try {
     const base::JsonFile json(json_text, file.string());
-    return BoardReader(file).read(json.root());
+    Board board = BoardReader(file).read(json.root());
+    board.text = json_text;
+    return board;
   } catch (const base::ConfigError &e) {
     throw BoardError(e);
   }

@@ -226,6 +226,9 @@ struct Board {
   std::string name;
   std::string description;
   std::filesystem::path file; // where it was loaded from
+  // The file as it was read: a reload compares with it what only a restart
+  // may change (run/board_reload.h).
+  std::string text;
   LensConfig lens;
   // The live pipeline (`camhead run`); a board without a camera serves only
   // the lens commands.

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "board.h"
@@ -61,6 +62,8 @@ public:
   [[nodiscard]] lens_control::LensState state_at(std::int64_t t_ns) const {
     return tracker_.state_at(t_ns);
   }
+  // A reloaded profile; the readings so far are kept (LensTracker::set_profile).
+  void set_profile(lens_control::LensProfile profile) { tracker_.set_profile(std::move(profile)); }
 
   // Keeps the camera poses the source sends from now on (a FreeD or
   // OpenTrackIO tracker's, in that protocol's axes: `type`), moved back by

@@ -39,6 +39,8 @@ struct RunArgs {
 };
 
 std::atomic<bool> stop_requested{false};
+std::atomic<bool> reload_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
 
 constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
@@ -49,25 +51,39 @@ extern "C" void on_stop_signal(int signal) {
   std::signal(signal, SIG_DFL);
 }
 
+// Under systemd, SIGHUP (`systemctl reload`) reloads the board; the handler
+// stays for the next one.
+extern "C" void on_reload_signal(int) {
+  reload_requested = true;
+}
+
 // The summary, a line for the run and one for each output, and the exit
 // status (docs/input-errors.md): 3 when frames could not be rendered (the
 // GPU failed), 4 when a file output lost frames or could not be completed
 // (a full disk, a size limit), 5 when a device or stream failed (the
 // camera's take broke off, a webcam or display output failed); where more
 // than one applies, the smallest, and every cause is said.
+std::string reloads(const pipeline::RunSummary &s) {
+  if (s.reloads + s.reloads_refused == 0)
+    return {};
+  return "; reloads " + std::to_string(s.reloads) + ", refused " +
+         std::to_string(s.reloads_refused);
+}
+
 int report(const pipeline::RunSummary &s) {
   std::fprintf(stderr,
                "camhead run: %llu frames in, %llu out in %.1f s (%.1f fps out); dropped: "
                "camera %llu, render busy %llu, output busy %llu; render failures %llu, "
                "repeated frames %llu, placeholder frames %llu, output errors %llu, camera "
-               "errors %llu, camera reconnects %llu, frames without their lens state %llu\n",
+               "errors %llu, camera reconnects %llu, frames without their lens state %llu%s\n",
                (unsigned long long)s.frames_in, (unsigned long long)s.frames_out, s.seconds,
                s.seconds > 0 ? double(s.frames_out) / s.seconds : 0.0,
                (unsigned long long)s.camera_dropped, (unsigned long long)s.render_busy,
                (unsigned long long)s.output_busy, (unsigned long long)s.render_failed,
                (unsigned long long)s.repeats, (unsigned long long)s.placeholders,
                (unsigned long long)s.sink_errors, (unsigned long long)s.camera_errors,
-               (unsigned long long)s.camera_reconnects, (unsigned long long)s.lens_late);
+               (unsigned long long)s.camera_reconnects, (unsigned long long)s.lens_late,
+               reloads(s).c_str());
   bool file_failed = false, device_failed = !s.camera_failure.empty();
   for (const pipeline::OutputSummary &o : s.outputs) {
     // A file output no frame reached (a run stopped while it started) keeps
@@ -123,8 +139,15 @@ int run(const RunArgs &args) {
   options.service = &service;
 
   stop_requested = false;
+  reload_requested = false;
   for (const int signal : kStopSignals)
     std::signal(signal, on_stop_signal);
+  // A service's SIGHUP is a reload (systemd/camhead@.service's ExecReload);
+  // in a terminal it is a hangup, and stops the run as Ctrl-C does.
+  if (service.active()) {
+    options.reload = &reload_requested;
+    std::signal(SIGHUP, on_reload_signal);
+  }
   int status = 0;
   try {
     status = report(pipeline::run_pipeline(options));
@@ -193,7 +216,11 @@ void add_run_command(CLI::App &app) {
              "with the lens's depth of field at each frame's mid-exposure and composited into\n"
              "the camera frame, out to every output. Stops at Ctrl-C (or SIGTERM, SIGHUP),\n"
              "after --duration or --frames, or when a camera file played once ends; a\n"
-             "second Ctrl-C ends it at once.\n"
+             "second Ctrl-C ends it at once. Under systemd (camhead@.service) SIGHUP,\n"
+             "`systemctl reload`, reloads the board instead: its scene, lens profile, render\n"
+             "settings and static pose are taken between two frames, without a gap; a\n"
+             "board that does not load, or that changes the camera, outputs, lens sources,\n"
+             "a tracked pose or the executor, is refused with its error and the run goes on.\n"
              "Outputs:\n"
              "  file:PATH.y4m[?format=yuyv|nv12]  Y4M video (ffplay PATH.y4m, mpv PATH.y4m)\n"
              "  file:DIR/%05d.png                 one PNG a frame\n"

@@ -9,6 +9,7 @@ void write_filler_record(std::FILE *out, std::uint64_t output_frame, const char 
                          std::int64_t output_ns) {
   std::fprintf(out, "{\"output_frame\":%" PRIu64 ",\"kind\":\"%s\",\"output_ns\":%" PRId64 "}\n",
                output_frame, kind, output_ns);
+  std::fflush(out); // a line as each frame goes out, for `tail -f` or a FIFO's reader
 }
 
 std::string json_string(std::string_view text) {
@@ -36,9 +37,9 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
   std::fprintf(
       out,
       "{\"output_frame\":%" PRIu64 ",\"kind\":\"composite\",\"sequence\":%" PRIu64
-      ",\"capture_ns\":%" PRId64 ",\"exposure_mid_ns\":%" PRId64 ",\"delivered_ns\":%" PRId64
-      ",\"render_start_ns\":%" PRId64 ",\"render_end_ns\":%" PRId64 ",\"output_ns\":%" PRId64
-      ",\"focus_m\":%s,\"f_number\":%.6g"
+      ",\"setup\":%" PRIu64 ",\"capture_ns\":%" PRId64 ",\"exposure_mid_ns\":%" PRId64
+      ",\"delivered_ns\":%" PRId64 ",\"render_start_ns\":%" PRId64 ",\"render_end_ns\":%" PRId64
+      ",\"output_ns\":%" PRId64 ",\"focus_m\":%s,\"f_number\":%.6g"
       ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
       ",\"camera_rays\":%" PRIu64 ",\"history_samples\":%u,\"reprojected_samples\":%" PRIu64
       ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
@@ -46,8 +47,8 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"pose\":{\"position\":[%.7g,%.7g,%.7g],\"forward\":[%.6g,%.6g,%.6g]"
       ",\"up\":[%.6g,%.6g,%.6g]},\"markers_seen\":%d,\"reprojection_px\":%s"
       ",\"track_ms\":%.3f,\"pose_wait_ms\":%.3f}\n",
-      output_frame, r.sequence, r.capture_ns, r.exposure_mid_ns, r.delivered_ns, r.render_start_ns,
-      r.render_end_ns, output_ns,
+      output_frame, r.sequence, r.setup, r.capture_ns, r.exposure_mid_ns, r.delivered_ns,
+      r.render_start_ns, r.render_end_ns, output_ns,
       std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
       r.focal_length_mm, r.lens_fresh ? "true" : "false", 1e3 * r.lens_wait_s, r.rpp, r.camera_rays,
       r.history_samples, r.reprojected_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
@@ -55,6 +56,7 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       r.pose_fresh ? "true" : "false", r.position.x, r.position.y, r.position.z, r.forward.x,
       r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z, r.markers_seen, reprojection,
       1e3 * r.track_s, 1e3 * r.pose_wait_s);
+  std::fflush(out);
 }
 
 } // namespace camhead::pipeline

@@ -15,6 +15,7 @@ namespace camhead::pipeline {
 // What the record says of one composite.
 struct FrameRecord {
   std::uint64_t sequence = 0;
+  std::uint64_t setup = 0; // what it was rendered with: 0 as the run started, +1 per reload
   std::int64_t capture_ns = 0;
   std::int64_t exposure_mid_ns = 0;
   std::int64_t delivered_ns = 0; // when the camera handed the frame over

@@ -89,6 +89,14 @@ PoseSnapshot LensHub::pose_at(std::int64_t t_ns, const CameraPose &rest) const {
   return {at->pose, at->fresh && connected_[*pose_channel_]};
 }
 
+void LensHub::set_profile(const lens_control::LensProfile &profile) {
+  // Copied before the lock: a frame waiting for its lens waits on it.
+  std::vector<lens_control::LensProfile> copies(channels_.size(), profile);
+  std::lock_guard lock(mutex_);
+  for (std::size_t i = 0; i < channels_.size(); ++i)
+    channels_[i].set_profile(std::move(copies[i]));
+}
+
 std::string LensHub::source_name() const {
   std::lock_guard lock(mutex_);
   const LensChannel &lens = channels_.front();

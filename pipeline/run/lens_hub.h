@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "camhead/lens_control/lens_profile.h"
 #include "camhead/lens_control/lens_state.h"
 #include "lens_sources.h"
 
@@ -71,6 +72,10 @@ public:
   // "static", or the tracker's type and lens source ("freed:tracker"), for
   // the record and the status line.
   [[nodiscard]] const std::string &pose_source() const { return pose_source_; }
+
+  // Every source's readings mapped through `profile` from the next state_at()
+  // on (a reload): the history stays, so no frame loses its lens.
+  void set_profile(const lens_control::LensProfile &profile);
 
   // "focus pull [trace ...]" for the status line.
   [[nodiscard]] std::string source_name() const;

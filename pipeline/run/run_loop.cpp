@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <system_error>
 #include <thread>
@@ -15,6 +16,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "board_reload.h"
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
 #include "camhead/base/thread_name.h"
@@ -24,8 +26,10 @@
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "frame_record.h"
+#include "frame_setup.h"
 #include "lens_camera.h"
 #include "lens_hub.h"
+#include "lens_sources.h"
 #include "output_uri.h"
 #include "placeholder.h"
 #include "rig_setup.h"
@@ -85,8 +89,12 @@ private:
   void render_loop();
   void output_loop();
   void status_loop();
-  // A frame's request as the board and the options make it.
-  [[nodiscard]] renderer::FrameRequest board_request() const;
+  // On each RunOptions::reload: the board read anew, checked, and its setup
+  // made and handed to the render thread; `live` is the board running.
+  void reload_loop(Board live);
+  // One reload: the new setup taken, or why not (for the status line and
+  // the journal).
+  std::string reload(Board &live, std::uint64_t generation);
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
   // are on their way, and says how long in the record.
   LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
@@ -103,12 +111,13 @@ private:
   template <typename Frame> void send(Frame frame, std::int64_t capture_ns);
 
   const RunOptions &options_;
+  // The board as the run started: what only a restart changes (the camera,
+  // the outputs, the lens sources, the pose's kind, the executor).
   const Board &board_;
-  const renderer::Scene scene_;
-  // The scene's camera at the board's static pose, on the camera's sensor;
-  // a tracker's pose replaces its place frame by frame.
-  const renderer::FrameCamera base_camera_;
-  const CameraPose rest_pose_;
+  // What frames are rendered with (the scene, the static pose, the render
+  // settings, the renderer): the render thread's, replaced by reloads.
+  std::unique_ptr<FrameSetup> setup_;
+  SetupHandover handover_;
   LensHub lens_;
   std::unique_ptr<CameraSource> camera_;
   // A marker pose's tracker (null for any other pose): fed by the capture
@@ -117,7 +126,6 @@ private:
   // A trace pose's camera path.
   std::optional<PoseTrace> pose_trace_;
   double fps_ = 25.0;
-  std::unique_ptr<renderer::FrameRenderer> renderer_;
   std::vector<std::unique_ptr<FrameSink>> sinks_;
   std::vector<bool> file_sinks_;           // which sinks are files (their errors: exit 4)
   std::vector<std::uint64_t> sink_failed_; // output thread: frames each sink did not take
@@ -136,6 +144,10 @@ private:
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   RunCounters counters_;
+  // The reload thread's word for the status thread: the last outcome.
+  std::mutex reload_mutex_;
+  std::string reload_note_;
+  std::atomic<std::uint64_t> reloads_{0}, reloads_refused_{0};
   std::optional<RunStatus> status_; // the status line, unless options_.status is null
   std::atomic<bool> stopping_{false};
   // A camera that waits for its consumer (a file not played in real time):
@@ -172,22 +184,22 @@ const Board &checked_board(const RunOptions &options) {
 // camera comes before the renderer: a take's size is checked against the
 // board before anything of that size is allocated.
 Pipeline::Pipeline(const RunOptions &options)
-    : options_(options), board_(checked_board(options)), scene_(load_run_scene(board_)),
-      base_camera_(base_camera(board_, scene_)), rest_pose_(pose_of(base_camera_)), lens_(board_),
-      camera_(open_camera(board_, scene_, base_camera_, lens_, options.threads)),
-      markers_(open_marker_source(board_, camera_->format(), base_camera_, lens_,
+    : options_(options), board_(checked_board(options)), setup_(load_frame_setup(board_)),
+      lens_(board_),
+      camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_, options.threads)),
+      markers_(open_marker_source(board_, camera_->format(), setup_->base_camera, lens_,
                                   offline_take(board_),
                                   lens_wait_ns(offline_take(board_), camera_fps(*camera_)))),
       pose_trace_(board_.pose && board_.pose->type == PoseType::trace
                       ? std::optional<PoseTrace>(load_pose_trace(board_.pose->file))
                       : std::nullopt),
-      fps_(camera_fps(*camera_)),
-      renderer_(make_renderer(board_, options.executor.value_or(board_.render.executor), scene_,
-                              options.threads)),
-      executor_name_(renderer_->executor()), record_fields_{json_string(executor_name_),
-                                                            json_string(pose_source_name())} {
+      fps_(camera_fps(*camera_)) {
+  setup_->renderer = make_renderer(board_, options.executor.value_or(board_.render.executor),
+                                   setup_->scene, options.threads);
+  executor_name_ = setup_->renderer->executor();
+  record_fields_ = {json_string(executor_name_), json_string(pose_source_name())};
   const std::vector<OutputSpec> specs = output_specs(options);
-  std::vector<RunPath> paths = run_inputs(board_, scene_);
+  std::vector<RunPath> paths = run_inputs(board_, setup_->scene);
   for (RunPath &output : run_outputs(specs))
     paths.push_back(std::move(output));
   if (options.stats_file)
@@ -211,9 +223,9 @@ Pipeline::Pipeline(const RunOptions &options)
   for (const auto &sink : sinks_)
     formats.push_back(sink->format());
   // The lens as it is now decides the kernels prepare() builds (its model).
-  renderer::FrameRequest first = board_request();
-  first.camera = lens_camera(base_camera_, lens_.state_at(base::monotonic_ns()).state);
-  renderer_->prepare(first, camera_->format(), formats);
+  renderer::FrameRequest first = setup_request(*setup_, options_.influence_region);
+  first.camera = lens_camera(setup_->base_camera, lens_.state_at(base::monotonic_ns()).state);
+  setup_->renderer->prepare(first, camera_->format(), formats);
   for (Slot &slot : slots_)
     for (const auto &sink : sinks_)
       slot.images.emplace_back(base::frame_bytes(sink->format()));
@@ -239,15 +251,6 @@ Pipeline::Pipeline(const RunOptions &options)
 Pipeline::~Pipeline() {
   if (stats_ != nullptr)
     std::fclose(stats_); // a run that failed: what was recorded stays
-}
-
-renderer::FrameRequest Pipeline::board_request() const {
-  renderer::FrameRequest request;
-  request.camera = base_camera_;
-  request.adaptive = board_.render.adaptive;
-  request.influence_region = options_.influence_region;
-  request.accumulation = board_.render.accumulation;
-  return request;
 }
 
 bool Pipeline::should_stop() const {
@@ -300,11 +303,7 @@ void Pipeline::capture_loop() {
 }
 
 void Pipeline::render_loop() {
-  renderer::FrameBudgetSettings budget_settings;
-  budget_settings.target_s = 1.0 / fps_;
-  budget_settings.min_rpp = board_.render.min_rays_per_pixel;
-  budget_settings.max_rpp = board_.render.max_rays_per_pixel;
-  renderer::FrameBudget budget(budget_settings);
+  renderer::FrameBudget budget(frame_budget_settings(setup_->board.render, fps_));
   std::optional<std::uint64_t> last_sequence;
   std::uint64_t rendered = 0;
   for (;;) {
@@ -313,6 +312,9 @@ void Pipeline::render_loop() {
         std::this_thread::sleep_for(10ms);
       break;
     }
+    // A reload's setup, between two frames (and while no camera sends).
+    if (handover_.take(setup_))
+      budget = renderer::FrameBudget(frame_budget_settings(setup_->board.render, fps_));
     std::optional<Delivered> delivered = captured_.pop(100ms);
     if (!delivered) {
       if (captured_.drained())
@@ -332,6 +334,7 @@ void Pipeline::render_loop() {
     FrameRecord &r = slot.record;
     r = {};
     r.sequence = frame.sequence;
+    r.setup = setup_->generation;
     r.capture_ns = frame.timestamp_ns;
     r.exposure_mid_ns = hal::camera::mid_exposure_ns(frame);
     r.delivered_ns = delivered->at_ns;
@@ -348,16 +351,16 @@ void Pipeline::render_loop() {
     r.lens_fresh = lens.fresh;
     const PoseSnapshot pose = pose_at(frame.sequence, r);
     const renderer::FrameCamera posed = markers_ || pose_trace_ || lens_.tracks_pose()
-                                            ? placed(base_camera_, pose.pose)
-                                            : base_camera_;
+                                            ? placed(setup_->base_camera, pose.pose)
+                                            : setup_->base_camera;
     r.pose_fresh = pose.fresh;
     counters_.pose_stale = !pose.fresh;
     r.position = posed.position;
     r.forward = glm::normalize(posed.look_at - posed.position);
     r.up = posed.up;
-    renderer::FrameRequest request = board_request();
+    renderer::FrameRequest request = setup_request(*setup_, options_.influence_region);
     request.camera = lens_camera(posed, lens.state);
-    request.rays_per_pixel = board_.render.rays_per_pixel.value_or(budget.rpp());
+    request.rays_per_pixel = setup_->board.render.rays_per_pixel.value_or(budget.rpp());
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     r.rpp = request.rays_per_pixel;
 
@@ -365,7 +368,7 @@ void Pipeline::render_loop() {
       targets_[i] = {sinks_[i]->format(), slot.images[i]};
     r.render_start_ns = base::monotonic_ns();
     const renderer::FrameReport report =
-        renderer_->render(request, {frame.format, frame.bytes}, targets_);
+        setup_->renderer->render(request, {frame.format, frame.bytes}, targets_);
     r.render_end_ns = base::monotonic_ns();
     delivered->frame.reset(); // the camera may fill the buffer again
     if (report.status != renderer::FrameStatus::ok) {
@@ -421,10 +424,10 @@ PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
   if (pose_trace_)
     return {pose_trace_->at(record.exposure_mid_ns), true};
   if (!markers_)
-    return lens_.pose_at(record.exposure_mid_ns, rest_pose_);
+    return lens_.pose_at(record.exposure_mid_ns, setup_->rest_pose);
   const std::int64_t deadline = record.delivered_ns + lens_wait_ns(lossless_, fps_);
   const FramePose found =
-      markers_->pose_for(sequence, record.exposure_mid_ns, deadline, rest_pose_);
+      markers_->pose_for(sequence, record.exposure_mid_ns, deadline, setup_->rest_pose);
   record.markers_seen = found.markers_seen;
   record.reprojection_px = found.reprojection_px;
   record.track_s = found.track_s;
@@ -490,6 +493,57 @@ void Pipeline::output_loop() {
   }
 }
 
+std::string Pipeline::reload(Board &live, std::uint64_t generation) {
+  try {
+    // Everything is read, checked and made beside the running setup; the
+    // render thread only swaps it in between two frames.
+    Board board = reread_board(live);
+    lens_control::LensProfile profile = load_board_profile(board);
+    std::unique_ptr<FrameSetup> next = load_frame_setup(board);
+    next->renderer = make_renderer(next->board, options_.executor.value_or(board_.render.executor),
+                                   next->scene, options_.threads);
+    std::vector<base::VideoFormat> formats;
+    for (const auto &sink : sinks_)
+      formats.push_back(sink->format());
+    renderer::FrameRequest first = setup_request(*next, options_.influence_region);
+    first.camera = lens_camera(next->base_camera, lens_.state_at(base::monotonic_ns()).state);
+    next->renderer->prepare(first, camera_->format(), formats);
+    next->generation = generation;
+    bool taken = false;
+    // Freed here, not in the render thread: the setup it replaced (or this
+    // one, when the run ended first).
+    std::unique_ptr<FrameSetup> spent = handover_.offer(
+        std::move(next), [this] { return should_stop(); }, taken);
+    if (!taken)
+      return {};
+    lens_.set_profile(profile);
+    live = std::move(board);
+    ++reloads_;
+    return "reloaded " + live.file.string() + ": setup " + std::to_string(generation);
+  } catch (const std::exception &e) {
+    ++reloads_refused_;
+    return std::string("reload refused, the run goes on as it was: ") + e.what();
+  }
+}
+
+void Pipeline::reload_loop(Board live) {
+  while (!should_stop()) {
+    std::this_thread::sleep_for(20ms);
+    if (!options_.reload->exchange(false))
+      continue;
+    if (options_.service != nullptr)
+      (void)options_.service->notify("RELOADING=1\nMONOTONIC_USEC=" +
+                                     std::to_string(base::monotonic_ns() / 1000));
+    const std::string note = reload(live, reloads_ + 1);
+    if (note.empty())
+      break; // the run ended first
+    if (options_.service != nullptr)
+      (void)options_.service->notify("READY=1\nSTATUS=" + note);
+    const std::lock_guard lock(reload_mutex_);
+    reload_note_ = note;
+  }
+}
+
 // The status line (run_status.h), a line a second, and what systemd hears
 // (RunOptions::service).
 void Pipeline::status_loop() {
@@ -504,6 +558,11 @@ void Pipeline::status_loop() {
     std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
     heartbeat.tick(now);
+    if (status_) {
+      const std::lock_guard lock(reload_mutex_);
+      if (!reload_note_.empty())
+        status_->note(std::exchange(reload_note_, {}));
+    }
     if (!status_ || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
@@ -522,6 +581,11 @@ RunSummary Pipeline::run() {
   start_ns_ = base::monotonic_ns();
   std::vector<std::thread> threads;
   try {
+    if (options_.reload != nullptr)
+      threads.emplace_back([this, live = setup_->board]() mutable {
+        base::name_this_thread("camhead-reload");
+        reload_loop(std::move(live));
+      });
     threads.emplace_back([this] {
       base::name_this_thread("camhead-capture");
       capture_loop();
@@ -588,6 +652,8 @@ RunSummary Pipeline::finish() {
   summary.render_failed = counters_.render_failed;
   summary.placeholders = counters_.placeholders;
   summary.repeats = counters_.repeats;
+  summary.reloads = reloads_;
+  summary.reloads_refused = reloads_refused_;
   summary.sink_errors += counters_.sink_errors;
   summary.seconds = double(base::monotonic_ns() - start_ns_) * 1e-9;
   summary.executor = executor_name_;

@@ -61,6 +61,13 @@ struct RunOptions {
   // camera frames and hangs until the run is stopped, as one stuck in a
   // driver would (the output repeats the last composite meanwhile).
   std::optional<std::uint64_t> stall_render_after_frames;
+  // Set (by SIGHUP) to reload the board from its file: the scene, the lens
+  // profile, the render settings and a static pose are taken between two
+  // frames, with no gap in the outputs; a board that does not load, or that
+  // changes what takes a restart (run/board_reload.h), is refused with its
+  // error on the status output and in systemd's STATUS=, and the run goes
+  // on as it was. The run clears it when it starts a reload. Null: none.
+  std::atomic<bool> *reload = nullptr;
 };
 
 // What one output took.
@@ -85,7 +92,9 @@ struct RunSummary {
   std::uint64_t placeholders = 0; // placeholder frames sent (no camera, or none yet)
   std::uint64_t repeats = 0;      // the last composite sent again (the camera was slow)
   std::uint64_t sink_errors = 0;
-  std::uint64_t lens_late = 0; // composites whose lens state did not cover their mid-exposure
+  std::uint64_t lens_late = 0;       // composites whose lens state did not cover their mid-exposure
+  std::uint64_t reloads = 0;         // taken (RunOptions::reload)
+  std::uint64_t reloads_refused = 0; // refused, the run going on as it was
   std::vector<OutputSummary> outputs;
   // Why the camera ended the run, if it broke off (a take played once with
   // a frame that cannot be read), naming the file and frame.

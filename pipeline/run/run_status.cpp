@@ -63,6 +63,11 @@ void RunStatus::second(std::int64_t now_ns, double dt, std::uint64_t in, std::ui
   std::fflush(out_);
 }
 
+void RunStatus::note(const std::string &text) {
+  std::fprintf(out_, "%scamhead run: %s\n", tty_ ? "\r\033[K" : "", text.c_str());
+  std::fflush(out_);
+}
+
 void RunStatus::end() {
   if (tty_)
     std::fprintf(out_, "\n");

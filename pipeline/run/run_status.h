@@ -34,6 +34,8 @@ public:
   // The last second's line as second() wrote it, without the terminal's
   // control codes (the service's STATUS=); empty before the first.
   [[nodiscard]] const std::string &last_line() const { return last_line_; }
+  // A line of its own ("camhead run: reloaded ...").
+  void note(const std::string &text);
   // Ends the line being redrawn; from here every line is a line of its own.
   void end();
   // A line for each output that failed since the last look (also after end()).

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <string>
 
 #include "camhead/lens_control/lens_tracker.h"
 #include "camhead/lens_control/time_alignment.h"
@@ -192,6 +193,31 @@ TEST(LensTracker, CountsWinWithAProfileValuesWithout) {
   fallback.push(both);
   EXPECT_NEAR(fallback.state_at(0).focus_distance_m.value, 5.0, 1e-9);
   EXPECT_NEAR(fallback.state_at(0).f_number.value, 8.0, 1e-9);
+}
+
+// A reloaded calibration (a service's SIGHUP) maps the history it finds:
+// the state is the one a tracker fed the same samples under the new profile
+// gives, at once and without a sample lost.
+TEST(LensTracker, ASwappedProfileMapsTheSameHistory) {
+  const std::string lenses = std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/";
+  const LensProfile prime = LensProfile::load(lenses + "example_35mm.json");
+  const LensProfile zoom = LensProfile::load(lenses + "example_zoom_24_70.json");
+  LensTracker swapped(prime), fresh(zoom);
+  for (std::int64_t t = 0; t <= 200 * kMs; t += 10 * kMs) {
+    const EncoderSample s = counts_at(t, std::int32_t(6000 + t / kMs * 10), 1900, 3000);
+    swapped.push(s);
+    fresh.push(s);
+  }
+  const std::int64_t mid = 105 * kMs;
+  const LensState before = swapped.state_at(mid);
+  swapped.set_profile(zoom);
+  const LensState after = swapped.state_at(mid), expected = fresh.state_at(mid);
+  EXPECT_NE(after.focal_length_mm.value, before.focal_length_mm.value) << "the profile is used";
+  EXPECT_EQ(after.focus_distance_m.value, expected.focus_distance_m.value);
+  EXPECT_EQ(after.f_number.value, expected.f_number.value);
+  EXPECT_EQ(after.focal_length_mm.value, expected.focal_length_mm.value);
+  EXPECT_EQ(after.projection_focal_length_mm.value, expected.projection_focal_length_mm.value);
+  EXPECT_TRUE(after.all_fresh());
 }
 
 // A focus sent as a distance still breathes as the profile says: the

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 
 #include "camhead/lens_control/encoder_filter.h"
 #include "camhead/lens_control/lens_profile.h"
@@ -59,6 +60,10 @@ public:
   }
 
   [[nodiscard]] const LensProfile &profile() const { return profile_; }
+  // Maps the history through `profile` from now on (a reloaded calibration):
+  // the counts are kept, not states, so nothing is lost. Which of counts and
+  // value an axis takes follows the new profile from the next sample on.
+  void set_profile(LensProfile profile) { profile_ = std::move(profile); }
 
 private:
   struct Axis {
