@@ -54,8 +54,25 @@ struct CpuKernel {
   [[nodiscard]] Light light_at(uint index) const { return lights[index]; }
   [[nodiscard]] glm::uvec4 surface_texel_at(uint texel) const { return surfaces[texel]; }
 
+  // GLSL's bitfieldReverse for the sampler's scrambles, which call it five
+  // times a sample: glm's generic one is a loop of templated steps that
+  // only -O2 flattens, and the sanitizer build (which runs the CPU
+  // reference at -O1) spent a third of its tracing in it. Found by class
+  // scope before glm's.
+  static constexpr uint bitfieldReverse(uint x) {
+    x = ((x >> 1u) & 0x55555555u) | ((x & 0x55555555u) << 1u);
+    x = ((x >> 2u) & 0x33333333u) | ((x & 0x33333333u) << 2u);
+    x = ((x >> 4u) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4u);
+    x = ((x >> 8u) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8u);
+    return (x >> 16u) | (x << 16u);
+  }
+
 #include "kernel.glsl"
 };
+
+static_assert(CpuKernel::bitfieldReverse(0x00000001u) == 0x80000000u);
+static_assert(CpuKernel::bitfieldReverse(0x12345678u) == 0x1e6a2c48u);
+static_assert(CpuKernel::bitfieldReverse(0xf0000001u) == 0x8000000fu);
 
 #undef INOUT
 #undef OUT
