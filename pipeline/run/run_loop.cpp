@@ -95,6 +95,10 @@ private:
   // One reload: the new setup taken, or why not (for the status line and
   // the journal).
   std::string reload(Board &live, std::uint64_t generation);
+  // Every pipeline and buffer `setup`'s renderer uses, made for the camera's
+  // and the outputs' formats; the lens as it is now decides the kernels
+  // (its model).
+  void prepare(FrameSetup &setup) const;
   // The lens at the frame's mid-exposure; waits (bounded) for readings that
   // are on their way, and says how long in the record.
   LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
@@ -219,13 +223,7 @@ Pipeline::Pipeline(const RunOptions &options)
                            ": cannot be written: " + std::strerror(errno));
   }
   // Every pipeline and buffer the loop uses, made now.
-  std::vector<base::VideoFormat> formats;
-  for (const auto &sink : sinks_)
-    formats.push_back(sink->format());
-  // The lens as it is now decides the kernels prepare() builds (its model).
-  renderer::FrameRequest first = setup_request(*setup_, options_.influence_region);
-  first.camera = lens_camera(setup_->base_camera, lens_.state_at(base::monotonic_ns()).state);
-  setup_->renderer->prepare(first, camera_->format(), formats);
+  prepare(*setup_);
   for (Slot &slot : slots_)
     for (const auto &sink : sinks_)
       slot.images.emplace_back(base::frame_bytes(sink->format()));
@@ -502,12 +500,7 @@ std::string Pipeline::reload(Board &live, std::uint64_t generation) {
     std::unique_ptr<FrameSetup> next = load_frame_setup(board);
     next->renderer = make_renderer(next->board, options_.executor.value_or(board_.render.executor),
                                    next->scene, options_.threads);
-    std::vector<base::VideoFormat> formats;
-    for (const auto &sink : sinks_)
-      formats.push_back(sink->format());
-    renderer::FrameRequest first = setup_request(*next, options_.influence_region);
-    first.camera = lens_camera(next->base_camera, lens_.state_at(base::monotonic_ns()).state);
-    next->renderer->prepare(first, camera_->format(), formats);
+    prepare(*next);
     next->generation = generation;
     bool taken = false;
     // Freed here, not in the render thread: the setup it replaced (or this
@@ -524,6 +517,15 @@ std::string Pipeline::reload(Board &live, std::uint64_t generation) {
     ++reloads_refused_;
     return std::string("reload refused, the run goes on as it was: ") + e.what();
   }
+}
+
+void Pipeline::prepare(FrameSetup &setup) const {
+  std::vector<base::VideoFormat> formats;
+  for (const auto &sink : sinks_)
+    formats.push_back(sink->format());
+  renderer::FrameRequest first = setup_request(setup, options_.influence_region);
+  first.camera = lens_camera(setup.base_camera, lens_.state_at(base::monotonic_ns()).state);
+  setup.renderer->prepare(first, camera_->format(), formats);
 }
 
 void Pipeline::reload_loop(Board live) {
