@@ -44,8 +44,19 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # Not linked, but needed: a Vulkan driver (lavapipe where there is no GPU)
 # and systemd-sysusers for the service's user.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "mesa-vulkan-drivers | vulkan-icd, systemd")
+# The boards in /etc/camhead/board are conffiles (pipeline/CMakeLists.txt):
+# dpkg keeps an administrator's edits through upgrades and asks before
+# replacing one.
+list(JOIN CAMHEAD_CONFFILES "\n" camhead_conffiles_text)
+file(WRITE ${PROJECT_BINARY_DIR}/packaging/conffiles "${camhead_conffiles_text}\n")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
-  ${PROJECT_SOURCE_DIR}/packaging/debian/postinst ${PROJECT_SOURCE_DIR}/packaging/debian/postrm)
+  ${PROJECT_SOURCE_DIR}/packaging/debian/postinst ${PROJECT_SOURCE_DIR}/packaging/debian/postrm
+  ${PROJECT_BINARY_DIR}/packaging/conffiles)
+# One package of every component, the conffiles included (installed only
+# with --component conffiles by `cmake --install`).
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_COMPONENTS_GROUPING ALL_COMPONENTS_IN_ONE)
+set(CPACK_COMPONENTS_ALL Unspecified conffiles)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_STRIP_FILES TRUE)

@@ -512,27 +512,37 @@ std::filesystem::path resolve_board(std::string_view name_or_path) {
                      "no camhead data folder found (one holding board/sim.json); searched:\n" +
                          describe_data_dir_search() +
                          "set CAMHEAD_DATA_DIR, or give the board file's path");
-  const std::filesystem::path folder = dir / "board", file = folder / (s + ".json");
   std::error_code error;
+  // The administrator's boards first (conffiles of the package).
+  const std::filesystem::path config = config_board_dir();
+  if (!config.empty() && std::filesystem::exists(config / (s + ".json"), error))
+    return config / (s + ".json");
+  const std::filesystem::path folder = dir / "board", file = folder / (s + ".json");
   if (std::filesystem::exists(file, error) || !std::filesystem::is_directory(folder, error))
     return file; // found; or load_board names the file it cannot open
   // A misspelt name: say which names there are.
   std::vector<std::string> names;
-  for (const auto &entry : std::filesystem::directory_iterator(folder, error))
-    if (entry.path().extension() == ".json")
-      names.push_back(entry.path().stem().string());
+  for (const std::filesystem::path &where : {config, folder})
+    for (const auto &entry : std::filesystem::directory_iterator(where, error))
+      if (entry.path().extension() == ".json")
+        names.push_back(entry.path().stem().string());
   std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
   std::string known;
   for (const std::string &name : names)
     known += (known.empty() ? "" : ", ") + name;
-  throw BoardError(s, "(board name)",
-                   "no board of that name in " + folder.string() + " (there: " + known +
-                       "); give a board file's path for your own");
+  throw BoardError(
+      s, "(board name)",
+      "no board of that name in " +
+          (config.empty() ? folder.string() : config.string() + " or " + folder.string()) +
+          " (there: " + known + "); give a board file's path for your own");
 }
 
 Board parse_board(std::string_view json_text, const std::filesystem::path &file) {
   try {
-    const base::JsonFile json(json_text, file.string());
+    const std::filesystem::path folder = board_paths_folder(file);
+    const base::JsonFile json = folder.empty() ? base::JsonFile(json_text, file.string())
+                                               : base::JsonFile(json_text, file.string(), folder);
     Board board = BoardReader(file).read(json.root());
     board.text = json_text;
     return board;

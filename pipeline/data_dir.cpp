@@ -45,6 +45,28 @@ fs::path data_dir() {
   return {};
 }
 
+fs::path config_board_dir() {
+  if (const char *env = std::getenv("CAMHEAD_CONFIG_DIR"); env != nullptr && *env != '\0')
+    return fs::path(env) / "board";
+  if (std::getenv("CAMHEAD_DATA_DIR") != nullptr)
+    return {}; // a data folder given by hand: its boards alone
+  const fs::path exe = executable_dir();
+  std::error_code error;
+  if (exe.empty() || !fs::equivalent(data_dir(), exe / ".." / "share" / "camhead", error))
+    return {};
+  return "/etc/camhead/board";
+}
+
+fs::path board_paths_folder(const fs::path &board_file) {
+  const fs::path config = config_board_dir();
+  std::error_code error;
+  if (!config.empty() &&
+      fs::equivalent(fs::absolute(board_file, error).parent_path(), config, error))
+    if (const fs::path data = data_dir(); !data.empty())
+      return data / "board";
+  return {};
+}
+
 std::string describe_data_dir_search() {
   std::string text;
   for (const fs::path &dir : data_dir_candidates())

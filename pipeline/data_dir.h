@@ -20,6 +20,21 @@ namespace camhead::pipeline {
 // The first candidate that matches, or an empty path when none does.
 [[nodiscard]] std::filesystem::path data_dir();
 
+// The boards an administrator keeps, which a board's name finds before the
+// data folder's board/ (resolve_board()): $CAMHEAD_CONFIG_DIR/board where
+// that is set, else /etc/camhead/board for an installed camhead (its data
+// folder EXE_DIR/../share/camhead: the package ships its boards there as
+// conffiles, which an upgrade leaves as the administrator edited them).
+// Empty for a camhead run from its build tree or a copied binary, which see
+// only their own board/.
+[[nodiscard]] std::filesystem::path config_board_dir();
+
+// Where a board file's relative paths start: the data folder's board/ for
+// a board in config_board_dir() (so that a copy of a shipped board finds
+// the scenes and lens files beside the shipped one); empty for any other,
+// whose paths start from its own folder.
+[[nodiscard]] std::filesystem::path board_paths_folder(const std::filesystem::path &board_file);
+
 // What was searched, one folder a line, for the message when nothing matched.
 [[nodiscard]] std::string describe_data_dir_search();
 

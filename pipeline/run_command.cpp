@@ -237,8 +237,9 @@ void add_run_command(CLI::App &app) {
              "disk, a size limit; what it holds is kept); 5 the camera's take broke off or a\n"
              "device failed. The summary says what each output took.");
   cmd->add_option("--board", args->board,
-                  "Board name in board/ (sim, ...) or a board file; its camera, scene,\n"
-                  "lens and outputs")
+                  "Board name in board/ (sim, ...; an installed camhead looks in\n"
+                  "/etc/camhead/board first) or a board file; its camera, scene, lens and\n"
+                  "outputs")
       ->capture_default_str()
       ->check(path_text());
   cmd->add_option("--output", args->outputs,

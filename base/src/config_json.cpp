@@ -172,10 +172,22 @@ private:
 
 } // namespace
 
-JsonFile::JsonFile(std::string_view text, std::string file) : name_(std::move(file)) {
+namespace {
+std::filesystem::path folder_of(const std::string &file) {
   std::error_code ec;
-  const std::filesystem::path abs = std::filesystem::absolute(name_, ec);
-  folder_ = (ec ? std::filesystem::path(name_) : abs).parent_path();
+  const std::filesystem::path abs = std::filesystem::absolute(file, ec);
+  return (ec ? std::filesystem::path(file) : abs).parent_path();
+}
+} // namespace
+
+JsonFile::JsonFile(std::string_view text, std::string file)
+    : JsonFile(text, file, folder_of(file)) {}
+
+JsonFile::JsonFile(std::string_view text, std::string file, const std::filesystem::path &folder)
+    : name_(std::move(file)) {
+  std::error_code ec;
+  const std::filesystem::path abs = std::filesystem::absolute(folder, ec);
+  folder_ = ec || folder.empty() ? folder : abs;
   try {
     json_ = Json::parse(rewrite_non_finite(text), DuplicateKeyCheck(name_));
   } catch (const Json::exception &e) {

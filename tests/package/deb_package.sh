@@ -36,6 +36,13 @@ echo "$control" | grep -q '^Depends:.*libvulkan1' || fail "Depends lacks libvulk
 echo "$control" | grep -q '^Depends:.*mesa-vulkan-drivers | vulkan-icd' || fail "Depends lacks a Vulkan driver"
 dpkg-deb -e "$deb" "$scratch/control"
 grep -q 'systemd-sysusers camhead.conf' "$scratch/control/postinst" || fail "postinst makes no user"
+# Every board is the administrator's too: a conffile in /etc/camhead/board.
+for board in sim rpi5-libcamera-hdmi x86-uvc-webcam; do
+  grep -qx "/etc/camhead/board/$board.json" "$scratch/contents" || fail "no /etc board $board"
+  grep -qx "/etc/camhead/board/$board.json" "$scratch/control/conffiles" ||
+    fail "/etc/camhead/board/$board.json is not a conffile"
+done
+if grep -v '^/etc/' "$scratch/control/conffiles"; then fail "a conffile outside /etc"; fi
 
 if command -v lintian >/dev/null 2>&1; then
   lintian --tag-display-limit 0 "$deb" >"$scratch/lintian.log" 2>&1 || true
@@ -52,4 +59,13 @@ dpkg-deb -x "$deb" "$scratch/root"
 # Its status line names the lens trace it read: the package's own.
 grep -q "trace $scratch/root/usr/share/camhead/scenes/lenses/" "$scratch/run.log" ||
   { cat "$scratch/run.log"; fail "the packaged camhead read its data from elsewhere"; }
+# An administrator's edit of the /etc board is what `--board sim` runs
+# (CAMHEAD_CONFIG_DIR stands for /etc/camhead in the scratch root); its
+# relative paths still find the packaged scenes and lens files.
+sed -i 's/"name": "focus pull"/"name": "edited pull"/' "$scratch/root/etc/camhead/board/sim.json"
+(cd "$scratch" && env -u CAMHEAD_DATA_DIR CAMHEAD_CONFIG_DIR="$scratch/root/etc/camhead" \
+  "$scratch/root/usr/bin/camhead" run --frames 2 --output null >"$scratch/run_etc.log" 2>&1) ||
+  { cat "$scratch/run_etc.log"; fail "the packaged camhead on its /etc board"; }
+grep -q "lens edited pull \[trace $scratch/root/usr/share/camhead/scenes/lenses/" \
+  "$scratch/run_etc.log" || { cat "$scratch/run_etc.log"; fail "the /etc board was not the one run"; }
 echo "PASS"

@@ -1,9 +1,14 @@
 // Board files: the bundled ones load, and every kind of mistake is named by
 // file and field without loading anything half-way.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "board.h"
+#include "data_dir.h"
 #include "run/output_uri.h"
 
 #include <gtest/gtest.h>
@@ -26,6 +31,48 @@ std::string with_source(const std::string &source) {
   return R"({"format": "camhead-board", "version": 1, "name": "t",
              "lens": {"sources": [)" +
          source + "]}}";
+}
+
+// An administrator's boards (the package's conffiles in /etc/camhead/board;
+// CAMHEAD_CONFIG_DIR stands for /etc/camhead here) are found by name before
+// the shipped ones, and an edited copy of a shipped board finds the scenes
+// and lens files the shipped one does.
+TEST(Board, AnAdministratorsBoardIsFoundFirstAndReadsPathsAsTheShippedOne) {
+  namespace fs = std::filesystem;
+  const fs::path config = fs::temp_directory_path() / "camhead_config_dir_test";
+  fs::remove_all(config);
+  fs::create_directories(config / "board");
+  std::stringstream shipped;
+  shipped << std::ifstream(kBoards / "sim.json").rdbuf();
+  std::string edited = shipped.str();
+  edited.replace(edited.find("\"name\": \"sim\""), 13, "\"name\": \"ours\"");
+  std::ofstream(config / "board" / "sim.json") << edited;
+  std::ofstream(config / "board" / "mine.json") << edited;
+  ::setenv("CAMHEAD_CONFIG_DIR", config.c_str(), 1);
+
+  EXPECT_EQ(resolve_board("sim"), config / "board" / "sim.json");
+  EXPECT_EQ(resolve_board("mine"), config / "board" / "mine.json");
+  EXPECT_EQ(resolve_board("sim-moving"), data_dir() / "board" / "sim-moving.json")
+      << "a board the administrator has no copy of is the shipped one";
+  const Board board = load_board(resolve_board("sim"));
+  EXPECT_EQ(board.name, "ours");
+  ASSERT_TRUE(board.lens.profile.has_value());
+  EXPECT_EQ(*board.lens.profile,
+            (data_dir() / "scenes/lenses/example_35mm.json").lexically_normal());
+  EXPECT_TRUE(fs::exists(*board.scene)) << *board.scene;
+  try {
+    (void)resolve_board("sin");
+    ADD_FAILURE() << "a misspelt name was taken";
+  } catch (const BoardError &e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find((config / "board").string() + " or "), std::string::npos) << what;
+    EXPECT_NE(what.find("mine, "), std::string::npos) << what;
+    EXPECT_NE(what.find("sim-moving"), std::string::npos) << what;
+  }
+  ::unsetenv("CAMHEAD_CONFIG_DIR");
+  fs::remove_all(config);
+  EXPECT_EQ(resolve_board("sim"), data_dir() / "board" / "sim.json")
+      << "a camhead in its build tree sees its own boards alone";
 }
 
 TEST(Board, SimulatedRigLoadsWithATraceAndAProfileThatExist) {

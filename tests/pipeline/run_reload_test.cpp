@@ -125,16 +125,22 @@ TEST_F(RunLoop, AReloadTakesTheNewSceneBetweenTwoFramesAndARefusedOneChangesNoth
 
   EXPECT_EQ(summary.reloads, 1u);
   EXPECT_EQ(summary.reloads_refused, 2u);
-  EXPECT_EQ(summary.placeholders, 0u);
   // Every composite before the reload rendered the plain scene at 2 rays,
   // every one after it the ball at 5: one switch, between two frames.
   const std::vector<std::string> lines = lines_of(dir_ / "stats.jsonl");
   int setup = 0;
   std::size_t switched_at = 0;
+  bool composited = false;
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const std::string &line = lines[i];
-    if (line.find("\"kind\":\"composite\"") == std::string::npos)
+    if (line.find("\"kind\":\"composite\"") == std::string::npos) {
+      // Before the first composite a slow start shows the placeholder (a
+      // sanitizer build's first frame takes seconds); after it, the camera
+      // never went away.
+      EXPECT_FALSE(composited && line.find("placeholder") != std::string::npos) << line;
       continue;
+    }
+    composited = true;
     const int s = int(json_number(line, "setup"));
     ASSERT_GE(s, setup) << line;
     ASSERT_LE(s, 1) << "a refused reload was taken: " << line;

@@ -107,6 +107,9 @@ class JsonFile {
 public:
   // Throws ConfigError(file, "(JSON)", "invalid JSON at line L, column C: ...").
   JsonFile(std::string_view text, std::string file);
+  // The same with relative paths (JsonValue::path()) read from `folder`
+  // rather than the file's own.
+  JsonFile(std::string_view text, std::string file, const std::filesystem::path &folder);
   JsonFile(const JsonFile &) = delete;
   JsonFile &operator=(const JsonFile &) = delete;
 
