@@ -554,6 +554,7 @@ void Pipeline::status_loop() {
   ServiceHeartbeat heartbeat(options_.service, counters_);
   std::uint64_t last_in = 0, last_out = 0;
   std::int64_t last_ns = start_ns_;
+  std::string refused; // the last reload's refusal, until one is taken
   // Awake often, so that a run ends as soon as its last frame is out (it
   // lingered up to a second), and a line a second.
   while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
@@ -562,14 +563,20 @@ void Pipeline::status_loop() {
     heartbeat.tick(now);
     if (status_) {
       const std::lock_guard lock(reload_mutex_);
-      if (!reload_note_.empty())
+      if (!reload_note_.empty()) {
+        // A refusal stays in systemd's status until a reload is taken:
+        // `systemctl status` must show why the board on disk is not the
+        // one running.
+        refused = reload_note_.rfind("reload refused", 0) == 0 ? reload_note_ : std::string();
         status_->note(std::exchange(reload_note_, {}));
+      }
     }
     if (!status_ || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
     status_->second(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out);
-    heartbeat.status(status_->last_line());
+    heartbeat.status(refused.empty() ? status_->last_line()
+                                     : status_->last_line() + "; " + refused);
     last_in = in;
     last_out = out;
     last_ns = now;

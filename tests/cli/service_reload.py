@@ -6,7 +6,8 @@ camhead must say READY=1 once its first frame is out; on SIGHUP,
 RELOADING=1 with the time, then READY=1 and a STATUS= that says what
 happened: a board with a new render setting is taken (the record's frames
 after it carry "setup": 1 and the new rays per pixel), a broken one is
-refused with its file named and the run goes on; SIGTERM ends it with exit
+refused with its file named, the status lines after it keep saying so,
+and the run goes on; SIGTERM ends it with exit
 status 0 and a summary that counts both.
 
     service_reload.py CAMHEAD SOURCE_DIR SCRATCH_DIR
@@ -91,6 +92,17 @@ expect("RELOADING=1\n")
 refused = expect("READY=1\nSTATUS=")
 if "reload refused" not in refused or board not in refused:
     fail("a broken board was not refused naming it: %r" % refused)
+# The status line that follows keeps the refusal: `systemctl status` shows
+# why the board on disk is not the one running.
+while True:
+    try:
+        message = listener.recv(4096).decode()
+    except socket.timeout:
+        fail("no status line after the refusal")
+    if message.startswith("STATUS=in "):
+        break
+if "reload refused" not in message:
+    fail("the status line dropped the refusal: %r" % message)
 
 # Frames go on after the refusal, with the setup that was taken.
 deadline = time.monotonic() + 60

@@ -4,17 +4,21 @@
 // output feeds.
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -59,6 +63,39 @@ public:
     if (n < 0)
       return std::nullopt;
     return std::string(buffer, std::size_t(n));
+  }
+
+  // The next message and when it was sent (CLOCK_MONOTONIC): the kernel
+  // stamps each datagram as the sender hands it over (SO_TIMESTAMPNS), so a
+  // reader that a loaded machine wakes late still sees when it came.
+  std::optional<std::pair<std::string, std::int64_t>>
+  receive_stamped(std::chrono::milliseconds timeout) const {
+    const int on = 1;
+    ::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
+    timeval tv{long(timeout.count() / 1000), long(timeout.count() % 1000) * 1000};
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    char buffer[4096];
+    iovec io{buffer, sizeof buffer};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+    msghdr message{};
+    message.msg_iov = &io;
+    message.msg_iovlen = 1;
+    message.msg_control = control;
+    message.msg_controllen = sizeof control;
+    const ssize_t n = ::recvmsg(fd_, &message, 0);
+    if (n < 0)
+      return std::nullopt;
+    // Sent this long before now, on the realtime clock the stamp is in.
+    std::int64_t sent_ns = base::monotonic_ns();
+    for (cmsghdr *c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c))
+      if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+        timespec stamp{}, now{};
+        std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
+        ::clock_gettime(CLOCK_REALTIME, &now);
+        sent_ns -= (std::int64_t(now.tv_sec) - stamp.tv_sec) * 1'000'000'000 +
+                   (now.tv_nsec - stamp.tv_nsec);
+      }
+    return std::pair(std::string(buffer, std::size_t(n)), sent_ns);
   }
 
   // Every message until STOPPING=1 (or none for 5 s).
@@ -214,9 +251,9 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
     // is short (net.unix.max_dgram_qlen, 10 by default).
     std::vector<Message> messages;
     std::thread reader([&] {
-      while (std::optional<std::string> m = systemd.receive(5000ms)) {
-        messages.push_back({*m, base::monotonic_ns()});
-        if (*m == "STOPPING=1")
+      while (auto m = systemd.receive_stamped(5000ms)) {
+        messages.push_back({m->first, m->second});
+        if (m->first == "STOPPING=1")
           break;
       }
     });
