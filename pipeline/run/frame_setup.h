@@ -1,6 +1,6 @@
 // What the live pipeline renders a frame with, made from a board: the scene,
-// the camera at the board's pose, the frame budget and the renderer made for
-// them. A reload (board_reload.h) makes a whole new one beside the running
+// the camera at the board's pose, the render settings and the renderer made
+// for them. A reload (board_reload.h) makes a whole new one beside the running
 // one and hands it to the render thread between two frames (SetupHandover),
 // so no output waits for a scene to load or a kernel to compile.
 #pragma once
@@ -46,8 +46,10 @@ struct FrameSetup {
 [[nodiscard]] renderer::FrameRequest setup_request(const FrameSetup &setup, bool influence_region);
 
 // A new setup from a reload thread to the render thread. The render thread
-// only swaps two pointers between frames (nothing is made, freed or waited
-// for in its loop); what it replaced goes back to the reload thread to free.
+// only swaps two pointers between frames (nothing is made or freed in its
+// loop, and its lock is held only for the other side's swap); what it
+// replaced goes back to the reload thread to free. Not yet held by the
+// allocation test (run_allocations_test.cpp runs no reload).
 //
 // Thread safety: offer() from one thread, take() from another.
 class SetupHandover {
