@@ -48,8 +48,8 @@ struct FrameSetup {
 // A new setup from a reload thread to the render thread. The render thread
 // only swaps two pointers between frames (nothing is made or freed in its
 // loop, and its lock is held only for the other side's swap); what it
-// replaced goes back to the reload thread to free. Not yet held by the
-// allocation test (run_allocations_test.cpp runs no reload).
+// replaced goes back to the reload thread to free
+// (RunAllocations.AReloadAllocatesNothingInTheFrameLoop holds it).
 //
 // Thread safety: offer() from one thread, take() from another.
 class SetupHandover {

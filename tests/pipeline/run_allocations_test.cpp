@@ -9,10 +9,14 @@
 //
 // Counted (tests/support/counting_new.h): C++ allocations, not the C
 // library's malloc (stdio buffers its streams with it, once).
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <pthread.h>
@@ -48,18 +52,28 @@ namespace {
 
 namespace fs = std::filesystem;
 
+std::size_t lines_in(const fs::path &file) {
+  std::ifstream in(file);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);)
+    ++n;
+  return n;
+}
+
 class RunAllocations : public RunLoop {
 protected:
   struct Counts {
     std::uint64_t render = 0, output = 0, frames_out = 0;
-    std::uint64_t reprojected = 0;    // samples moved, in all the records
-    std::uint64_t tracked_frames = 0; // composites with a tracker's pose, fresh
+    std::uint64_t reprojected = 0;     // samples moved, in all the records
+    std::uint64_t tracked_frames = 0;  // composites with a tracker's pose, fresh
+    std::uint64_t reloaded_frames = 0; // composites of a reload's setup
   };
 
   // A run of a take played in real time, looped, through a floor with a
   // virtual ball, with `render` as the board's render settings; `tracked`:
-  // the pose of a FreeD head on this host panning to and fro.
-  Counts run(const std::string &render, bool tracked = false) {
+  // the pose of a FreeD head on this host panning to and fro; `reload`: the
+  // board reloaded (unchanged) once 10 frames are out.
+  Counts run(const std::string &render, bool tracked = false, bool reload = false) {
     const int w = 96, h = 64, n = 8;
     std::vector<std::vector<std::uint8_t>> frames;
     for (int k = 0; k < n; ++k)
@@ -94,16 +108,36 @@ protected:
     std::optional<Tracker> head;
     if (tracked)
       head.emplace("freed", port, 2.0, 3.0); // +-2 degrees, to and fro every 3 s
+    std::atomic<bool> reload_now{false};
+    std::thread reloader;
+    if (reload) {
+      options.reload = &reload_now;
+      reloader = std::thread([&] {
+        for (int i = 0; i < 6000 && lines_in(dir_ / "stats.jsonl") < 10; ++i)
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        reload_now = true;
+      });
+    }
     test::counting_new::start(thread_bucket);
     const RunSummary summary = run_pipeline(options);
     test::counting_new::stop();
+    if (reloader.joinable())
+      reloader.join();
     std::uint64_t reprojected = 0, tracked_frames = 0;
     for (const CompositeRecord &record : recorded_composites(dir_ / "stats.jsonl")) {
       reprojected += record.reprojected_samples;
       tracked_frames += record.pose_fresh ? 1 : 0;
     }
-    return {test::counting_new::count(kRender), test::counting_new::count(kOutput),
-            summary.frames_out, reprojected, tracked_frames};
+    std::uint64_t reloaded_frames = 0;
+    std::ifstream stats(dir_ / "stats.jsonl");
+    for (std::string line; std::getline(stats, line);)
+      reloaded_frames += line.find("\"setup\":1,") != std::string::npos ? 1 : 0;
+    return {test::counting_new::count(kRender),
+            test::counting_new::count(kOutput),
+            summary.frames_out,
+            reprojected,
+            tracked_frames,
+            reloaded_frames};
   }
 };
 
@@ -115,6 +149,17 @@ TEST_F(RunAllocations, TheRenderAndOutputThreadsAllocateNothingOnTheCpuReference
   // The pull's frames started with the frames before them moved
   // (render.reproject), and the record says so.
   EXPECT_GT(counts.reprojected, 0u);
+}
+
+// A reload's setup is made on the reload thread and swapped in between two
+// frames: the render thread (and the new renderer's workers, which it starts
+// on the reload thread) allocate nothing for it, nor does the output.
+TEST_F(RunAllocations, AReloadAllocatesNothingInTheFrameLoop) {
+  const Counts counts = run(R"({"executor": "cpu"})", false, true);
+  EXPECT_EQ(counts.frames_out, 40u);
+  EXPECT_GT(counts.reloaded_frames, 0u) << "the reload was not taken within the run";
+  EXPECT_EQ(counts.render, 0u);
+  EXPECT_EQ(counts.output, 0u);
 }
 
 // A tracker's pose, read for every frame from the lens thread's history,
