@@ -75,7 +75,27 @@ def expect(prefix):
         return message
 
 
+def composites():
+    try:
+        with open(stats) as f:
+            return [json.loads(line) for line in f if '"kind":"composite"' in line]
+    except FileNotFoundError:
+        return []
+
+
+def wait_for(predicate, what):
+    deadline = time.monotonic() + 60
+    while not predicate():
+        if time.monotonic() > deadline:
+            run.kill()
+            fail("no %s within 60 s" % what)
+        time.sleep(0.05)
+
+
 expect("READY=1")
+# READY=1 comes with the first frame out, which on a slow start is the
+# placeholder: the first setup's composites come before the reload.
+wait_for(lambda: len(composites()) >= 3, "composites of the first setup")
 write_board(3)
 run.send_signal(signal.SIGHUP)
 reloading = expect("RELOADING=1\n")
@@ -105,13 +125,8 @@ if "reload refused" not in message:
     fail("the status line dropped the refusal: %r" % message)
 
 # Frames go on after the refusal, with the setup that was taken.
-deadline = time.monotonic() + 60
-while time.monotonic() < deadline:
-    with open(stats) as f:
-        composites = [json.loads(line) for line in f if '"kind":"composite"' in line]
-    if sum(1 for c in composites if c["setup"] == 1) >= 10:
-        break
-    time.sleep(0.1)
+wait_for(lambda: sum(1 for c in composites() if c["setup"] == 1) >= 10,
+         "frames of the reloaded setup")
 run.send_signal(signal.SIGTERM)
 _, stderr = run.communicate(timeout=60)
 sys.stderr.write(stderr)
@@ -119,10 +134,11 @@ if run.returncode != 0:
     fail("exit status %d" % run.returncode)
 if "reloads 1, refused 1" not in stderr:
     fail("the summary does not count the reloads")
-setups = [c["setup"] for c in composites]
+records = composites()
+setups = [c["setup"] for c in records]
 if setups != sorted(setups) or set(setups) != {0, 1}:
     fail("setups not 0 then 1: %r" % setups)
-for c in composites:
+for c in records:
     if c["rpp"] != (2 if c["setup"] == 0 else 3):
         fail("frame %d of setup %d has %d rays per pixel" % (c["sequence"], c["setup"], c["rpp"]))
 print("PASS %d frames of setup 0, %d of setup 1" % (setups.count(0), setups.count(1)))
