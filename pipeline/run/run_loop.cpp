@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 #include <system_error>
 #include <thread>
@@ -16,7 +15,6 @@
 
 #include <glm/geometric.hpp>
 
-#include "board_reload.h"
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
 #include "camhead/base/thread_name.h"
@@ -29,13 +27,13 @@
 #include "frame_setup.h"
 #include "lens_camera.h"
 #include "lens_hub.h"
-#include "lens_sources.h"
 #include "output_uri.h"
 #include "placeholder.h"
 #include "rig_setup.h"
 #include "run_paths.h"
 #include "run_status.h"
 #include "service/service_heartbeat.h"
+#include "setup_reloader.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
 #include "tracking/pose_trace.h"
@@ -89,12 +87,8 @@ private:
   void render_loop();
   void output_loop();
   void status_loop();
-  // On each RunOptions::reload: the board read anew, checked, and its setup
-  // made and handed to the render thread; `live` is the board running.
-  void reload_loop(Board live);
-  // One reload: the new setup taken, or why not (for the status line and
-  // the journal).
-  std::string reload(Board &live, std::uint64_t generation);
+  // A reload's setup of `board`, its renderer made and prepared.
+  std::unique_ptr<FrameSetup> build_setup(const Board &board) const;
   // Every pipeline and buffer `setup`'s renderer uses, made for the camera's
   // and the outputs' formats; the lens as it is now decides the kernels
   // (its model).
@@ -148,10 +142,8 @@ private:
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   RunCounters counters_;
-  // The reload thread's word for the status thread: the last outcome.
-  std::mutex reload_mutex_;
-  std::string reload_note_;
-  std::atomic<std::uint64_t> reloads_{0}, reloads_refused_{0};
+  // The reload thread's (RunOptions::reload); null without reloads.
+  std::optional<SetupReloader> reloader_;
   std::optional<RunStatus> status_; // the status line, unless options_.status is null
   std::atomic<bool> stopping_{false};
   // A camera that waits for its consumer (a file not played in real time):
@@ -491,32 +483,12 @@ void Pipeline::output_loop() {
   }
 }
 
-std::string Pipeline::reload(Board &live, std::uint64_t generation) {
-  try {
-    // Everything is read, checked and made beside the running setup; the
-    // render thread only swaps it in between two frames.
-    Board board = reread_board(live);
-    lens_control::LensProfile profile = load_board_profile(board);
-    std::unique_ptr<FrameSetup> next = load_frame_setup(board);
-    next->renderer = make_renderer(next->board, options_.executor.value_or(board_.render.executor),
-                                   next->scene, options_.threads);
-    prepare(*next);
-    next->generation = generation;
-    bool taken = false;
-    // Freed here, not in the render thread: the setup it replaced (or this
-    // one, when the run ended first).
-    std::unique_ptr<FrameSetup> spent = handover_.offer(
-        std::move(next), [this] { return should_stop(); }, taken);
-    if (!taken)
-      return {};
-    lens_.set_profile(profile);
-    live = std::move(board);
-    ++reloads_;
-    return "reloaded " + live.file.string() + ": setup " + std::to_string(generation);
-  } catch (const std::exception &e) {
-    ++reloads_refused_;
-    return std::string("reload refused, the run goes on as it was: ") + e.what();
-  }
+std::unique_ptr<FrameSetup> Pipeline::build_setup(const Board &board) const {
+  std::unique_ptr<FrameSetup> setup = load_frame_setup(board);
+  setup->renderer = make_renderer(setup->board, options_.executor.value_or(board_.render.executor),
+                                  setup->scene, options_.threads);
+  prepare(*setup);
+  return setup;
 }
 
 void Pipeline::prepare(FrameSetup &setup) const {
@@ -526,24 +498,6 @@ void Pipeline::prepare(FrameSetup &setup) const {
   renderer::FrameRequest first = setup_request(setup, options_.influence_region);
   first.camera = lens_camera(setup.base_camera, lens_.state_at(base::monotonic_ns()).state);
   setup.renderer->prepare(first, camera_->format(), formats);
-}
-
-void Pipeline::reload_loop(Board live) {
-  while (!should_stop()) {
-    std::this_thread::sleep_for(20ms);
-    if (!options_.reload->exchange(false))
-      continue;
-    if (options_.service != nullptr)
-      (void)options_.service->notify("RELOADING=1\nMONOTONIC_USEC=" +
-                                     std::to_string(base::monotonic_ns() / 1000));
-    const std::string note = reload(live, reloads_ + 1);
-    if (note.empty())
-      break; // the run ended first
-    if (options_.service != nullptr)
-      (void)options_.service->notify("READY=1\nSTATUS=" + note);
-    const std::lock_guard lock(reload_mutex_);
-    reload_note_ = note;
-  }
 }
 
 // The status line (run_status.h), a line a second, and what systemd hears
@@ -561,16 +515,14 @@ void Pipeline::status_loop() {
     std::this_thread::sleep_for(20ms);
     const std::int64_t now = base::monotonic_ns();
     heartbeat.tick(now);
-    if (status_) {
-      const std::lock_guard lock(reload_mutex_);
-      if (!reload_note_.empty()) {
+    if (status_ && reloader_)
+      if (std::optional<std::string> note = reloader_->take_note()) {
         // A refusal stays in systemd's status until a reload is taken:
         // `systemctl status` must show why the board on disk is not the
         // one running.
-        refused = reload_note_.rfind("reload refused", 0) == 0 ? reload_note_ : std::string();
-        status_->note(std::exchange(reload_note_, {}));
+        refused = note->rfind("reload refused", 0) == 0 ? *note : std::string();
+        status_->note(*note);
       }
-    }
     if (!status_ || now - last_ns < 1'000'000'000)
       continue;
     const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
@@ -590,11 +542,16 @@ RunSummary Pipeline::run() {
   start_ns_ = base::monotonic_ns();
   std::vector<std::thread> threads;
   try {
-    if (options_.reload != nullptr)
+    if (options_.reload != nullptr) {
+      reloader_.emplace(
+          *options_.reload, options_.service, handover_, lens_,
+          [this](const Board &board) { return build_setup(board); },
+          [this] { return should_stop(); });
       threads.emplace_back([this, live = setup_->board]() mutable {
         base::name_this_thread("camhead-reload");
-        reload_loop(std::move(live));
+        reloader_->run(std::move(live));
       });
+    }
     threads.emplace_back([this] {
       base::name_this_thread("camhead-capture");
       capture_loop();
@@ -661,8 +618,8 @@ RunSummary Pipeline::finish() {
   summary.render_failed = counters_.render_failed;
   summary.placeholders = counters_.placeholders;
   summary.repeats = counters_.repeats;
-  summary.reloads = reloads_;
-  summary.reloads_refused = reloads_refused_;
+  summary.reloads = reloader_ ? reloader_->reloads() : 0;
+  summary.reloads_refused = reloader_ ? reloader_->refused() : 0;
   summary.sink_errors += counters_.sink_errors;
   summary.seconds = double(base::monotonic_ns() - start_ns_) * 1e-9;
   summary.executor = executor_name_;
