@@ -54,20 +54,21 @@ with open(board, "w") as f:
         "render": {"executor": "cpu", "min_rays_per_pixel": 1, "max_rays_per_pixel": 4}}, f)
 
 
-def rss_kib(pid):
+def status_field(pid, name):
+    """A number from /proc/PID/status ("VmRSS" in KiB, "Threads")."""
     with open("/proc/%d/status" % pid) as f:
         for line in f:
-            if line.startswith("VmRSS:"):
+            if line.startswith(name + ":"):
                 return int(line.split()[1])
-    raise RuntimeError("no VmRSS")
+    raise RuntimeError("no %s in /proc/%d/status" % (name, pid))
+
+
+def rss_kib(pid):
+    return status_field(pid, "VmRSS")
 
 
 def threads(pid):
-    with open("/proc/%d/status" % pid) as f:
-        for line in f:
-            if line.startswith("Threads:"):
-                return int(line.split()[1])
-    raise RuntimeError("no Threads")
+    return status_field(pid, "Threads")
 
 
 def descriptors(pid):
