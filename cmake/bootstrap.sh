@@ -38,6 +38,10 @@ run_packages=(
   libglm-dev nlohmann-json3-dev libcli11-dev zlib1g-dev libpng-dev
   libtinyobjloader-dev libstb-dev libtinyexr-dev
   libgpiod-dev libusb-1.0-0-dev
+  # The operator page's module (pipeline/web/libevent, `camhead run --http`):
+  # libevent's evhttp, libjpeg-turbo for the preview; libcrypt (the
+  # password's hash) comes with libc6-dev.
+  libevent-dev libturbojpeg0-dev
   # hal/output/drm: the kernel's DRM uapi headers (drm.h, drm_mode.h), which
   # Debian ships in libdrm-dev only; nothing links libdrm.
   libdrm-dev
@@ -51,6 +55,11 @@ test_packages=(
   # python3 plays systemd's notification socket for `systemctl reload`
   # (tests/cli/service_reload.py).
   systemd lintian python3
+  # The operator page's tests (tests/web): a client in Python with Pillow,
+  # NumPy and Prometheus's own parser, and headless Chromium driven by
+  # Selenium.
+  python3-pil python3-numpy python3-prometheus-client python3-selenium
+  chromium chromium-driver
   # The demo scene's bunny (scenes/ar_demo.json), which tests and
   # benchmarks render.
   glmark2-data

@@ -66,7 +66,7 @@ public:
 
   Board read(const JsonValue &root) {
     root.object({"format", "version", "name", "lens"},
-                {"description", "camera", "scene", "pose", "outputs", "render"});
+                {"description", "camera", "scene", "pose", "outputs", "render", "http"});
     const JsonValue format = root.at("format");
     if (!format.json().is_string() || format.json().get<std::string>() != kFormat)
       format.fail("must be \"" + std::string(kFormat) + "\"");
@@ -91,6 +91,8 @@ public:
         board.outputs.push_back(output.string());
     if (root.has("render"))
       board.render = read_render(root.at("render"));
+    if (root.has("http"))
+      board.http = read_http(root.at("http"));
     if (board.camera && !board.scene)
       root.fail_member("scene",
                        "missing: a board with a camera needs the scene of its virtual objects");
@@ -116,6 +118,20 @@ private:
                                           "\" is already the name of sources[" + std::to_string(j) +
                                           "]; give each source its own name");
     return lens;
+  }
+
+  static web::WebOptions read_http(const JsonValue &d) {
+    d.object({"listen"}, {"password_file"});
+    web::WebOptions http;
+    const JsonValue listen = d.at("listen");
+    try {
+      http.listen = web::parse_listen(listen.string(), "");
+    } catch (const web::WebAccessError &e) {
+      listen.fail(e.what());
+    }
+    if (d.has("password_file"))
+      http.password_file = d.at("password_file").path();
+    return http;
   }
 
   static CameraConfig read_camera(const JsonValue &d) {

@@ -34,6 +34,7 @@
 #include "camhead/base/config_error.h"
 #include "camhead/base/video_format.h"
 #include "camhead/renderer/accumulation.h"
+#include "web/web_access.h"
 
 namespace camhead::pipeline {
 
@@ -237,6 +238,9 @@ struct Board {
   std::optional<PoseConfig> pose;
   std::vector<std::string> outputs; // output URIs, as `camhead run --output`
   RenderConfig render;
+  // The operator page (`camhead run --http`): where it listens and its
+  // password file; none: off unless the command line asks.
+  std::optional<web::WebOptions> http;
 };
 
 // "sim" and the other names in board/ resolve to board/<name>.json in the

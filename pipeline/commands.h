@@ -19,6 +19,7 @@ void add_calibrate_command(CLI::App &app); // camhead calibrate
 void add_lens_command(CLI::App &app);      // camhead lens monitor | record
 void add_markers_command(CLI::App &app);   // camhead markers draw
 void add_run_command(CLI::App &app);       // camhead run
+void add_web_command(CLI::App &app);       // camhead web-password
 
 // A command-line path held to the rule every path camhead takes from a user
 // follows (base/path_text.h): no control characters.

@@ -19,6 +19,7 @@ int main(int argc, char **argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "camhead 0.1.0");
   camhead::cli::add_run_command(app);
+  camhead::cli::add_web_command(app);
   camhead::cli::add_render_command(app);
   camhead::cli::add_devices_command(app);
   camhead::cli::add_bench_command(app);

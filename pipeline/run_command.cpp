@@ -23,6 +23,8 @@
 #include "run/run_loop.h"
 #include "run/run_paths.h"
 #include "service/service_notifier.h"
+#include "web/web_access.h"
+#include "web/web_server.h"
 
 namespace camhead::cli {
 namespace {
@@ -36,6 +38,8 @@ struct RunArgs {
   std::string executor;
   int threads = 0;
   bool no_influence_region = false;
+  std::string http;          // ADDR:PORT of the operator page; empty: the board's, if any
+  std::string http_password; // its password file
 };
 
 std::atomic<bool> stop_requested{false};
@@ -134,6 +138,21 @@ int run(const RunArgs &args) {
   options.threads = args.threads;
   options.influence_region = !args.no_influence_region;
   options.stop = &stop_requested;
+  try {
+    if (!args.http.empty()) {
+      options.web = pipeline::web::WebOptions{
+          pipeline::web::parse_listen(args.http, "--http"),
+          args.http_password.empty() ? std::nullopt
+                                     : std::optional<std::filesystem::path>(args.http_password)};
+    } else if (options.board.http) {
+      options.web = *options.board.http;
+      if (!args.http_password.empty())
+        options.web->password_file = args.http_password;
+    }
+  } catch (const pipeline::web::WebAccessError &e) {
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    return 2;
+  }
   // Under systemd (systemd/camhead@.service): its notification socket.
   const pipeline::ServiceNotifier service = pipeline::ServiceNotifier::from_environment();
   options.service = &service;
@@ -148,6 +167,9 @@ int run(const RunArgs &args) {
     options.reload = &reload_requested;
     std::signal(SIGHUP, on_reload_signal);
   }
+  // The operator page's reload button.
+  if (options.web)
+    options.reload = &reload_requested;
   int status = 0;
   try {
     status = report(pipeline::run_pipeline(options));
@@ -175,6 +197,12 @@ int run(const RunArgs &args) {
   } catch (const pipeline::StatsFileError &e) {
     std::fprintf(stderr, "camhead run: %s\n", e.what());
     status = 4;
+  } catch (const pipeline::web::WebAccessError &e) { // the page's address or password
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 2;
+  } catch (const pipeline::web::WebError &e) { // the page's module or port
+    std::fprintf(stderr, "camhead run: %s\n", e.what());
+    status = 2;
   } catch (const renderer::GpuError &e) {
     std::fprintf(stderr,
                  "camhead run: Vulkan error: %s\n(--executor cpu renders with the CPU reference "
@@ -268,6 +296,17 @@ void add_run_command(CLI::App &app) {
                 "Trace every pixel, not only where the virtual objects, their shadows and\n"
                 "their reflections can change the frame (the same video, bit for bit; for\n"
                 "comparing the cost)");
+  cmd->add_option("--http", args->http,
+                  "Serve the operator page on ADDR:PORT (8080 alone: 127.0.0.1:8080): the\n"
+                  "live preview, the lens and pose, each stage's latency, the devices' health,\n"
+                  "freeze and reload; /api/state, /api/events, /metrics (Prometheus),\n"
+                  "/stream.mjpeg. An address other machines reach needs --http-password.\n"
+                  "Replaces the board's \"http\"")
+      ->check(path_text());
+  cmd->add_option("--http-password", args->http_password,
+                  "The operator page's password file (mode 0600, from `camhead web-password\n"
+                  "FILE`): every request must give its password (the browser asks once)")
+      ->check(path_text());
   cmd->callback([args] { set_exit_code(run(*args)); });
 }
 

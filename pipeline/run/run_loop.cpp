@@ -37,6 +37,7 @@
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
 #include "tracking/pose_trace.h"
+#include "web/operator_page.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -151,6 +152,9 @@ private:
   bool lossless_ = false;
   std::int64_t start_ns_ = 0;
   std::int64_t last_output_ns_ = 0; // output thread only
+  // The operator page, if asked for; last, so that its server (which reads
+  // the members above) stops first.
+  std::unique_ptr<web::OperatorPage> page_;
 };
 
 std::vector<OutputSpec> output_specs(const RunOptions &options) {
@@ -231,6 +235,15 @@ Pipeline::Pipeline(const RunOptions &options)
   if (options.status != nullptr)
     status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_,
                     pose_source_name());
+  if (options.web) {
+    page_ = std::make_unique<web::OperatorPage>(
+        *options.web,
+        web::RunView{board_.name, board_.file.string(), board_.description, *camera_, lens_, sinks_,
+                     counters_, executor_name_, pose_source_name(), fps_, options.reload},
+        sinks_.front()->format(), camera_->format());
+    if (options.status != nullptr)
+      std::fprintf(options.status, "camhead run: operator page at %s\n", page_->url().c_str());
+  }
   if (markers_)
     markers_->start();
   // Last: a trace played from the rig's start starts with the run, not a
@@ -360,6 +373,8 @@ void Pipeline::render_loop() {
     const renderer::FrameReport report =
         setup_->renderer->render(request, {frame.format, frame.bytes}, targets_);
     r.render_end_ns = base::monotonic_ns();
+    if (page_)
+      page_->feed().camera(frame.sequence, frame.format, frame.bytes);
     delivered->frame.reset(); // the camera may fill the buffer again
     if (report.status != renderer::FrameStatus::ok) {
       ++counters_.render_failed;
@@ -462,6 +477,10 @@ void Pipeline::output_loop() {
       if (stats_ != nullptr)
         write_filler_record(stats_, output_frame, repeat ? "repeat" : "placeholder",
                             last_output_ns_);
+      if (page_)
+        page_->feed().filler(
+            output_frame, repeat ? web::FeedEntry::Kind::repeat : web::FeedEntry::Kind::placeholder,
+            last_output_ns_);
       ++output_frame;
       continue;
     }
@@ -474,6 +493,8 @@ void Pipeline::output_loop() {
     counters_.latency_ns = last_output_ns_ - slot.record.capture_ns;
     if (stats_ != nullptr)
       write_composite_record(stats_, output_frame, slot.record, last_output_ns_, record_fields_);
+    if (page_)
+      page_->feed().composite(output_frame, slot.record, last_output_ns_, slot.images.front());
     ++output_frame;
     for (std::size_t i = 0; i < sinks_.size(); ++i)
       last_frames_[i].swap(slot.images[i]); // the slot takes the older buffer

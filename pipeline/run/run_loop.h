@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "board.h"
+#include "web/web_access.h"
 
 namespace camhead::pipeline {
 
@@ -68,6 +69,10 @@ struct RunOptions {
   // error on the status output and in systemd's STATUS=, and the run goes
   // on as it was. The run clears it when it starts a reload. Null: none.
   std::atomic<bool> *reload = nullptr;
+  // The operator page (web/operator_page.h): served while the run goes,
+  // from the web module, on its own thread; the frame loop only hands it
+  // each frame's record and, while someone watches, a small preview.
+  std::optional<web::WebOptions> web;
 };
 
 // What one output took.

@@ -9,6 +9,7 @@
 //
 // Counted (tests/support/counting_new.h): C++ allocations, not the C
 // library's malloc (stdio buffers its streams with it, once).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -19,7 +20,11 @@
 #include <thread>
 #include <vector>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <pthread.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "counting_new.h"
 #include "run/run_loop.h"
@@ -67,13 +72,16 @@ protected:
     std::uint64_t reprojected = 0;     // samples moved, in all the records
     std::uint64_t tracked_frames = 0;  // composites with a tracker's pose, fresh
     std::uint64_t reloaded_frames = 0; // composites of a reload's setup
+    std::uint64_t preview_parts = 0;   // preview frames the page's watchers got
   };
 
   // A run of a take played in real time, looped, through a floor with a
   // virtual ball, with `render` as the board's render settings; `tracked`:
   // the pose of a FreeD head on this host panning to and fro; `reload`: the
-  // board reloaded (unchanged) once 10 frames are out.
-  Counts run(const std::string &render, bool tracked = false, bool reload = false) {
+  // board reloaded (unchanged) once 10 frames are out; `watched`: the
+  // operator page on, its composite and camera previews watched throughout.
+  Counts run(const std::string &render, bool tracked = false, bool reload = false,
+             bool watched = false) {
     const int w = 96, h = 64, n = 8;
     std::vector<std::vector<std::uint8_t>> frames;
     for (int k = 0; k < n; ++k)
@@ -118,9 +126,20 @@ protected:
         reload_now = true;
       });
     }
+    std::atomic<bool> ended{false};
+    std::atomic<std::uint64_t> preview_parts{0};
+    std::thread watchers;
+    if (watched) {
+      const std::uint16_t http_port = free_tcp_port();
+      options.web = web::WebOptions{{"127.0.0.1", http_port}, std::nullopt};
+      watchers = std::thread([&] { watch_previews(http_port, ended, preview_parts); });
+    }
     test::counting_new::start(thread_bucket);
     const RunSummary summary = run_pipeline(options);
     test::counting_new::stop();
+    ended = true;
+    if (watchers.joinable())
+      watchers.join();
     if (reloader.joinable())
       reloader.join();
     std::uint64_t reprojected = 0, tracked_frames = 0;
@@ -137,7 +156,66 @@ protected:
             summary.frames_out,
             reprojected,
             tracked_frames,
-            reloaded_frames};
+            reloaded_frames,
+            preview_parts};
+  }
+
+  static std::uint16_t free_tcp_port() {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    ::bind(fd, reinterpret_cast<sockaddr *>(&address), sizeof address);
+    ::getsockname(fd, reinterpret_cast<sockaddr *>(&address), &length);
+    ::close(fd);
+    return ntohs(address.sin_port);
+  }
+
+  // Two preview streams (the composite and the camera) read until `ended`;
+  // counts the parts that came.
+  static void watch_previews(std::uint16_t port, const std::atomic<bool> &ended,
+                             std::atomic<std::uint64_t> &parts) {
+    std::vector<int> streams;
+    for (const char *view : {"composite", "camera"}) {
+      int fd = -1;
+      while (!ended && fd < 0) { // until the page listens
+        fd = ::socket(AF_INET, SOCK_STREAM, 0);
+        sockaddr_in address{};
+        address.sin_family = AF_INET;
+        address.sin_port = htons(port);
+        address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        if (::connect(fd, reinterpret_cast<sockaddr *>(&address), sizeof address) != 0) {
+          ::close(fd);
+          fd = -1;
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+      }
+      if (fd < 0)
+        break;
+      const std::string request =
+          std::string("GET /stream.mjpeg?view=") + view + " HTTP/1.1\r\nHost: x\r\n\r\n";
+      (void)::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+      timeval timeout{0, 100'000};
+      ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+      streams.push_back(fd);
+    }
+    // The end of each stream so far: a part's header split between two reads.
+    std::vector<std::string> tails(streams.size());
+    char buffer[65536];
+    while (!ended)
+      for (std::size_t i = 0; i < streams.size(); ++i) {
+        const ssize_t n = ::recv(streams[i], buffer, sizeof buffer, 0);
+        if (n <= 0)
+          continue;
+        const std::string text = tails[i] + std::string(buffer, std::size_t(n));
+        for (std::size_t at = text.find("X-Frame:"); at != std::string::npos;
+             at = text.find("X-Frame:", at + 1))
+          ++parts;
+        tails[i] = text.substr(text.size() - std::min<std::size_t>(7, text.size()));
+      }
+    for (const int fd : streams)
+      ::close(fd);
   }
 };
 
@@ -170,6 +248,22 @@ TEST_F(RunAllocations, ATrackedPoseAllocatesNothingFrameAfterFrame) {
   EXPECT_GT(counts.tracked_frames, 30u) << "the run had the head's pose";
   EXPECT_EQ(counts.render, 0u);
   EXPECT_EQ(counts.output, 0u);
+}
+
+// The operator page, its previews watched: the frame loop shrinks each
+// composite and camera frame into storage made at the start, and hands the
+// page its record without a lock or an allocation (web/web_feed.h).
+TEST_F(RunAllocations, WatchersOfTheOperatorPageAddNothingToTheFrameLoop) {
+#ifndef CAMHEAD_TEST_WEB_MODULE
+  GTEST_SKIP() << "the web module was not built (libevent-dev, libturbojpeg0-dev)";
+#else
+  ::setenv("CAMHEAD_WEB_MODULE", CAMHEAD_TEST_WEB_MODULE, 1);
+  const Counts counts = run(R"({"executor": "cpu"})", false, false, true);
+  EXPECT_EQ(counts.frames_out, 40u);
+  EXPECT_GT(counts.preview_parts, 10u) << "the previews were not watched";
+  EXPECT_EQ(counts.render, 0u);
+  EXPECT_EQ(counts.output, 0u);
+#endif
 }
 
 // The driver's own threads are not camhead's, and not counted (lavapipe's

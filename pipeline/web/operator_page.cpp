@@ -1,0 +1,345 @@
+#include "operator_page.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "camhead/base/monotonic_clock.h"
+#include "web_server.h"
+
+namespace camhead::pipeline::web {
+namespace {
+
+using nlohmann::json;
+
+web_module::ServerConfig server_config(const WebOptions &options) {
+  web_module::ServerConfig config;
+  config.host = options.listen.host;
+  config.port = options.listen.port;
+  if (options.password_file) {
+    config.password_hash = read_password_file(*options.password_file);
+  } else if (!is_loopback(options.listen.host)) {
+    throw WebAccessError(
+        "--http " + options.listen.host + ":" + std::to_string(options.listen.port) +
+        ": an address other machines reach needs a password: give --http-password FILE "
+        "(`camhead web-password FILE` sets one), or listen on 127.0.0.1");
+  }
+  return config;
+}
+
+// A JSON number, or null for a value that is none (NaN: no marker seen).
+json number(double value) {
+  return std::isfinite(value) ? json(value) : json(nullptr);
+}
+
+json vec(const glm::vec3 &v) {
+  return json::array({v.x, v.y, v.z});
+}
+
+// A Prometheus label value: backslash, quote and newline escaped.
+std::string label(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\\' || c == '"')
+      out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+class Metrics {
+public:
+  // A family's help and type lines, once.
+  void family(const char *name, const char *type, const char *help) {
+    out_ += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n";
+  }
+  void sample(const std::string &name_and_labels, double value) {
+    char text[64];
+    if (std::isnan(value))
+      std::snprintf(text, sizeof text, "NaN");
+    else
+      std::snprintf(text, sizeof text, "%.9g", value);
+    out_ += name_and_labels + " " + text + "\n";
+  }
+  void one(const char *name, const char *type, const char *help, double value) {
+    family(name, type, help);
+    sample(name, value);
+  }
+  std::string take() { return std::move(out_); }
+
+private:
+  std::string out_;
+};
+
+} // namespace
+
+OperatorPage::OperatorPage(const WebOptions &options, RunView run,
+                           const base::VideoFormat &composite, const base::VideoFormat &camera)
+    : run_(std::move(run)), feed_(composite, camera), start_ns_(base::monotonic_ns()) {
+  server_ = start_web_server(server_config(options), *this);
+}
+
+OperatorPage::~OperatorPage() {
+  server_.reset(); // no call from the server's thread after this
+}
+
+std::string OperatorPage::url() const {
+  return server_->url();
+}
+
+void OperatorPage::watch(View view, int delta) {
+  feed_.watch(view, delta);
+}
+
+const PreviewImage &OperatorPage::preview(View view) {
+  if (!frozen_)
+    (void)feed_.take_preview(view);
+  return feed_.preview(view);
+}
+
+void OperatorPage::drain() {
+  while (const std::optional<FeedEntry> entry = feed_.next_entry())
+    history_.add(*entry);
+}
+
+std::string OperatorPage::state_json(const web_module::HttpStats &http) {
+  drain();
+  const RunCounters &c = run_.counters;
+  const std::int64_t now = base::monotonic_ns();
+  json state;
+  state["version"] = CAMHEAD_VERSION;
+  state["uptime_s"] = double(now - start_ns_) * 1e-9;
+  state["board"] = {{"name", run_.board_name},
+                    {"file", run_.board_file},
+                    {"description", run_.board_description}};
+  state["executor"] = run_.executor;
+  state["frozen"] = frozen_;
+  state["can_reload"] = run_.reload != nullptr;
+
+  const hal::camera::CameraStatus camera = run_.camera.status();
+  state["camera"] = {{"name", run_.camera.name()},
+                     {"format", base::describe(run_.camera.format())},
+                     {"fps", run_.fps},
+                     {"connected", camera.connected && !c.camera_lost},
+                     {"frames", camera.frames},
+                     {"dropped", camera.dropped},
+                     {"errors", camera.errors},
+                     {"reconnects", camera.reconnects},
+                     {"detail", camera.detail}};
+  json outputs = json::array();
+  for (const auto &sink : run_.sinks) {
+    const hal::output::SinkStatus status = sink->status();
+    outputs.push_back({{"name", sink->name()},
+                       {"format", base::describe(sink->format())},
+                       {"connected", status.connected},
+                       {"frames", status.frames},
+                       {"errors", status.errors},
+                       {"detail", status.detail}});
+  }
+  state["outputs"] = outputs;
+
+  const LensSnapshot lens = run_.lens.state_at(now);
+  state["lens"] = {{"source", run_.lens.source_name()},
+                   {"connected", lens.connected},
+                   {"fresh", lens.fresh},
+                   {"focus_m", lens.state.focus_distance_m.value},
+                   {"f_number", lens.state.f_number.value},
+                   {"focal_length_mm", lens.state.focal_length_mm.value}};
+
+  state["counts"] = {
+      {"frames_in", c.frames_in.load()},     {"frames_out", c.frames_out.load()},
+      {"composites", history_.composites()}, {"render_busy", c.render_busy.load()},
+      {"output_busy", c.output_busy.load()}, {"render_failed", c.render_failed.load()},
+      {"camera_dropped", camera.dropped},    {"placeholders", c.placeholders.load()},
+      {"repeats", c.repeats.load()},         {"sink_errors", c.sink_errors.load()},
+      {"lens_late", c.lens_late.load()},     {"page_records_dropped", feed_.entries_dropped()}};
+  state["rpp"] = c.rpp.load();
+  state["traced"] = c.traced_permille.load() / 1000.0;
+  state["renderer_lost"] = c.renderer_lost.load();
+
+  // Frames in and out per second over the last ten seconds of the history.
+  const auto &minute = history_.minute();
+  double out_fps = 0.0;
+  if (minute.size() > 1) {
+    const std::int64_t since = minute.back().output_ns - 10'000'000'000;
+    std::size_t n = 0;
+    std::int64_t first = minute.back().output_ns;
+    for (auto it = minute.rbegin(); it != minute.rend() && it->output_ns >= since; ++it, ++n)
+      first = it->output_ns;
+    if (n > 1 && minute.back().output_ns > first)
+      out_fps = double(n - 1) / (double(minute.back().output_ns - first) * 1e-9);
+  }
+  state["out_fps"] = out_fps;
+
+  json latency = json::object();
+  const auto stages = history_.latency();
+  for (int s = 0; s < kStages; ++s)
+    latency[std::string(stage_name(Stage(s)))] = {
+        {"median_ms", stages[std::size_t(s)].median_s * 1e3},
+        {"p99_ms", stages[std::size_t(s)].p99_s * 1e3}};
+  state["latency"] = latency;
+
+  // The newest composite as the record says it (frame_record.h).
+  if (const auto &last = history_.last_composite()) {
+    const FrameRecord &r = last->record;
+    state["frame"] = {{"frame", last->output_frame},
+                      {"sequence", r.sequence},
+                      {"setup", r.setup},
+                      {"focus_m", r.focus_m},
+                      {"f_number", r.f_number},
+                      {"focal_length_mm", r.focal_length_mm},
+                      {"lens_fresh", r.lens_fresh},
+                      {"rpp", r.rpp},
+                      {"traced", r.traced},
+                      {"history_samples", r.history_samples}};
+    state["pose"] = {{"source", run_.pose_source},
+                     {"fresh", r.pose_fresh},
+                     {"position", vec(r.position)},
+                     {"forward", vec(r.forward)},
+                     {"up", vec(r.up)},
+                     {"markers_seen", r.markers_seen},
+                     {"reprojection_px", number(r.reprojection_px)}};
+  } else {
+    state["frame"] = nullptr;
+    state["pose"] = {{"source", run_.pose_source}};
+  }
+  state["http"] = {{"requests", http.requests},
+                   {"refused_credentials", http.refused_credentials},
+                   {"missing_credentials", http.missing_credentials},
+                   {"refused_requests", http.refused_requests},
+                   {"stream_clients", http.stream_clients},
+                   {"preview_frames", http.preview_frames}};
+  return state.dump();
+}
+
+std::string OperatorPage::history_json() {
+  drain();
+  json t = json::array(), focus = json::array(), iris = json::array(), zoom = json::array(),
+       latency = json::array(), render = json::array();
+  const auto &minute = history_.minute();
+  const std::int64_t newest = minute.empty() ? 0 : minute.back().output_ns;
+  for (const FeedEntry &entry : minute) {
+    if (entry.kind != FeedEntry::Kind::composite)
+      continue;
+    t.push_back(double(entry.output_ns - newest) * 1e-9);
+    focus.push_back(entry.record.focus_m);
+    iris.push_back(entry.record.f_number);
+    zoom.push_back(entry.record.focal_length_mm);
+    latency.push_back(stage_seconds(Stage::capture_to_output, entry) * 1e3);
+    render.push_back(stage_seconds(Stage::render, entry) * 1e3);
+  }
+  return json{{"t_s", t},
+              {"focus_m", focus},
+              {"f_number", iris},
+              {"focal_length_mm", zoom},
+              {"latency_ms", latency},
+              {"render_ms", render}}
+      .dump();
+}
+
+std::string OperatorPage::metrics(const web_module::HttpStats &http) {
+  drain();
+  const RunCounters &c = run_.counters;
+  const hal::camera::CameraStatus camera = run_.camera.status();
+  Metrics m;
+  m.family("camhead_info", "gauge", "What runs: version, board and executor.");
+  m.sample("camhead_info{version=\"" + label(CAMHEAD_VERSION) + "\",board=\"" +
+               label(run_.board_name) + "\",executor=\"" + label(run_.executor) + "\"}",
+           1);
+  m.one("camhead_uptime_seconds", "gauge", "Seconds since the run started.",
+        double(base::monotonic_ns() - start_ns_) * 1e-9);
+  m.one("camhead_frames_in_total", "counter", "Camera frames captured.", double(c.frames_in));
+  m.one("camhead_frames_out_total", "counter", "Composites sent to the outputs.",
+        double(c.frames_out));
+  m.family("camhead_fillers_total", "counter",
+           "Frames sent without a new composite: the last one again, or the placeholder.");
+  m.sample("camhead_fillers_total{kind=\"repeat\"}", double(c.repeats));
+  m.sample("camhead_fillers_total{kind=\"placeholder\"}", double(c.placeholders));
+  m.family("camhead_drops_total", "counter", "Camera frames that never reached the outputs.");
+  m.sample("camhead_drops_total{cause=\"camera\"}", double(camera.dropped));
+  m.sample("camhead_drops_total{cause=\"render_busy\"}", double(c.render_busy));
+  m.sample("camhead_drops_total{cause=\"output_busy\"}", double(c.output_busy));
+  m.sample("camhead_drops_total{cause=\"render_failed\"}", double(c.render_failed));
+  m.one("camhead_lens_late_total", "counter",
+        "Composites whose lens state did not cover their mid-exposure.", double(c.lens_late));
+  m.one("camhead_camera_connected", "gauge", "1 while the camera delivers.",
+        camera.connected && !c.camera_lost ? 1 : 0);
+  m.family("camhead_output_frames_total", "counter", "Frames each output took.");
+  for (const auto &sink : run_.sinks)
+    m.sample("camhead_output_frames_total{output=\"" + label(sink->name()) + "\"}",
+             double(sink->status().frames));
+  m.family("camhead_output_errors_total", "counter", "Frames each output did not take.");
+  for (const auto &sink : run_.sinks)
+    m.sample("camhead_output_errors_total{output=\"" + label(sink->name()) + "\"}",
+             double(sink->status().errors));
+  m.one("camhead_rays_per_pixel", "gauge", "Rays per pixel of the last composite.", double(c.rpp));
+  m.one("camhead_traced_ratio", "gauge", "The fraction of the last composite's pixels traced.",
+        c.traced_permille / 1000.0);
+  if (const auto &last = history_.last_composite()) {
+    m.one("camhead_lens_focus_distance_metres", "gauge", "Focus distance of the last composite.",
+          last->record.focus_m);
+    m.one("camhead_lens_f_number", "gauge", "f-number of the last composite.",
+          last->record.f_number);
+    m.one("camhead_lens_focal_length_metres", "gauge", "Focal length of the last composite.",
+          last->record.focal_length_mm * 1e-3);
+    m.one("camhead_lens_fresh", "gauge", "1 when the last composite's lens state was current.",
+          last->record.lens_fresh ? 1 : 0);
+    m.one("camhead_pose_fresh", "gauge", "1 when the last composite's pose was current.",
+          last->record.pose_fresh ? 1 : 0);
+  }
+  m.family("camhead_stage_latency_seconds", "summary",
+           "Each stage of a composite's way, over the last ten seconds.");
+  const auto stages = history_.latency();
+  for (int s = 0; s < kStages; ++s) {
+    const std::string stage = "stage=\"" + std::string(stage_name(Stage(s))) + "\"";
+    const StageLatency &l = stages[std::size_t(s)];
+    m.sample("camhead_stage_latency_seconds{" + stage + ",quantile=\"0.5\"}", l.median_s);
+    m.sample("camhead_stage_latency_seconds{" + stage + ",quantile=\"0.99\"}", l.p99_s);
+    m.sample("camhead_stage_latency_seconds_count{" + stage + "}", double(l.frames));
+  }
+  m.one("camhead_http_requests_total", "counter", "Requests the operator page answered.",
+        double(http.requests));
+  m.family("camhead_http_refused_total", "counter", "Requests the operator page refused.");
+  m.sample("camhead_http_refused_total{reason=\"wrong_credentials\"}",
+           double(http.refused_credentials));
+  m.sample("camhead_http_refused_total{reason=\"no_credentials\"}",
+           double(http.missing_credentials));
+  m.sample("camhead_http_refused_total{reason=\"bad_request\"}", double(http.refused_requests));
+  m.one("camhead_http_stream_clients", "gauge", "Preview and event streams open.",
+        http.stream_clients);
+  m.one("camhead_preview_frames_total", "counter", "Preview frames sent to clients.",
+        double(http.preview_frames));
+  m.family("camhead_preview_jpeg_seconds", "summary", "JPEG encoding of preview frames.");
+  m.sample("camhead_preview_jpeg_seconds_sum", http.jpeg_seconds);
+  m.sample("camhead_preview_jpeg_seconds_count", double(http.jpeg_frames));
+  return m.take();
+}
+
+web_module::Reply OperatorPage::action(std::string_view name, std::string_view body) {
+  const json request = json::parse(body.empty() ? std::string_view("{}") : body, nullptr, false);
+  if (request.is_discarded() || !request.is_object())
+    return {400, json{{"error", "the body is not a JSON object"}}.dump()};
+  if (name == "freeze") {
+    const auto frozen = request.find("frozen");
+    if (frozen == request.end() || !frozen->is_boolean())
+      return {400, json{{"error", "freeze: \"frozen\" must be true or false"}}.dump()};
+    frozen_ = frozen->get<bool>();
+    return {200, json{{"frozen", frozen_}}.dump()};
+  }
+  if (name == "reload") {
+    if (run_.reload == nullptr)
+      return {409, json{{"error", "this run cannot reload its board"}}.dump()};
+    run_.reload->store(true);
+    return {202, json{{"reload", "requested: the board is read again between two frames; "
+                                 "the state's \"frame.setup\" counts the ones taken"}}
+                     .dump()};
+  }
+  return {404, json{{"error", "no action '" + std::string(name) + "' (freeze, reload)"}}.dump()};
+}
+
+} // namespace camhead::pipeline::web

@@ -1,0 +1,76 @@
+// The operator page of a run (`camhead run --http`): what the web module's
+// server (web_server.h) serves, read from the run as it goes. The frame
+// loop only feeds it (web_feed.h); everything else here runs on the
+// server's thread: the history of the last minute, the state as JSON, the
+// metrics for Prometheus, and the operator's actions.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camhead/hal/camera/camera_source.h"
+#include "camhead/hal/output/frame_sink.h"
+#include "run/lens_hub.h"
+#include "run/run_counters.h"
+#include "run_history.h"
+#include "web_access.h"
+#include "web_feed.h"
+#include "web_module_abi.h"
+
+namespace camhead::pipeline::web {
+
+// What the page reads of the run; each must outlive the page.
+struct RunView {
+  std::string board_name, board_file, board_description;
+  const hal::camera::CameraSource &camera;
+  const LensHub &lens;
+  const std::vector<std::unique_ptr<hal::output::FrameSink>> &sinks;
+  const RunCounters &counters;
+  std::string executor;
+  std::string pose_source;
+  double fps = 25.0;
+  // Set by the reload action (RunOptions::reload); null: the run cannot reload.
+  std::atomic<bool> *reload = nullptr;
+};
+
+class OperatorPage final : public web_module::Host {
+public:
+  // Starts serving (throws WebAccessError for a password the address needs
+  // and the file does not give, WebError when the server cannot start).
+  OperatorPage(const WebOptions &options, RunView run, const base::VideoFormat &composite,
+               const base::VideoFormat &camera);
+  ~OperatorPage(); // stops serving first
+  OperatorPage(const OperatorPage &) = delete;
+  OperatorPage &operator=(const OperatorPage &) = delete;
+
+  // The frame loop's side (web_feed.h).
+  [[nodiscard]] WebFeed &feed() { return feed_; }
+  // Where it is served, as bound ("http://127.0.0.1:8080/").
+  [[nodiscard]] std::string url() const;
+
+  // web_module::Host, on the server's thread.
+  void watch(View view, int delta) override;
+  const PreviewImage &preview(View view) override;
+  std::string state_json(const web_module::HttpStats &http) override;
+  std::string history_json() override;
+  std::string metrics(const web_module::HttpStats &http) override;
+  web_module::Reply action(std::string_view name, std::string_view body) override;
+
+private:
+  // Takes the record lines the frame loop sent since the last call.
+  void drain();
+
+  RunView run_;
+  WebFeed feed_;
+  RunHistory history_;
+  std::int64_t start_ns_;
+  bool frozen_ = false;                        // the preview holds its frame (the outputs go on)
+  std::unique_ptr<web_module::Server> server_; // last: stopped first
+};
+
+} // namespace camhead::pipeline::web

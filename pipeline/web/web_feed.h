@@ -1,0 +1,77 @@
+// What the frame loop hands the operator page (architecture.md: "a
+// snapshot of the pipeline's state per frame, never the frame loop"): each
+// output frame's record, and, while someone watches, a preview of the
+// composite and of the camera frame. The frame loop's side copies into
+// storage made here, once, and never waits (latest_value.h, spsc_ring.h);
+// the page reads at its own pace on its own thread and loses what it was
+// too slow for, never the other way round.
+//
+// Thread safety: composite() and filler() from the output thread,
+// camera() from the render thread, the rest from the page's thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "camhead/base/video_format.h"
+#include "latest_value.h"
+#include "preview_image.h"
+#include "run/frame_record.h"
+#include "spsc_ring.h"
+
+namespace camhead::pipeline::web {
+
+enum class View { composite = 0, camera = 1 };
+inline constexpr int kViews = 2;
+
+// One line of the run's record, as the page's history keeps it.
+struct FeedEntry {
+  enum class Kind : std::uint8_t { composite, repeat, placeholder };
+  Kind kind = Kind::composite;
+  std::uint64_t output_frame = 0;
+  std::int64_t output_ns = 0;
+  FrameRecord record; // a composite's; empty for a repeat or a placeholder
+};
+
+class WebFeed {
+public:
+  // `composite` is the format of the frames composite() gets (the first
+  // output's), `camera` the camera's.
+  WebFeed(const base::VideoFormat &composite, const base::VideoFormat &camera);
+
+  // Output thread: a composite sent to the outputs as `output_frame`.
+  void composite(std::uint64_t output_frame, const FrameRecord &record, std::int64_t output_ns,
+                 std::span<const std::uint8_t> image);
+  // Output thread: a repeat or a placeholder sent as `output_frame`.
+  void filler(std::uint64_t output_frame, FeedEntry::Kind kind, std::int64_t output_ns);
+  // Render thread: the camera frame `sequence` as it came (shrunk only
+  // while someone watches the camera, and only a frame of the camera's format).
+  void camera(std::uint64_t sequence, const base::VideoFormat &format,
+              std::span<const std::uint8_t> frame);
+
+  // Page thread: how many watch `view` (the frame loop shrinks frames for a
+  // view only while someone does).
+  void watch(View view, int delta);
+  // Page thread: whether a preview of `view` newer than preview() came; if
+  // so, preview() is it.
+  bool take_preview(View view);
+  [[nodiscard]] const PreviewImage &preview(View view) const;
+  // Page thread: the oldest record line not read yet.
+  [[nodiscard]] std::optional<FeedEntry> next_entry() { return entries_.pop(); }
+  // Record lines the page was too slow for.
+  [[nodiscard]] std::uint64_t entries_dropped() const { return entries_.dropped(); }
+
+private:
+  void shrink(View view, std::uint64_t frame, const base::VideoFormat &format,
+              std::span<const std::uint8_t> image);
+
+  base::VideoFormat formats_[kViews];
+  std::atomic<int> watchers_[kViews] = {0, 0};
+  LatestValue<PreviewImage> previews_[kViews];
+  // Four seconds of frames at 25 fps: the page drains it ten times a second.
+  SpscRing<FeedEntry> entries_{100};
+};
+
+} // namespace camhead::pipeline::web

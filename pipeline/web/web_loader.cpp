@@ -1,0 +1,80 @@
+// Finds and opens libcamhead_web.so (web_server.h), as marker_loader.cpp
+// opens the marker module: $CAMHEAD_WEB_MODULE, beside the executable, the
+// install's lib folder, then the library path. No libevent header here.
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "camhead/hal/module_search.h"
+#include "camhead/hal/shared_library.h"
+#include "web_module_abi.h"
+#include "web_server.h"
+
+namespace camhead::pipeline::web {
+namespace {
+
+constexpr const char *kModuleName = CAMHEAD_WEB_MODULE_NAME;
+// The Debian packages whose libraries the module needs at run time.
+constexpr const char *kPackages = "libevent-2.1-7 and libturbojpeg0";
+
+// Opened once and never closed: its server threads run its code until the end.
+web_module::Module &module() {
+  struct Opened {
+    hal::SharedLibrary *library; // kept reachable, for leak checkers too
+    web_module::Module *module;
+  };
+  static std::mutex mutex;
+  static const Opened *opened = nullptr;
+  const std::lock_guard lock(mutex);
+  if (opened != nullptr)
+    return *opened->module;
+  const hal::ModuleSearch search =
+      hal::module_search("CAMHEAD_WEB_MODULE", kModuleName, CAMHEAD_WEB_MODULE_RELDIR);
+  std::string last_error;
+  for (const std::string &path : search.candidates) {
+    auto library = std::make_unique<hal::SharedLibrary>(path, kPackages);
+    web_module::Factory factory = nullptr;
+    library->resolve(web_module::kFactorySymbol, factory);
+    if (!library->ok()) {
+      last_error = library->error();
+      if (path == kModuleName && hal::module_not_installed(last_error, kModuleName))
+        last_error.clear();
+      if (!last_error.empty())
+        break;
+      continue;
+    }
+    web_module::Module *instance = factory(web_module::kAbiVersion);
+    if (instance == nullptr)
+      throw WebError(path + ": built for another camhead (module ABI " +
+                     std::to_string(web_module::kAbiVersion) +
+                     " wanted); rebuild camhead and its web module together");
+    opened = new Opened{library.release(), instance}; // never closed: see above
+    return *instance;
+  }
+  if (!last_error.empty())
+    throw WebError("operator page: " + last_error);
+  throw WebError(std::string("operator page: ") + kModuleName + " is not in " + search.searched +
+                 ": camhead builds it where libevent-dev and libturbojpeg0-dev are installed "
+                 "(cmake/bootstrap.sh installs them), and it needs the Debian packages " +
+                 kPackages + " to run");
+}
+
+} // namespace
+
+std::unique_ptr<web_module::Server> start_web_server(const web_module::ServerConfig &config,
+                                                     web_module::Host &host) {
+  std::string error;
+  std::unique_ptr<web_module::Server> server = module().start(config, host, error);
+  if (!server)
+    throw WebError("operator page: " + error);
+  return server;
+}
+
+std::string hash_password(const std::string &password) {
+  std::string hash, error;
+  if (!module().hash_password(password, hash, error))
+    throw WebError("operator page: " + error);
+  return hash;
+}
+
+} // namespace camhead::pipeline::web

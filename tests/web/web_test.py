@@ -1,0 +1,261 @@
+#!/usr/bin/env python3
+"""The operator page of `camhead run` from outside, as a client sees it.
+
+    web_test.py CAMHEAD SOURCE_DIR SCRATCH_DIR
+
+1. State: /api/state's newest frame is a line of --record-stats, value for value.
+2. Metrics: /metrics parses with Prometheus's own parser (prometheus_client).
+3. Preview: the MJPEG stream's frames decode to the composite: each part
+   (its X-Frame) against that frame of the run's Y4M output, shrunk the same
+   way, within JPEG's error (PSNR).
+4. Clients: one that never reads and 20 that do, at once: the outputs get
+   every composite (no output-busy drop, no repeat) while they watch, and
+   the page still answers.
+5. Access: a page on an address other machines reach needs a password
+   (refused to start without one, or with a file others can read); without
+   it every endpoint answers 401, a wrong one 401 and after five 429 for the
+   sender; traversal, oversized headers, bad JSON and a flood are refused
+   with the right status and the run goes on.
+Prints a line per check, then PASS or FAIL.
+"""
+import io
+import json
+import os
+import socket
+import stat
+import subprocess
+import sys
+import threading
+import time
+
+import numpy
+from PIL import Image
+from prometheus_client.parser import text_string_to_metric_families
+
+import web_rig
+
+camhead, source, scratch = sys.argv[1], os.path.abspath(sys.argv[2]), os.path.abspath(sys.argv[3])
+os.makedirs(scratch, exist_ok=True)
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what, flush=True)
+    if not ok:
+        failures.append(what)
+
+
+def y4m_frames(path):
+    """Each frame's (Y, Cb, Cr) planes of a 4:2:2 Y4M file, as float arrays."""
+    data = open(path, "rb").read()
+    header_end = data.index(b"\n")
+    fields = data[:header_end].split()
+    width = int([f for f in fields if f.startswith(b"W")][0][1:])
+    height = int([f for f in fields if f.startswith(b"H")][0][1:])
+    assert b"C422" in fields, fields
+    frames, at = [], header_end + 1
+    size = width * height * 2
+    while at < len(data):
+        at = data.index(b"\n", at) + 1  # FRAME line
+        y = numpy.frombuffer(data, numpy.uint8, width * height, at).reshape(height, width)
+        cb = numpy.frombuffer(data, numpy.uint8, width * height // 2, at + width * height)
+        cr = numpy.frombuffer(data, numpy.uint8, width * height // 2,
+                              at + width * height * 3 // 2)
+        frames.append((y.astype(float), cb.reshape(height, width // 2).astype(float),
+                       cr.reshape(height, width // 2).astype(float)))
+        at += size
+    return frames
+
+
+def preview_of(planes, step):
+    """A Y4M frame shrunk by `step` (box) to BT.709 limited-range R'G'B', as camhead shrinks it."""
+    y, cb, cr = planes
+    h, w = y.shape[0] // step, y.shape[1] // step
+    box = lambda p, sx: p[:h * step, :w * sx].reshape(h, step, w, sx).mean(axis=(1, 3))
+    l = (box(y, step) - 16) * 255 / 219
+    u = (box(cb, step // 2) - 128) * 255 / 224
+    v = (box(cr, step // 2) - 128) * 255 / 224
+    kr, kb = 0.2126, 0.0722
+    r = l + 2 * (1 - kr) * v
+    b = l + 2 * (1 - kb) * u
+    g = (l - kr * r - kb * b) / (1 - kr - kb)
+    return numpy.clip(numpy.stack([r, g, b], axis=-1), 0, 255)
+
+
+def psnr(a, b):
+    mse = numpy.mean((a - b) ** 2)
+    return 99.0 if mse == 0 else 10 * numpy.log10(255 ** 2 / mse)
+
+
+# -- 1 to 4: a loopback page, no password ----------------------------------
+board = web_rig.write_board(scratch, source)
+y4m = os.path.join(scratch, "web.y4m")
+stats = os.path.join(scratch, "web_stats.jsonl")
+with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + y4m,
+                 "--duration", "40", stats=stats) as run:
+    run.wait_frames(10)
+    state = run.state()
+    seen_frame = state["frame"]
+    check(state["board"]["name"] == "web" and state["camera"]["connected"] and
+          len(state["outputs"]) == 1 and "capture_to_output" in state["latency"],
+          "state: board, camera, outputs and latency per stage")
+
+    status, headers, body = run.get("/metrics")
+    families = {f.name: f for f in text_string_to_metric_families(body.decode())}
+    out = families.get("camhead_frames_out")  # the parser drops _total
+    check(status == 200 and out is not None and out.samples[0].value >= 10 and
+          "camhead_stage_latency_seconds" in families and
+          headers.get("Content-Type", "").startswith("text/plain; version=0.0.4"),
+          "metrics: parsed by prometheus_client (%d families)" % len(families))
+
+    c = run.connection()
+    c.request("GET", "/stream.mjpeg")
+    response = c.getresponse()
+    parts = web_rig.mjpeg_frames(response, 8)
+    c.close()
+    check(response.status == 200 and len({n for n, _ in parts}) == 8,
+          "preview: 8 distinct frames from /stream.mjpeg")
+
+    # 4. Twenty clients that read and one that never does.
+    quiet = socket.create_connection((run.host, run.port))
+    quiet.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    quiet.sendall(b"GET /stream.mjpeg HTTP/1.1\r\nHost: x\r\n\r\n")
+    stop_readers = threading.Event()
+    received = [0] * 20
+
+    def reader(i):
+        rc = run.connection(timeout=20)
+        rc.request("GET", "/stream.mjpeg")
+        rr = rc.getresponse()
+        while not stop_readers.is_set():
+            web_rig.mjpeg_frames(rr, 1)
+            received[i] += 1
+        rc.close()
+
+    before = run.state()
+    readers = [threading.Thread(target=reader, args=(i,)) for i in range(20)]
+    for t in readers:
+        t.start()
+    time.sleep(8)
+    during = run.state()
+    stop_readers.set()
+    for t in readers:
+        t.join()
+    quiet.close()
+    watched = during["counts"]["frames_out"] - before["counts"]["frames_out"]
+    check(during["http"]["stream_clients"] >= 21 and min(received) > 0,
+          "clients: 21 streams open, each reader got frames (fewest %d)" % min(received))
+    check(during["counts"]["output_busy"] == before["counts"]["output_busy"] and
+          during["counts"]["repeats"] == before["counts"]["repeats"] and watched > 0,
+          "clients: %d composites out while they watched, no output-busy drop, no repeat"
+          % watched)
+check(run.process.returncode == 0, "the run ended as asked (exit %s)" % run.process.returncode)
+records = [r for r in web_rig.read_stats(stats) if r["kind"] == "composite"]
+by_frame = {r["output_frame"]: r for r in records}
+r = by_frame.get(seen_frame["frame"])
+check(r is not None and all(abs(r[k] - seen_frame[k]) <= 1e-5 * max(1.0, abs(r[k]))
+                            for k in ("focus_m", "f_number", "focal_length_mm")) and
+      r["sequence"] == seen_frame["sequence"],
+      "state: frame %d's lens is the record's (focus %.4f m, f/%.3f)"
+      % (seen_frame["frame"], seen_frame["focus_m"], seen_frame["f_number"]))
+frames = y4m_frames(y4m)
+worst = 99.0
+for number, jpeg in parts:
+    image = numpy.asarray(Image.open(io.BytesIO(jpeg)).convert("RGB"), dtype=float)
+    step = frames[number][0].shape[1] // image.shape[1]
+    worst = min(worst, psnr(image, preview_of(frames[number], step)))
+other = parts[0][0] + 50
+wrong = psnr(numpy.asarray(Image.open(io.BytesIO(parts[0][1])).convert("RGB"), dtype=float),
+             preview_of(frames[min(other, len(frames) - 1)], step))
+check(worst >= 32.0, "preview: each JPEG is its Y4M frame within JPEG's error "
+      "(worst PSNR %.1f dB; a frame 50 later: %.1f dB)" % (worst, wrong))
+
+# -- 5: access ----------------------------------------------------------------
+password_file = os.path.join(scratch, "web-password")
+if os.path.exists(password_file):
+    os.unlink(password_file)
+setter = subprocess.run([camhead, "web-password", password_file], input="correct horse\n",
+                        text=True, capture_output=True)
+check(setter.returncode == 0 and stat.S_IMODE(os.stat(password_file).st_mode) == 0o600,
+      "web-password: the hash written with mode 0600")
+short = subprocess.run([camhead, "web-password", os.path.join(scratch, "short")], input="abc\n",
+                       text=True, capture_output=True)
+check(short.returncode == 2 and not os.path.exists(os.path.join(scratch, "short")),
+      "web-password: a short password refused, nothing written")
+
+no_password = subprocess.run([camhead, "run", "--board", board, "--http", "0.0.0.0:0",
+                              "--duration", "5"], capture_output=True, text=True, timeout=60)
+check(no_password.returncode == 2 and "needs a password" in no_password.stderr,
+      "access: 0.0.0.0 without a password refused to start: " +
+      no_password.stderr.strip().splitlines()[-1])
+open_file = os.path.join(scratch, "open-password")
+with open(open_file, "w") as f:
+    f.write(open(password_file).read())
+os.chmod(open_file, 0o644)
+readable = subprocess.run([camhead, "run", "--board", board, "--http", "0.0.0.0:0",
+                           "--http-password", open_file, "--duration", "5"],
+                          capture_output=True, text=True, timeout=60)
+check(readable.returncode == 2 and "chmod 600" in readable.stderr,
+      "access: a password file others can read refused")
+
+good = web_rig.basic("operator", "correct horse")
+bad = web_rig.basic("operator", "wrong horse")
+with web_rig.Run(camhead, board, "--http", "0.0.0.0:0", "--http-password", password_file,
+                 "--duration", "60") as run:
+    run.host = "127.0.0.1"
+    endpoints = ["/", "/app.js", "/api/state", "/api/history", "/api/events", "/metrics",
+                 "/stream.mjpeg", "/snapshot.jpg", "/nothing"]
+    codes = {path: run.get(path)[0] for path in endpoints}
+    codes["POST /api/freeze"] = run.get("/api/freeze", method="POST", body="{}")[0]
+    check(set(codes.values()) == {401}, "access: every endpoint 401 without the password %s"
+          % sorted(set(codes.values())))
+    run.wait_frames(5, good)
+    check(run.get("/", good)[0] == 200 and run.get("/metrics", good)[0] == 200,
+          "access: the password opens the page")
+    traversal = [run.get(p, good)[0] for p in
+                 ["/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/..%2f..%2fetc%2fpasswd",
+                  "//etc/passwd", "/index.html/../../../etc/passwd"]]
+    check(all(code in (400, 404) for code in traversal),
+          "access: traversal refused %s" % traversal)
+    big = socket.create_connection((run.host, run.port), timeout=10)
+    big.sendall(b"GET /api/state HTTP/1.1\r\nHost: x\r\nX-Big: " + b"a" * 20000 + b"\r\n\r\n")
+    answer = big.recv(200)
+    big.close()
+    check(answer == b"" or answer.split(b" ")[1] in (b"400", b"413", b"431"),
+          "access: a 20 kB header refused (%r)" % answer[:30])
+    bad_json = run.get("/api/freeze", dict(good, **{"Content-Type": "application/json"}),
+                       method="POST", body="{not json")
+    bad_field = run.get("/api/freeze", good, method="POST", body='{"frozen": "yes"}')
+    unknown = run.get("/api/format_disk", good, method="POST", body="{}")
+    check(bad_json[0] == 400 and bad_field[0] == 400 and unknown[0] == 404,
+          "access: bad JSON 400, a wrong field 400, an unknown action 404")
+    # libevent answers a method the server does not take with 501.
+    put = run.get("/api/state", good, method="PUT", body="{}")
+    check(put[0] in (405, 501), "access: PUT refused (%d)" % put[0])
+    before = run.state(good)["counts"]["frames_out"]
+    start = time.monotonic()
+    flood_codes = set()
+    for _ in range(300):
+        flood_codes.add(run.get("/api/state", good)[0])
+    flood_s = time.monotonic() - start
+    time.sleep(1)
+    after = run.state(good)["counts"]["frames_out"]
+    check(flood_codes == {200} and after > before,
+          "access: 300 requests in %.1f s answered, the run went on (%d composites)"
+          % (flood_s, after - before))
+    wrong = [run.get("/api/state", bad)[0] for _ in range(7)]
+    locked = run.get("/api/state", good)
+    check(wrong[:5] == [401] * 5 and 429 in wrong[5:] and locked[0] == 429 and
+          "Retry-After" in locked[1],
+          "access: wrong passwords 401, then 429 with Retry-After for the sender %s" % wrong)
+    time.sleep(int(locked[1].get("Retry-After", "0")) + 0.2)
+    reopened = run.get("/metrics", good)
+    check(reopened[0] == 200, "access: the sender is heard again after Retry-After (%d)"
+          % reopened[0])
+    refused = {s.labels["reason"]: s.value for s in next(
+        f for f in text_string_to_metric_families(reopened[2].decode())
+        if f.name == "camhead_http_refused").samples}
+    check(refused["wrong_credentials"] >= 7 and refused["no_credentials"] >= len(codes),
+          "access: the refusals counted %s" % refused)
+print("PASS" if not failures else "FAIL " + "; ".join(failures))
+sys.exit(1 if failures else 0)
