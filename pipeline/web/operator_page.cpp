@@ -80,7 +80,9 @@ private:
 
 OperatorPage::OperatorPage(const WebOptions &options, RunView run,
                            const base::VideoFormat &composite, const base::VideoFormat &camera)
-    : run_(std::move(run)), feed_(composite, camera), start_ns_(base::monotonic_ns()) {
+    : run_(std::move(run)),
+      feed_(composite, camera), previews_{preview_for(composite), preview_for(camera)},
+      start_ns_(base::monotonic_ns()) {
   server_ = start_web_server(server_config(options), *this);
 }
 
@@ -97,9 +99,13 @@ void OperatorPage::watch(View view, int delta) {
 }
 
 const PreviewImage &OperatorPage::preview(View view) {
-  if (!frozen_)
-    (void)feed_.take_preview(view);
-  return feed_.preview(view);
+  PreviewImage &preview = previews_[int(view)];
+  if (!frozen_ && feed_.take_frame(view)) {
+    const FrameCopy &frame = feed_.frame(view);
+    shrink_to_preview(frame.format, frame.bytes, preview);
+    preview.frame = frame.frame;
+  }
+  return preview;
 }
 
 void OperatorPage::drain() {

@@ -15,6 +15,7 @@
 
 #include "camhead/hal/camera/camera_source.h"
 #include "camhead/hal/output/frame_sink.h"
+#include "preview_image.h"
 #include "run/lens_hub.h"
 #include "run/run_counters.h"
 #include "run_history.h"
@@ -68,6 +69,7 @@ private:
   RunView run_;
   WebFeed feed_;
   RunHistory history_;
+  PreviewImage previews_[kViews]; // the newest frame of each view, shrunk
   std::int64_t start_ns_;
   bool frozen_ = false;                        // the preview holds its frame (the outputs go on)
   std::unique_ptr<web_module::Server> server_; // last: stopped first

@@ -1,15 +1,27 @@
 #include "web_feed.h"
 
+#include <cstring>
+
 namespace camhead::pipeline::web {
+namespace {
+
+FrameCopy copy_for(const base::VideoFormat &format) {
+  FrameCopy copy;
+  copy.format = format;
+  copy.bytes.assign(base::frame_bytes(format), 0);
+  return copy;
+}
+
+} // namespace
 
 WebFeed::WebFeed(const base::VideoFormat &composite, const base::VideoFormat &camera)
-    : formats_{composite, camera}, previews_{LatestValue<PreviewImage>(preview_for(composite)),
-                                             LatestValue<PreviewImage>(preview_for(camera))} {}
+    : frames_{LatestValue<FrameCopy>(copy_for(composite)),
+              LatestValue<FrameCopy>(copy_for(camera))} {}
 
 void WebFeed::composite(std::uint64_t output_frame, const FrameRecord &record,
                         std::int64_t output_ns, std::span<const std::uint8_t> image) {
   entries_.push({FeedEntry::Kind::composite, output_frame, output_ns, record});
-  shrink(View::composite, output_frame, formats_[0], image);
+  copy(View::composite, output_frame, image);
 }
 
 void WebFeed::filler(std::uint64_t output_frame, FeedEntry::Kind kind, std::int64_t output_ns) {
@@ -18,31 +30,32 @@ void WebFeed::filler(std::uint64_t output_frame, FeedEntry::Kind kind, std::int6
 
 void WebFeed::camera(std::uint64_t sequence, const base::VideoFormat &format,
                      std::span<const std::uint8_t> frame) {
-  if (format == formats_[int(View::camera)])
-    shrink(View::camera, sequence, format, frame);
+  if (format == frames_[int(View::camera)].back().format)
+    copy(View::camera, sequence, frame);
 }
 
-void WebFeed::shrink(View view, std::uint64_t frame, const base::VideoFormat &format,
-                     std::span<const std::uint8_t> image) {
-  if (watchers_[int(view)].load(std::memory_order_relaxed) <= 0 ||
-      image.size() < base::frame_bytes(format))
+void WebFeed::copy(View view, std::uint64_t frame, std::span<const std::uint8_t> image) {
+  if (watchers_[int(view)].load(std::memory_order_relaxed) <= 0)
     return;
-  PreviewImage &preview = previews_[int(view)].back();
-  shrink_to_preview(format, image, preview);
-  preview.frame = frame;
-  previews_[int(view)].publish();
+  FrameCopy &to = frames_[int(view)].back();
+  if (image.size() < to.bytes.size())
+    return;
+  std::memcpy(to.bytes.data(), image.data(), to.bytes.size());
+  to.frame = frame;
+  to.valid = true;
+  frames_[int(view)].publish();
 }
 
 void WebFeed::watch(View view, int delta) {
   watchers_[int(view)].fetch_add(delta, std::memory_order_relaxed);
 }
 
-bool WebFeed::take_preview(View view) {
-  return previews_[int(view)].take();
+bool WebFeed::take_frame(View view) {
+  return frames_[int(view)].take();
 }
 
-const PreviewImage &WebFeed::preview(View view) const {
-  return previews_[int(view)].front();
+const FrameCopy &WebFeed::frame(View view) const {
+  return frames_[int(view)].front();
 }
 
 } // namespace camhead::pipeline::web

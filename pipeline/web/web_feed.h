@@ -1,10 +1,12 @@
 // What the frame loop hands the operator page (architecture.md: "a
 // snapshot of the pipeline's state per frame, never the frame loop"): each
-// output frame's record, and, while someone watches, a preview of the
-// composite and of the camera frame. The frame loop's side copies into
-// storage made here, once, and never waits (latest_value.h, spsc_ring.h);
-// the page reads at its own pace on its own thread and loses what it was
-// too slow for, never the other way round.
+// output frame's record, and, while someone watches, a copy of the
+// composite and of the camera frame, which the page shrinks into its
+// preview on its own thread (a copy costs the frame loop a fortieth of a
+// shrink: bench/RESULTS.md). The frame loop's side copies into storage made
+// here, once, and never waits (latest_value.h, spsc_ring.h); the page reads
+// at its own pace and loses what it was too slow for, never the other way
+// round.
 //
 // Thread safety: composite() and filler() from the output thread,
 // camera() from the render thread, the rest from the page's thread.
@@ -14,10 +16,10 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "camhead/base/video_format.h"
 #include "latest_value.h"
-#include "preview_image.h"
 #include "run/frame_record.h"
 #include "spsc_ring.h"
 
@@ -25,6 +27,14 @@ namespace camhead::pipeline::web {
 
 enum class View { composite = 0, camera = 1 };
 inline constexpr int kViews = 2;
+
+// A frame as the frame loop handed it over.
+struct FrameCopy {
+  base::VideoFormat format;
+  std::vector<std::uint8_t> bytes; // frame_bytes(format), made once
+  std::uint64_t frame = 0;         // composite: the output frame; camera: its sequence
+  bool valid = false;              // false until a frame was copied into it
+};
 
 // One line of the run's record, as the page's history keeps it.
 struct FeedEntry {
@@ -46,30 +56,28 @@ public:
                  std::span<const std::uint8_t> image);
   // Output thread: a repeat or a placeholder sent as `output_frame`.
   void filler(std::uint64_t output_frame, FeedEntry::Kind kind, std::int64_t output_ns);
-  // Render thread: the camera frame `sequence` as it came (shrunk only
+  // Render thread: the camera frame `sequence` as it came (copied only
   // while someone watches the camera, and only a frame of the camera's format).
   void camera(std::uint64_t sequence, const base::VideoFormat &format,
               std::span<const std::uint8_t> frame);
 
-  // Page thread: how many watch `view` (the frame loop shrinks frames for a
+  // Page thread: how many watch `view` (the frame loop copies frames for a
   // view only while someone does).
   void watch(View view, int delta);
-  // Page thread: whether a preview of `view` newer than preview() came; if
-  // so, preview() is it.
-  bool take_preview(View view);
-  [[nodiscard]] const PreviewImage &preview(View view) const;
+  // Page thread: whether a frame of `view` newer than frame() came; if so,
+  // frame() is it.
+  bool take_frame(View view);
+  [[nodiscard]] const FrameCopy &frame(View view) const;
   // Page thread: the oldest record line not read yet.
   [[nodiscard]] std::optional<FeedEntry> next_entry() { return entries_.pop(); }
   // Record lines the page was too slow for.
   [[nodiscard]] std::uint64_t entries_dropped() const { return entries_.dropped(); }
 
 private:
-  void shrink(View view, std::uint64_t frame, const base::VideoFormat &format,
-              std::span<const std::uint8_t> image);
+  void copy(View view, std::uint64_t frame, std::span<const std::uint8_t> image);
 
-  base::VideoFormat formats_[kViews];
   std::atomic<int> watchers_[kViews] = {0, 0};
-  LatestValue<PreviewImage> previews_[kViews];
+  LatestValue<FrameCopy> frames_[kViews];
   // Four seconds of frames at 25 fps: the page drains it ten times a second.
   SpscRing<FeedEntry> entries_{100};
 };

@@ -51,7 +51,8 @@ public:
   // Someone started (+1) or stopped (-1) watching `view`.
   virtual void watch(pipeline::web::View view, int delta) = 0;
   // The newest preview of `view` (PreviewImage::valid false before the
-  // first); what the frame loop made since the last call is taken.
+  // first): the newest frame the frame loop handed over since the last
+  // call, shrunk.
   virtual const pipeline::web::PreviewImage &preview(pipeline::web::View view) = 0;
   // GET /api/state: the run now, as JSON.
   virtual std::string state_json(const HttpStats &http) = 0;
