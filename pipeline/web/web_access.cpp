@@ -92,9 +92,15 @@ void write_password_file(const std::filesystem::path &file, const std::string &h
   const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0)
     throw WebAccessError(partial.string() + ": " + std::strerror(errno));
+  // A file that exists keeps its owner: the package's belongs to the
+  // service's user, who must read it, and root sets the password.
+  struct stat existing {};
+  const bool keep_owner = ::stat(file.c_str(), &existing) == 0 && ::geteuid() == 0;
   const std::string line = hash + "\n";
   const bool written = ::write(fd, line.data(), line.size()) == ssize_t(line.size()) &&
-                       ::fchmod(fd, 0600) == 0 && ::fsync(fd) == 0;
+                       ::fchmod(fd, 0600) == 0 &&
+                       (!keep_owner || ::fchown(fd, existing.st_uid, existing.st_gid) == 0) &&
+                       ::fsync(fd) == 0;
   const int error = errno;
   if (::close(fd) != 0 || !written)
     throw fail(std::strerror(error));

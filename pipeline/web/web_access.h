@@ -39,8 +39,8 @@ struct WebOptions {
 // it). Throws WebAccessError naming the file when it is missing, readable
 // or writable by anyone but its owner, or holds no hash.
 [[nodiscard]] std::string read_password_file(const std::filesystem::path &file);
-// Writes `hash` to `file` (replacing it whole, mode 0600; throws
-// WebAccessError naming it).
+// Writes `hash` to `file` (replacing it whole, mode 0600, the owner of the
+// file it replaces kept when run as root; throws WebAccessError naming it).
 void write_password_file(const std::filesystem::path &file, const std::string &hash);
 
 } // namespace camhead::pipeline::web

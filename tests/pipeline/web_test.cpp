@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "board.h"
 #include "web/latest_value.h"
@@ -296,6 +297,22 @@ TEST_F(PasswordFile, WrittenOnlyForItsOwnerAndReadBack) {
   EXPECT_EQ(st.st_mode & 0777, 0600u);
   EXPECT_EQ(read_password_file(file), "$y$j9T$salt$hash");
   EXPECT_FALSE(fs::exists(dir_ / "web-password.partial"));
+}
+
+// The package's file belongs to the service's user; root setting the
+// password must not take it away from the service.
+TEST_F(PasswordFile, ASetPasswordKeepsTheFilesOwner) {
+  if (::geteuid() != 0)
+    GTEST_SKIP() << "only root can give a file to another user";
+  const fs::path file = dir_ / "web-password";
+  { std::ofstream{file}; }
+  ASSERT_EQ(::chown(file.c_str(), 65534, 65534), 0);
+  write_password_file(file, "$y$j9T$salt$hash");
+  struct stat st {};
+  ASSERT_EQ(::stat(file.c_str(), &st), 0);
+  EXPECT_EQ(st.st_uid, 65534u);
+  EXPECT_EQ(st.st_gid, 65534u);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
 }
 
 TEST_F(PasswordFile, AFileOthersCanReadAnEmptyOneOrNoneIsRefusedByName) {
