@@ -97,10 +97,9 @@ void write_password_file(const std::filesystem::path &file, const std::string &h
   struct stat existing {};
   const bool keep_owner = ::stat(file.c_str(), &existing) == 0 && ::geteuid() == 0;
   const std::string line = hash + "\n";
-  const bool written = ::write(fd, line.data(), line.size()) == ssize_t(line.size()) &&
-                       ::fchmod(fd, 0600) == 0 &&
-                       (!keep_owner || ::fchown(fd, existing.st_uid, existing.st_gid) == 0) &&
-                       ::fsync(fd) == 0;
+  const bool written =
+      ::write(fd, line.data(), line.size()) == ssize_t(line.size()) && ::fchmod(fd, 0600) == 0 &&
+      (!keep_owner || ::fchown(fd, existing.st_uid, existing.st_gid) == 0) && ::fsync(fd) == 0;
   const int error = errno;
   if (::close(fd) != 0 || !written)
     throw fail(std::strerror(error));
