@@ -121,7 +121,7 @@ private:
   }
 
   static web::WebOptions read_http(const JsonValue &d) {
-    d.object({"listen"}, {"password_file"});
+    d.object({"listen"}, {"password_file", "recordings"});
     web::WebOptions http;
     const JsonValue listen = d.at("listen");
     try {
@@ -131,6 +131,8 @@ private:
     }
     if (d.has("password_file"))
       http.password_file = d.at("password_file").path();
+    if (d.has("recordings"))
+      http.recordings = d.at("recordings").path();
     return http;
   }
 

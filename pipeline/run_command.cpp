@@ -139,13 +139,11 @@ int run(const RunArgs &args) {
   options.influence_region = !args.no_influence_region;
   options.stop = &stop_requested;
   try {
-    if (!args.http.empty()) {
-      options.web = pipeline::web::WebOptions{
-          pipeline::web::parse_listen(args.http, "--http"),
-          args.http_password.empty() ? std::nullopt
-                                     : std::optional<std::filesystem::path>(args.http_password)};
-    } else if (options.board.http) {
-      options.web = *options.board.http;
+    // The board's page, its address and password file replaced by the flags.
+    if (!args.http.empty() || options.board.http) {
+      options.web = options.board.http.value_or(pipeline::web::WebOptions{});
+      if (!args.http.empty())
+        options.web->listen = pipeline::web::parse_listen(args.http, "--http");
       if (!args.http_password.empty())
         options.web->password_file = args.http_password;
     }
@@ -301,11 +299,12 @@ void add_run_command(CLI::App &app) {
                   "live preview, the lens and pose, each stage's latency, the devices' health,\n"
                   "freeze and reload; /api/state, /api/events, /metrics (Prometheus),\n"
                   "/stream.mjpeg. An address other machines reach needs --http-password.\n"
-                  "Replaces the board's \"http\"")
+                  "Replaces the board's \"http\" \"listen\"")
       ->check(path_text());
   cmd->add_option("--http-password", args->http_password,
                   "The operator page's password file (mode 0600, from `camhead web-password\n"
-                  "FILE`): every request must give its password (the browser asks once)")
+                  "FILE`): every request must give its password (the browser asks once).\n"
+                  "Replaces the board's \"http\" \"password_file\"")
       ->check(path_text());
   cmd->callback([args] { set_exit_code(run(*args)); });
 }

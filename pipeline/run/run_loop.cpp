@@ -155,6 +155,7 @@ private:
   // The operator page, if asked for; last, so that its server (which reads
   // the members above) stops first.
   std::unique_ptr<web::OperatorPage> page_;
+  std::optional<std::size_t> recording_sink_; // the output whose frames the page records
 };
 
 std::vector<OutputSpec> output_specs(const RunOptions &options) {
@@ -236,10 +237,17 @@ Pipeline::Pipeline(const RunOptions &options)
     status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_,
                     pose_source_name());
   if (options.web) {
+    // The page's takes are Y4M, of the first output in a format it takes.
+    for (std::size_t i = 0; i < sinks_.size() && !recording_sink_; ++i)
+      if (const base::PixelFormat f = sinks_[i]->format().pixel;
+          f == base::PixelFormat::yuyv || f == base::PixelFormat::nv12)
+        recording_sink_ = i;
     page_ = std::make_unique<web::OperatorPage>(
         *options.web,
         web::RunView{board_.name, board_.file.string(), board_.description, *camera_, lens_, sinks_,
-                     counters_, executor_name_, pose_source_name(), fps_, options.reload},
+                     counters_, executor_name_, pose_source_name(), fps_, options.reload,
+                     recording_sink_ ? std::optional(sinks_[*recording_sink_]->format())
+                                     : std::nullopt},
         sinks_.front()->format(), camera_->format());
     if (options.status != nullptr)
       std::fprintf(options.status, "camhead run: operator page at %s\n", page_->url().c_str());
@@ -493,8 +501,11 @@ void Pipeline::output_loop() {
     counters_.latency_ns = last_output_ns_ - slot.record.capture_ns;
     if (stats_ != nullptr)
       write_composite_record(stats_, output_frame, slot.record, last_output_ns_, record_fields_);
-    if (page_)
+    if (page_) {
       page_->feed().composite(output_frame, slot.record, last_output_ns_, slot.images.front());
+      if (recording_sink_)
+        page_->recorder().submit(slot.images[*recording_sink_], slot.record.capture_ns);
+    }
     ++output_frame;
     for (std::size_t i = 0; i < sinks_.size(); ++i)
       last_frames_[i].swap(slot.images[i]); // the slot takes the older buffer

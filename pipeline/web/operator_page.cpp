@@ -82,7 +82,7 @@ OperatorPage::OperatorPage(const WebOptions &options, RunView run,
                            const base::VideoFormat &composite, const base::VideoFormat &camera)
     : run_(std::move(run)),
       feed_(composite, camera), previews_{preview_for(composite), preview_for(camera)},
-      start_ns_(base::monotonic_ns()) {
+      recorder_(options.recordings, run_.record_format, run_.fps), start_ns_(base::monotonic_ns()) {
   server_ = start_web_server(server_config(options), *this);
 }
 
@@ -126,6 +126,11 @@ std::string OperatorPage::state_json(const web_module::HttpStats &http) {
   state["executor"] = run_.executor;
   state["frozen"] = frozen_;
   state["can_reload"] = run_.reload != nullptr;
+  state["can_record"] = run_.record_format.has_value();
+  if (const auto take = recorder_.file())
+    state["recording"] = {{"file", take->string()}, {"frames", recorder_.frames()}};
+  else
+    state["recording"] = nullptr;
 
   const hal::camera::CameraStatus camera = run_.camera.status();
   state["camera"] = {{"name", run_.camera.name()},
@@ -337,6 +342,24 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
     frozen_ = frozen->get<bool>();
     return {200, json{{"frozen", frozen_}}.dump()};
   }
+  if (name == "record") {
+    const auto recording = request.find("recording");
+    if (recording == request.end() || !recording->is_boolean())
+      return {400, json{{"error", "record: \"recording\" must be true or false"}}.dump()};
+    if (recording->get<bool>()) {
+      const PageRecorder::Started started = recorder_.start();
+      if (!started.error.empty())
+        return {409, json{{"error", "record: " + started.error}}.dump()};
+      return {200, json{{"recording", true}, {"file", started.file.string()}}.dump()};
+    }
+    const PageRecorder::Stopped stopped = recorder_.stop();
+    if (stopped.file.empty())
+      return {409, json{{"error", "record: " + stopped.error}}.dump()};
+    json reply{{"recording", false}, {"file", stopped.file.string()}, {"frames", stopped.frames}};
+    if (!stopped.error.empty())
+      reply["error"] = stopped.error;
+    return {stopped.error.empty() ? 200 : 500, reply.dump()};
+  }
   if (name == "reload") {
     if (run_.reload == nullptr)
       return {409, json{{"error", "this run cannot reload its board"}}.dump()};
@@ -345,7 +368,8 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
                                  "the state's \"frame.setup\" counts the ones taken"}}
                      .dump()};
   }
-  return {404, json{{"error", "no action '" + std::string(name) + "' (freeze, reload)"}}.dump()};
+  return {404,
+          json{{"error", "no action '" + std::string(name) + "' (freeze, record, reload)"}}.dump()};
 }
 
 } // namespace camhead::pipeline::web

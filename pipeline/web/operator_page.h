@@ -15,6 +15,7 @@
 
 #include "camhead/hal/camera/camera_source.h"
 #include "camhead/hal/output/frame_sink.h"
+#include "page_recorder.h"
 #include "preview_image.h"
 #include "run/lens_hub.h"
 #include "run/run_counters.h"
@@ -37,6 +38,9 @@ struct RunView {
   double fps = 25.0;
   // Set by the reload action (RunOptions::reload); null: the run cannot reload.
   std::atomic<bool> *reload = nullptr;
+  // The format of the output the record button writes (yuyv or nv12);
+  // none: no output of the run is in one.
+  std::optional<base::VideoFormat> record_format;
 };
 
 class OperatorPage final : public web_module::Host {
@@ -49,8 +53,9 @@ public:
   OperatorPage(const OperatorPage &) = delete;
   OperatorPage &operator=(const OperatorPage &) = delete;
 
-  // The frame loop's side (web_feed.h).
+  // The frame loop's side (web_feed.h, page_recorder.h).
   [[nodiscard]] WebFeed &feed() { return feed_; }
+  [[nodiscard]] PageRecorder &recorder() { return recorder_; }
   // Where it is served, as bound ("http://127.0.0.1:8080/").
   [[nodiscard]] std::string url() const;
 
@@ -70,6 +75,7 @@ private:
   WebFeed feed_;
   RunHistory history_;
   PreviewImage previews_[kViews]; // the newest frame of each view, shrunk
+  PageRecorder recorder_;
   std::int64_t start_ns_;
   bool frozen_ = false;                        // the preview holds its frame (the outputs go on)
   std::unique_ptr<web_module::Server> server_; // last: stopped first

@@ -26,6 +26,9 @@ struct WebOptions {
   ListenAddress listen;
   // The password file; needed for an address other than loopback.
   std::optional<std::filesystem::path> password_file;
+  // Where the page's record button writes its takes (relative: to the
+  // working directory, /var/lib/camhead for the service).
+  std::filesystem::path recordings = "recordings";
 };
 
 // "8080" (on 127.0.0.1), "127.0.0.1:8080", "0.0.0.0:8080", "[::]:8080",

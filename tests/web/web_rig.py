@@ -40,7 +40,9 @@ class Run:
         args = [camhead, "run", "--board", board, "--threads", "1", *extra]
         if stats:
             args += ["--record-stats", stats]
-        self.process = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+        # In the board's folder: the page's takes go to ./recordings.
+        self.process = subprocess.Popen(args, stderr=subprocess.PIPE, text=True,
+                                        cwd=os.path.dirname(os.path.abspath(board)))
         self.lines = []
         self.url = None
         deadline = time.monotonic() + 60

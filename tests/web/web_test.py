@@ -8,6 +8,8 @@
 3. Preview: the MJPEG stream's frames decode to the composite: each part
    (its X-Frame) against that frame of the run's Y4M output, shrunk the same
    way, within JPEG's error (PSNR).
+   Record: the record button's take holds the composites the outputs got
+   while it was on, byte for byte.
 4. Clients: one that never reads and 20 that do, at once: the outputs get
    every composite (no output-busy drop, no repeat) while they watch, and
    the page still answers.
@@ -116,6 +118,17 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + 
     check(response.status == 200 and len({n for n, _ in parts}) == 8,
           "preview: 8 distinct frames from /stream.mjpeg")
 
+    started = run.get("/api/record", method="POST", body='{"recording": true}')
+    again = run.get("/api/record", method="POST", body='{"recording": true}')
+    time.sleep(2)
+    recording = run.state()["recording"]
+    stopped = run.get("/api/record", method="POST", body='{"recording": false}')
+    take = json.loads(stopped[2]) if stopped[0] == 200 else {}
+    check(started[0] == 200 and again[0] == 409 and recording and recording["frames"] > 0 and
+          stopped[0] == 200 and os.path.exists(take.get("file", "")),
+          "record: a take started, a second refused (%d), stopped with %s frames in %s"
+          % (again[0], take.get("frames"), take.get("file")))
+
     # 4. Twenty clients that read and one that never does.
     quiet = socket.create_connection((run.host, run.port))
     quiet.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
@@ -167,6 +180,14 @@ for number, jpeg in parts:
 other = parts[0][0] + 50
 wrong = psnr(numpy.asarray(Image.open(io.BytesIO(parts[0][1])).convert("RGB"), dtype=float),
              preview_of(frames[min(other, len(frames) - 1)], step))
+take_frames = y4m_frames(take["file"]) if take.get("file") else []
+first = next((i for i, f in enumerate(frames)
+              if take_frames and all((a == b).all() for a, b in zip(f, take_frames[0]))), None)
+check(len(take_frames) == take.get("frames") and first is not None and
+      all(all((a == b).all() for a, b in zip(frames[first + i], t))
+          for i, t in enumerate(take_frames)),
+      "record: the take's %d frames are the output's frames %s.. byte for byte"
+      % (len(take_frames), first))
 check(worst >= 32.0, "preview: each JPEG is its Y4M frame within JPEG's error "
       "(worst PSNR %.1f dB; a frame 50 later: %.1f dB)" % (worst, wrong))
 

@@ -72,6 +72,10 @@ function show(state) {
     ['lens late', c.lens_late], ['output errors', c.sink_errors],
   ].map(([name, n]) => [name, String(n)]));
   $('freeze').setAttribute('aria-pressed', String(state.frozen));
+  const recording = state.recording;
+  $('record').setAttribute('aria-pressed', String(recording !== null));
+  $('record').textContent = recording ? 'stop recording (' + recording.frames + ' frames)' : 'record';
+  $('record').disabled = !state.can_record;
   $('reload').disabled = !state.can_reload;
 }
 
@@ -130,6 +134,11 @@ async function act(name, body) {
 $('freeze').addEventListener('click', () =>
   act('freeze', { frozen: $('freeze').getAttribute('aria-pressed') !== 'true' }));
 $('reload').addEventListener('click', () => act('reload', {}));
+$('record').addEventListener('click', async () => {
+  const answer = await act('record', { recording: $('record').getAttribute('aria-pressed') !== 'true' });
+  if (answer.file) text('message', (answer.recording ? 'recording to ' : 'recorded ') + answer.file +
+      (answer.frames !== undefined ? ' (' + answer.frames + ' frames)' : ''));
+});
 for (const radio of document.querySelectorAll('input[name=view]')) {
   radio.addEventListener('change', () => {
     $('preview').src = '/stream.mjpeg?view=' + radio.value;
