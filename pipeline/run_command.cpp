@@ -297,15 +297,17 @@ void add_run_command(CLI::App &app) {
   cmd->add_option("--http", args->http,
                   "Serve the operator page on ADDR:PORT (8080 alone: 127.0.0.1:8080): the\n"
                   "live preview, the lens and pose, each stage's latency, the devices' health,\n"
-                  "freeze and reload; /api/state, /api/events, /metrics (Prometheus),\n"
+                  "freeze, record and reload; /api/state, /api/events, /metrics (Prometheus),\n"
                   "/stream.mjpeg. An address other machines reach needs --http-password.\n"
                   "Replaces the board's \"http\" \"listen\"")
-      ->check(path_text());
+      ->check(path_text())
+      ->type_name("ADDR:PORT");
   cmd->add_option("--http-password", args->http_password,
                   "The operator page's password file (mode 0600, from `camhead web-password\n"
                   "FILE`): every request must give its password (the browser asks once).\n"
                   "Replaces the board's \"http\" \"password_file\"")
-      ->check(path_text());
+      ->check(path_text())
+      ->type_name("FILE");
   cmd->callback([args] { set_exit_code(run(*args)); });
 }
 
