@@ -300,8 +300,7 @@ void add_run_command(CLI::App &app) {
                   "freeze, record and reload; /api/state, /api/events, /metrics (Prometheus),\n"
                   "/stream.mjpeg. An address other machines reach needs --http-password.\n"
                   "Replaces the board's \"http\" \"listen\"")
-      ->check(path_text())
-      ->type_name("ADDR:PORT");
+      ->type_name("ADDR:PORT"); // parse_listen() checks it
   cmd->add_option("--http-password", args->http_password,
                   "The operator page's password file (mode 0600, from `camhead web-password\n"
                   "FILE`): every request must give its password (the browser asks once).\n"
