@@ -78,18 +78,18 @@ PageRecorder::Stopped PageRecorder::stop(double wait_s) {
     return {{}, 0, "not recording"};
   stopping_.store(true, std::memory_order_release);
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
-  while (!released_.load(std::memory_order_acquire) &&
-         std::chrono::steady_clock::now() < give_up)
+  while (!released_.load(std::memory_order_acquire) && std::chrono::steady_clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   if (!released_.load(std::memory_order_acquire))
-    return {file_, frames(), "the output thread sent no frame for " + std::to_string(wait_s) +
-                                 " s; the take goes on"};
+    return {file_, frames(),
+            "the output thread sent no frame for " + std::to_string(wait_s) +
+                " s; the take goes on"};
   Stopped out{file_, frames(), {}};
   if (!sink_->close())
     out.error = file_.string() + ": " + sink_->status().detail;
   else if (failed_ > 0)
-    out.error = std::to_string(failed_.load()) + " frames could not be written: " +
-                sink_->status().detail;
+    out.error =
+        std::to_string(failed_.load()) + " frames could not be written: " + sink_->status().detail;
   sink_.reset();
   return out;
 }

@@ -29,6 +29,10 @@ ListenAddress parse_listen(const std::string &text, const std::string &what) {
                           " (PORT, ADDRESS:PORT or [IPv6]:PORT, such as 8080, "
                           "127.0.0.1:8080 or 0.0.0.0:8080)");
   };
+  for (const char c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      throw WebAccessError((what.empty() ? "" : what + ": ") +
+                           "has a control character (PORT, ADDRESS:PORT or [IPv6]:PORT)");
   ListenAddress out{"127.0.0.1", 0};
   std::string port = text;
   if (!text.empty() && text.front() == '[') {

@@ -49,7 +49,7 @@ std::string base64(const std::string &text) {
 const std::string &hash() {
   static const std::string h = [] {
     crypt_data data{};
-    return std::string(crypt_r("right password", "$5$rounds=1000$fuzzsalt$", &data));
+    return std::string(crypt_rn("right password", "$5$rounds=1000$fuzzsalt$", &data, sizeof data));
   }();
   return h;
 }

@@ -132,7 +132,7 @@ protected:
     if (watched) {
       const std::uint16_t http_port = free_tcp_port();
       options.web = web::WebOptions{{"127.0.0.1", http_port}, std::nullopt};
-      watchers = std::thread([&] { watch_previews(http_port, ended, preview_parts); });
+      watchers = std::thread([&, http_port] { watch_previews(http_port, ended, preview_parts); });
     }
     test::counting_new::start(thread_bucket);
     const RunSummary summary = run_pipeline(options);

@@ -59,9 +59,11 @@ std::optional<std::string> base64_decode(std::string_view text) {
   return out;
 }
 
+// crypt_rn, not crypt_r: the sanitizers intercept crypt_r, and their
+// interceptor finds no libcrypt in a module opened after start (a crash).
 bool password_matches(const std::string &password, const std::string &hash) {
   crypt_data data{};
-  const char *result = crypt_r(password.c_str(), hash.c_str(), &data);
+  const char *result = crypt_rn(password.c_str(), hash.c_str(), &data, sizeof data);
   return result != nullptr && result[0] != '*' && same(result, hash);
 }
 
@@ -115,7 +117,7 @@ std::string hash_password(const std::string &password, std::string &error) {
     return {};
   }
   crypt_data data{};
-  const char *hash = crypt_r(password.c_str(), salt, &data);
+  const char *hash = crypt_rn(password.c_str(), salt, &data, sizeof data);
   if (hash == nullptr || hash[0] == '*') {
     error = "the password could not be hashed";
     return {};

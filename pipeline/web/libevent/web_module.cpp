@@ -336,12 +336,16 @@ private:
     evhttp_send_reply_start(request, 200, "OK");
   }
 
-  // The client's connection is gone: libevent frees its request.
+  // The client's connection is gone. A stream libevent had not seen
+  // finished is taken off the connection, left to its user to free
+  // (evhttp_connection_incoming_fail); one still on it is freed with it.
   void closed(StreamClient *client) {
     for (auto it = clients_.begin(); it != clients_.end(); ++it)
       if (&*it == client) {
         if (client->kind != StreamClient::Kind::events)
           host_.watch(client->view, -1);
+        if (evhttp_request_get_connection(client->request) == nullptr)
+          evhttp_request_free(client->request);
         clients_.erase(it);
         return;
       }
