@@ -11,6 +11,7 @@
 #include "camhead/renderer/gpu_tracer.h"
 #include "commands.h"
 #include "tracking/marker_tracker.h"
+#include "web/web_server.h"
 
 namespace camhead::cli {
 namespace {
@@ -109,6 +110,16 @@ void list_pose_sources() {
     std::printf("  marker: not here: %s\n", problem.c_str());
 }
 
+void list_operator_page() {
+  const std::string problem = pipeline::web::web_module_problem();
+  if (problem.empty())
+    std::printf("Operator page (camhead run --http ADDR:PORT, board \"http\"): can be served "
+                "(%s loads)\n",
+                pipeline::web::web_module_name());
+  else
+    std::printf("Operator page: not here: %s\n", problem.c_str());
+}
+
 int list_vulkan() {
   try {
     const auto devices = renderer::list_gpu_devices();
@@ -130,6 +141,7 @@ int list_devices() {
   list_displays(discovery::list_display_cards());
   list_lens_encoders();
   list_pose_sources();
+  list_operator_page();
   return list_vulkan();
 }
 

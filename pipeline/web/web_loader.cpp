@@ -52,19 +52,41 @@ web_module::Module &module() {
     return *instance;
   }
   if (!last_error.empty())
-    throw WebError("operator page: " + last_error);
-  throw WebError(std::string("operator page: ") + kModuleName + " is not in " + search.searched +
+    throw WebError(last_error);
+  throw WebError(std::string(kModuleName) + " is not in " + search.searched +
                  ": camhead builds it where libevent-dev and libturbojpeg0-dev are installed "
                  "(cmake/bootstrap.sh installs them), and it needs the Debian packages " +
                  kPackages + " to run");
 }
 
+// The module, or WebError saying the operator page cannot be served and why.
+web_module::Module &page_module() {
+  try {
+    return module();
+  } catch (const WebError &e) {
+    throw WebError(std::string("operator page: ") + e.what());
+  }
+}
+
 } // namespace
+
+const char *web_module_name() {
+  return kModuleName;
+}
+
+std::string web_module_problem() {
+  try {
+    (void)module();
+    return {};
+  } catch (const WebError &e) {
+    return e.what();
+  }
+}
 
 std::unique_ptr<web_module::Server> start_web_server(const web_module::ServerConfig &config,
                                                      web_module::Host &host) {
   std::string error;
-  std::unique_ptr<web_module::Server> server = module().start(config, host, error);
+  std::unique_ptr<web_module::Server> server = page_module().start(config, host, error);
   if (!server)
     throw WebError("operator page: " + error);
   return server;
@@ -72,7 +94,7 @@ std::unique_ptr<web_module::Server> start_web_server(const web_module::ServerCon
 
 std::string hash_password(const std::string &password) {
   std::string hash, error;
-  if (!module().hash_password(password, hash, error))
+  if (!page_module().hash_password(password, hash, error))
     throw WebError("operator page: " + error);
   return hash;
 }

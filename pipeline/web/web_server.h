@@ -22,6 +22,11 @@ public:
 [[nodiscard]] std::unique_ptr<web_module::Server>
 start_web_server(const web_module::ServerConfig &config, web_module::Host &host);
 
+// The module's file name, and why it cannot be opened ("" when it can):
+// for `camhead devices`.
+[[nodiscard]] const char *web_module_name();
+[[nodiscard]] std::string web_module_problem();
+
 // `password`'s crypt(3) hash, for a password file (throws WebError).
 [[nodiscard]] std::string hash_password(const std::string &password);
 

@@ -28,6 +28,11 @@ for path in /usr/bin/camhead /usr/lib/systemd/system/camhead@.service \
   /usr/lib/modprobe.d/camhead-v4l2loopback.conf /usr/lib/modules-load.d/camhead.conf; do
   grep -qx "$path" "$scratch/contents" || fail "$path is not in the package"
 done
+# The operator page's module, where the build made it, beside the others.
+if [ -e "$build/libcamhead_web.so" ]; then
+  grep -q '^/usr/lib/.*camhead/libcamhead_web.so$' "$scratch/contents" ||
+    fail "the operator page's module is not in the package"
+fi
 if grep -q '^/usr/local/' "$scratch/contents"; then fail "files under /usr/local"; fi
 
 control=$(dpkg-deb -f "$deb")
@@ -36,6 +41,8 @@ echo "$control" | grep -q '^Depends:.*libvulkan1' || fail "Depends lacks libvulk
 echo "$control" | grep -q '^Depends:.*mesa-vulkan-drivers | vulkan-icd' || fail "Depends lacks a Vulkan driver"
 dpkg-deb -e "$deb" "$scratch/control"
 grep -q 'systemd-sysusers camhead.conf' "$scratch/control/postinst" || fail "postinst makes no user"
+grep -q 'install -m 0600 /dev/null /etc/camhead/web-password' "$scratch/control/postinst" ||
+  fail "postinst makes no empty operator page password file"
 # Every board is the administrator's too: a conffile in /etc/camhead/board.
 for board in sim rpi5-libcamera-hdmi x86-uvc-webcam; do
   grep -qx "/etc/camhead/board/$board.json" "$scratch/contents" || fail "no /etc board $board"
