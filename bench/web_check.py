@@ -82,7 +82,7 @@ with web_rig.Run(args.camhead, board, "--http", "127.0.0.1:0", stats=stats) as r
         sockets = []
         if quiet:
             s = socket.create_connection((run.host, run.port))
-            s.sendall(b"GET /stream.mjpeg HTTP/1.1\r\nHost: x\r\n\r\n")
+            s.sendall(b"GET /stream.mjpeg HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
             sockets.append(s)
         for r in readers:
             r.start()

@@ -151,11 +151,11 @@ private:
   // the capture thread waits for the renderer instead of replacing frames.
   bool lossless_ = false;
   std::int64_t start_ns_ = 0;
-  std::int64_t last_output_ns_ = 0; // output thread only
+  std::int64_t last_output_ns_ = 0;           // output thread only
+  std::optional<std::size_t> recording_sink_; // the output whose frames the page records
   // The operator page, if asked for; last, so that its server (which reads
   // the members above) stops first.
   std::unique_ptr<web::OperatorPage> page_;
-  std::optional<std::size_t> recording_sink_; // the output whose frames the page records
 };
 
 std::vector<OutputSpec> output_specs(const RunOptions &options) {
@@ -485,10 +485,15 @@ void Pipeline::output_loop() {
       if (stats_ != nullptr)
         write_filler_record(stats_, output_frame, repeat ? "repeat" : "placeholder",
                             last_output_ns_);
-      if (page_)
+      if (page_) {
         page_->feed().filler(
             output_frame, repeat ? web::FeedEntry::Kind::repeat : web::FeedEntry::Kind::placeholder,
             last_output_ns_);
+        if (recording_sink_) // a take keeps the outputs' time, fillers included
+          page_->recorder().submit(repeat ? last_frames_[*recording_sink_]
+                                          : placeholders_[*recording_sink_],
+                                   last_output_ns_);
+      }
       ++output_frame;
       continue;
     }

@@ -1,5 +1,6 @@
-// The operator page's record button: the composite written to a Y4M file
-// while it is on, as the `file:PATH.y4m` output writes one. The page's
+// The operator page's record button: what an output gets (the composites,
+// and the repeats and placeholders that keep its time) written to a Y4M
+// file while it is on, as the `file:PATH.y4m` output writes one. The page's
 // thread opens the file (so no frame waits for the disk's open or the
 // folder's creation) and hands the sink to the output thread, which writes
 // each composite it sends anyway; to stop, the output thread lets go of
@@ -30,7 +31,7 @@ public:
   PageRecorder(std::filesystem::path folder, std::optional<base::VideoFormat> format, double fps);
   ~PageRecorder(); // a take still running is closed whole
 
-  // Output thread: a composite sent to the outputs, in `format`.
+  // Output thread: a frame sent to the outputs, in `format`.
   void submit(std::span<const std::uint8_t> frame, std::int64_t capture_ns);
 
   // Page thread. Starts a take named by the time; its path, or an error.

@@ -194,7 +194,7 @@ protected:
       if (fd < 0)
         break;
       const std::string request =
-          std::string("GET /stream.mjpeg?view=") + view + " HTTP/1.1\r\nHost: x\r\n\r\n";
+          std::string("GET /stream.mjpeg?view=") + view + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
       (void)::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
       timeval timeout{0, 100'000};
       ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);

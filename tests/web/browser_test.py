@@ -10,7 +10,10 @@ on the simulated rig.
    frame it names (the page shows one frame's record, so they match it
    exactly, to the digits shown).
 3. The lens plot has been drawn (its canvas is not blank).
-A screenshot of the whole page is left in SCRATCH_DIR/page.png.
+4. On a phone's screen (390x844 CSS pixels) nothing is wider than the
+   screen: no sideways scrolling.
+Screenshots of the whole page are left in SCRATCH_DIR/page.png and
+phone.png.
 Prints a line per check, then PASS or FAIL.
 """
 import io
@@ -72,6 +75,13 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--duration", "60",
             "return lit")
         check(blank > 100, "the lens plot is drawn (%d bright pixels)" % blank)
         driver.save_screenshot(os.path.join(scratch, "page.png"))
+        driver.set_window_size(390, 844)
+        time.sleep(1)
+        widths = driver.execute_script(
+            "return [document.documentElement.scrollWidth, window.innerWidth]")
+        check(widths[0] <= widths[1],
+              "on a phone's screen the page is no wider than it (%d <= %d px)" % tuple(widths))
+        driver.save_screenshot(os.path.join(scratch, "phone.png"))
     finally:
         driver.quit()
 frame, focus, iris, zoom = shown

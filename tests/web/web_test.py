@@ -121,21 +121,40 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + 
     check(response.status == 200 and len({n for n, _ in parts}) == 8,
           "preview: 8 distinct frames from /stream.mjpeg")
 
-    started = run.get("/api/record", method="POST", body='{"recording": true}')
-    again = run.get("/api/record", method="POST", body='{"recording": true}')
+    as_json = {"Content-Type": "application/json"}
+    started = run.get("/api/record", as_json, method="POST", body='{"recording": true}')
+    again = run.get("/api/record", as_json, method="POST", body='{"recording": true}')
     time.sleep(2)
     recording = run.state()["recording"]
-    stopped = run.get("/api/record", method="POST", body='{"recording": false}')
+    stopped = run.get("/api/record", as_json, method="POST", body='{"recording": false}')
     take = json.loads(stopped[2]) if stopped[0] == 200 else {}
     check(started[0] == 200 and again[0] == 409 and recording and recording["frames"] > 0 and
           stopped[0] == 200 and os.path.exists(take.get("file", "")),
           "record: a take started, a second refused (%d), stopped with %s frames in %s"
           % (again[0], take.get("frames"), take.get("file")))
 
+    taken = subprocess.run([camhead, "run", "--board", board, "--http", "127.0.0.1:%d" % run.port,
+                            "--output", "file:" + os.path.join(scratch, "never.y4m"),
+                            "--duration", "5"], capture_output=True, text=True, timeout=60)
+    check(taken.returncode == 2 and "cannot listen on 127.0.0.1:%d" % run.port in taken.stderr and
+          not os.path.exists(os.path.join(scratch, "never.y4m")) and
+          not os.path.exists(os.path.join(scratch, "never.y4m.partial")),
+          "a port already taken: exit 2, named, no output file left: " +
+          (taken.stderr.strip().splitlines() or [""])[-1])
+
+    # A page of another site in this machine's browser: a form's POST, and
+    # a name of that site resolving here (DNS rebinding).
+    form = run.get("/api/freeze", {"Content-Type": "text/plain"}, method="POST",
+                   body='{"frozen": true}')
+    rebound = run.get("/api/state", {"Host": "attacker.example:%d" % run.port})
+    check(form[0] == 415 and rebound[0] == 403 and not run.state()["frozen"],
+          "access: a form's POST refused (%d), a foreign Host refused (%d)"
+          % (form[0], rebound[0]))
+
     # 4. Twenty clients that read and one that never does.
     quiet = socket.create_connection((run.host, run.port))
     quiet.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    quiet.sendall(b"GET /stream.mjpeg HTTP/1.1\r\nHost: x\r\n\r\n")
+    quiet.sendall(b"GET /stream.mjpeg HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
     stop_readers = threading.Event()
     received = [0] * 20
 
@@ -185,13 +204,15 @@ other = parts[0][0] + 50
 wrong = psnr(numpy.asarray(Image.open(io.BytesIO(parts[0][1])).convert("RGB"), dtype=float),
              preview_of(frames[min(other, len(frames) - 1)], step))
 take_frames = y4m_frames(take["file"]) if take.get("file") else []
-first = next((i for i, f in enumerate(frames)
-              if take_frames and all((a == b).all() for a, b in zip(f, take_frames[0]))), None)
-check(len(take_frames) == take.get("frames") and first is not None and
-      all(all((a == b).all() for a, b in zip(frames[first + i], t))
-          for i, t in enumerate(take_frames)),
-      "record: the take's %d frames are the output's frames %s.. byte for byte"
-      % (len(take_frames), first))
+same = lambda a, b: all((p == q).all() for p, q in zip(a, b))
+# Where in the output the take starts: the offset at which every frame of
+# it is the output's (a still lens can give equal frames, so not the first
+# equal one alone).
+first = next((i for i in range(len(frames) - len(take_frames) + 1) if take_frames and
+              all(same(frames[i + k], t) for k, t in enumerate(take_frames))), None)
+check(len(take_frames) == take.get("frames") and first is not None,
+      "record: the take's %d frames (%s said) are the output's frames %s.. byte for byte"
+      % (len(take_frames), take.get("frames"), first))
 check(worst >= 32.0, "preview: each JPEG is its Y4M frame within JPEG's error "
       "(worst PSNR %.1f dB; a frame 50 later: %.1f dB)" % (worst, wrong))
 
@@ -248,10 +269,10 @@ with web_rig.Run(camhead, board, "--http", "0.0.0.0:0", "--http-password", passw
     big.close()
     check(answer == b"" or answer.split(b" ")[1] in (b"400", b"413", b"431"),
           "access: a 20 kB header refused (%r)" % answer[:30])
-    bad_json = run.get("/api/freeze", dict(good, **{"Content-Type": "application/json"}),
-                       method="POST", body="{not json")
-    bad_field = run.get("/api/freeze", good, method="POST", body='{"frozen": "yes"}')
-    unknown = run.get("/api/format_disk", good, method="POST", body="{}")
+    good_json = dict(good, **{"Content-Type": "application/json"})
+    bad_json = run.get("/api/freeze", good_json, method="POST", body="{not json")
+    bad_field = run.get("/api/freeze", good_json, method="POST", body='{"frozen": "yes"}')
+    unknown = run.get("/api/format_disk", good_json, method="POST", body="{}")
     check(bad_json[0] == 400 and bad_field[0] == 400 and unknown[0] == 404,
           "access: bad JSON 400, a wrong field 400, an unknown action 404")
     # libevent answers a method the server does not take with 501.

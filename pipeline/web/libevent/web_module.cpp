@@ -119,7 +119,6 @@ struct StreamClient {
   Kind kind = Kind::mjpeg;
   View view = View::composite;
   std::uint64_t last_frame = ~std::uint64_t(0);
-  bool sent_any = false;
   bool writing = false;    // a chunk is on its way: wait for it to drain
   std::int64_t due_ns = 0; // events: the next; snapshot: give up
 };
@@ -241,6 +240,12 @@ private:
                         "Basic realm=\"camhead\", charset=\"UTF-8\"");
       return error(request, 401, "Unauthorized", "this page needs the head's password");
     }
+    // Without a password only this machine reaches the page, but a page in
+    // its browser from another site could, through a name that resolves to
+    // this machine (DNS rebinding): such a request names that site.
+    if (credentials == Credentials::none_needed && !local_host(request))
+      return refuse(request, 403, "Forbidden",
+                    "this page answers to localhost and this machine's loopback addresses only");
     const evhttp_uri *uri = evhttp_request_get_evhttp_uri(request);
     const char *raw_path = uri != nullptr ? evhttp_uri_get_path(uri) : nullptr;
     const std::string path = raw_path != nullptr && raw_path[0] != '\0' ? raw_path : "/";
@@ -249,6 +254,14 @@ private:
     if (method == EVHTTP_REQ_POST) {
       if (!path.starts_with("/api/") || path.size() > 64)
         return refuse(request, 404, "Not Found", "no such action");
+      // JSON only: a form on another site cannot send it without asking
+      // first (a CORS preflight, which this server does not answer), so a
+      // browser that holds the password cannot be made to act for it.
+      const char *type =
+          evhttp_find_header(evhttp_request_get_input_headers(request), "Content-Type");
+      if (type == nullptr || std::string_view(type).substr(0, 16) != "application/json")
+        return refuse(request, 415, "Unsupported Media Type",
+                      "an action's body is JSON (Content-Type: application/json)");
       evbuffer *input = evhttp_request_get_input_buffer(request);
       std::string body(evbuffer_get_length(input), '\0');
       evbuffer_copyout(input, body.data(), body.size());
@@ -285,6 +298,20 @@ private:
                     *view);
     }
     refuse(request, 404, "Not Found", "no such page");
+  }
+
+  // Whether the request's Host names this machine's loopback.
+  static bool local_host(evhttp_request *request) {
+    const char *host = evhttp_find_header(evhttp_request_get_input_headers(request), "Host");
+    if (host == nullptr)
+      return true; // HTTP/1.0: no browser sends one without it
+    std::string_view name(host);
+    if (name.starts_with("[")) {
+      name = name.substr(1, name.find(']') == std::string_view::npos ? 0 : name.find(']') - 1);
+    } else if (const std::size_t colon = name.rfind(':'); colon != std::string_view::npos) {
+      name = name.substr(0, colon);
+    }
+    return name == "localhost" || name == "::1" || name.starts_with("127.");
   }
 
   void refuse(evhttp_request *request, int status, const char *reason, const std::string &why) {
