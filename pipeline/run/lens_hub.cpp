@@ -68,6 +68,11 @@ LensSnapshot LensHub::state_at(std::int64_t t_ns) const {
   return snapshot;
 }
 
+std::optional<hal::lens::EncoderReading> LensHub::last_reading() const {
+  std::lock_guard lock(mutex_);
+  return channels_.front().last_reading();
+}
+
 LensSnapshot LensHub::state_when_covered(std::int64_t t_ns, std::int64_t give_up_ns,
                                          const std::atomic<bool> *stop) const {
   LensSnapshot lens = state_at(t_ns);

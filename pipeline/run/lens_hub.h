@@ -77,6 +77,10 @@ public:
   // on (a reload): the history stays, so no frame loses its lens.
   void set_profile(const lens_control::LensProfile &profile);
 
+  // The lens source's newest reading as it came (encoder counts, or the
+  // values a calibrated source sends), for calibration marks.
+  [[nodiscard]] std::optional<hal::lens::EncoderReading> last_reading() const;
+
   // "focus pull [trace ...]" for the status line.
   [[nodiscard]] std::string source_name() const;
 

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calibration_marks.h"
 #include "camhead/base/monotonic_clock.h"
 #include "web_server.h"
 
@@ -82,7 +83,8 @@ OperatorPage::OperatorPage(const WebOptions &options, RunView run,
                            const base::VideoFormat &composite, const base::VideoFormat &camera)
     : run_(std::move(run)),
       feed_(composite, camera), previews_{preview_for(composite), preview_for(camera)},
-      recorder_(options.recordings, run_.record_format, run_.fps), start_ns_(base::monotonic_ns()) {
+      recorder_(options.recordings, run_.record_format, run_.fps),
+      marks_file_(options.recordings / "lens-marks.csv"), start_ns_(base::monotonic_ns()) {
   server_ = start_web_server(server_config(options), *this);
 }
 
@@ -155,7 +157,18 @@ std::string OperatorPage::state_json(const web_module::HttpStats &http) {
   state["outputs"] = outputs;
 
   const LensSnapshot lens = run_.lens.state_at(now);
+  const std::optional<hal::lens::EncoderReading> reading = run_.lens.last_reading();
+  const auto counts = [&](std::optional<std::int32_t> hal::lens::EncoderReading::*axis) {
+    if (!reading)
+      return json(nullptr);
+    const std::optional<std::int32_t> &value = (*reading).*axis;
+    return value ? json(*value) : json(nullptr);
+  };
   state["lens"] = {{"source", run_.lens.source_name()},
+                   {"counts",
+                    {{"focus", counts(&hal::lens::EncoderReading::focus)},
+                     {"iris", counts(&hal::lens::EncoderReading::iris)},
+                     {"zoom", counts(&hal::lens::EncoderReading::zoom)}}},
                    {"connected", lens.connected},
                    {"fresh", lens.fresh},
                    {"focus_m", lens.state.focus_distance_m.value},
@@ -360,6 +373,43 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
       reply["error"] = stopped.error;
     return {stopped.error.empty() ? 200 : 500, reply.dump()};
   }
+  if (name == "mark") {
+    const auto axis_field = request.find("axis");
+    const auto value_field = request.find("value");
+    const std::optional<MarkAxis> axis = axis_field != request.end() && axis_field->is_string()
+                                             ? parse_mark_axis(axis_field->get<std::string>())
+                                             : std::nullopt;
+    if (!axis)
+      return {400,
+              json{{"error", "mark: \"axis\" must be \"focus\", \"iris\" or \"zoom\""}}.dump()};
+    if (value_field == request.end() || !value_field->is_number() ||
+        !std::isfinite(value_field->get<double>()) || value_field->get<double>() <= 0.0 ||
+        value_field->get<double>() > 1e6)
+      return {400, json{{"error", "mark: \"value\" must be the measured distance (m), "
+                                  "f-number or focal length (mm), above 0"}}
+                       .dump()};
+    const std::optional<hal::lens::EncoderReading> reading = run_.lens.last_reading();
+    const std::optional<std::int32_t> counts = !reading                   ? std::nullopt
+                                               : *axis == MarkAxis::focus ? reading->focus
+                                               : *axis == MarkAxis::iris  ? reading->iris
+                                                                          : reading->zoom;
+    if (!counts || !run_.lens.state_at(base::monotonic_ns()).connected)
+      return {409,
+              json{{"error", "mark: the lens source gives no " + axis_field->get<std::string>() +
+                                 " counts now (not connected, or it sends calibrated "
+                                 "values, which need no calibration)"}}
+                  .dump()};
+    const std::filesystem::path file = std::filesystem::absolute(marks_file_);
+    const std::string error =
+        append_mark(file, run_.board_name, *axis, *counts, value_field->get<double>());
+    if (!error.empty())
+      return {500, json{{"error", "mark: " + error}}.dump()};
+    return {200, json{{"file", file.string()},
+                      {"axis", axis_field->get<std::string>()},
+                      {"counts", *counts},
+                      {"value", value_field->get<double>()}}
+                     .dump()};
+  }
   if (name == "reload") {
     if (run_.reload == nullptr)
       return {409, json{{"error", "this run cannot reload its board"}}.dump()};
@@ -369,7 +419,8 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
                      .dump()};
   }
   return {404,
-          json{{"error", "no action '" + std::string(name) + "' (freeze, record, reload)"}}.dump()};
+          json{{"error", "no action '" + std::string(name) + "' (freeze, record, mark, reload)"}}
+              .dump()};
 }
 
 } // namespace camhead::pipeline::web

@@ -76,6 +76,7 @@ private:
   RunHistory history_;
   PreviewImage previews_[kViews]; // the newest frame of each view, shrunk
   PageRecorder recorder_;
+  std::filesystem::path marks_file_; // the calibration marks (calibration_marks.h)
   std::int64_t start_ns_;
   bool frozen_ = false;                        // the preview holds its frame (the outputs go on)
   std::unique_ptr<web_module::Server> server_; // last: stopped first

@@ -142,6 +142,18 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + 
           "a port already taken: exit 2, named, no output file left: " +
           (taken.stderr.strip().splitlines() or [""])[-1])
 
+    marks = [run.get("/api/mark", as_json, method="POST", body=body) for body in
+             ('{"axis": "focus", "value": 2.5}', '{"axis": "iris", "value": 4}',
+              '{"axis": "focal", "value": 35}', '{"axis": "zoom", "value": -1}')]
+    focus_mark, iris_mark = (json.loads(m[2]) for m in marks[:2])
+    rows = [line.strip().split(",") for line in open(focus_mark.get("file", os.devnull))
+            if line[:1].isalpha() and not line.startswith("axis,")]
+    check([m[0] for m in marks] == [200, 200, 400, 400] and
+          rows == [["focus", str(focus_mark["counts"]), "2.5", "", "", ""],
+                   ["iris", str(iris_mark["counts"]), "", "4", "", ""]],
+          "mark: focus and iris at the lens's counts, written as camhead calibrate reads them; "
+          "a wrong axis or value 400 (%s)" % rows)
+
     # A page of another site in this machine's browser: a form's POST, and
     # a name of that site resolving here (DNS rebinding).
     form = run.get("/api/freeze", {"Content-Type": "text/plain"}, method="POST",

@@ -43,6 +43,8 @@ function show(state) {
   badge.textContent = live ? 'live' : 'fault';
   badge.className = 'badge ' + (live ? 'ok' : 'bad');
   text('lens-source', state.lens.source);
+  const counts = state.lens.counts[$('mark-axis').value];
+  text('mark-counts', counts === null ? '–' : String(counts));
   const frame = state.frame;
   if (frame) {
     text('focus', fixed(frame.focus_m, 3));
@@ -134,6 +136,12 @@ async function act(name, body) {
 $('freeze').addEventListener('click', () =>
   act('freeze', { frozen: $('freeze').getAttribute('aria-pressed') !== 'true' }));
 $('reload').addEventListener('click', () => act('reload', {}));
+$('mark').addEventListener('submit', async (event) => {
+  event.preventDefault();
+  const answer = await act('mark', { axis: $('mark-axis').value, value: Number($('mark-value').value) });
+  if (answer.file) text('message', answer.axis + ' ' + answer.value + ' at ' + answer.counts +
+      ' counts, in ' + answer.file);
+});
 $('record').addEventListener('click', async () => {
   const answer = await act('record', { recording: $('record').getAttribute('aria-pressed') !== 'true' });
   if (answer.file) text('message', (answer.recording ? 'recording to ' : 'recorded ') + answer.file +
