@@ -5,8 +5,7 @@
 #include <mutex>
 #include <string>
 
-#include "camhead/hal/module_search.h"
-#include "camhead/hal/shared_library.h"
+#include "camhead/hal/module_loader.h"
 #include "marker_module_abi.h"
 #include "marker_tracker.h"
 
@@ -30,27 +29,14 @@ marker_module::Module &module() {
     return *opened->module;
   const hal::ModuleSearch search =
       hal::module_search("CAMHEAD_MARKERS_MODULE", kModuleName, CAMHEAD_MARKERS_MODULE_RELDIR);
-  std::string last_error;
-  for (const std::string &path : search.candidates) {
-    auto library = std::make_unique<hal::SharedLibrary>(path, kOpenCvPackage);
-    marker_module::Factory factory = nullptr;
-    library->resolve(marker_module::kFactorySymbol, factory);
-    if (!library->ok()) {
-      last_error = library->error();
-      if (path == kModuleName && hal::module_not_installed(last_error, kModuleName))
-        last_error.clear();
-      if (!last_error.empty())
-        break;
-      continue;
-    }
-    marker_module::Module *instance = factory(marker_module::kAbiVersion);
-    if (instance == nullptr)
-      throw MarkerModuleError(path + ": built for another camhead (module ABI " +
-                              std::to_string(marker_module::kAbiVersion) +
-                              " wanted); rebuild camhead and its markers module together");
-    opened = new Opened{library.release(), instance}; // never closed: see above
-    return *instance;
+  hal::LoadedModule<marker_module::Module> loaded = hal::load_module<marker_module::Module>(
+      search, kModuleName, kOpenCvPackage, marker_module::kFactorySymbol,
+      marker_module::kAbiVersion, "its markers module");
+  if (loaded.module != nullptr) {
+    opened = new Opened{loaded.library.release(), loaded.module}; // never closed: see above
+    return *loaded.module;
   }
+  const std::string &last_error = loaded.error;
   if (!last_error.empty())
     throw MarkerModuleError("marker tracking: " + last_error);
   throw MarkerModuleError(

@@ -5,8 +5,7 @@
 #include <mutex>
 #include <string>
 
-#include "camhead/hal/module_search.h"
-#include "camhead/hal/shared_library.h"
+#include "camhead/hal/module_loader.h"
 #include "web_module_abi.h"
 #include "web_server.h"
 
@@ -30,27 +29,14 @@ web_module::Module &module() {
     return *opened->module;
   const hal::ModuleSearch search =
       hal::module_search("CAMHEAD_WEB_MODULE", kModuleName, CAMHEAD_WEB_MODULE_RELDIR);
-  std::string last_error;
-  for (const std::string &path : search.candidates) {
-    auto library = std::make_unique<hal::SharedLibrary>(path, kPackages);
-    web_module::Factory factory = nullptr;
-    library->resolve(web_module::kFactorySymbol, factory);
-    if (!library->ok()) {
-      last_error = library->error();
-      if (path == kModuleName && hal::module_not_installed(last_error, kModuleName))
-        last_error.clear();
-      if (!last_error.empty())
-        break;
-      continue;
-    }
-    web_module::Module *instance = factory(web_module::kAbiVersion);
-    if (instance == nullptr)
-      throw WebError(path + ": built for another camhead (module ABI " +
-                     std::to_string(web_module::kAbiVersion) +
-                     " wanted); rebuild camhead and its web module together");
-    opened = new Opened{library.release(), instance}; // never closed: see above
-    return *instance;
+  hal::LoadedModule<web_module::Module> loaded = hal::load_module<web_module::Module>(
+      search, kModuleName, kPackages, web_module::kFactorySymbol, web_module::kAbiVersion,
+      "its web module");
+  if (loaded.module != nullptr) {
+    opened = new Opened{loaded.library.release(), loaded.module}; // never closed: see above
+    return *loaded.module;
   }
+  const std::string &last_error = loaded.error;
   if (!last_error.empty())
     throw WebError(last_error);
   throw WebError(std::string(kModuleName) + " is not in " + search.searched +

@@ -31,13 +31,7 @@ import web_rig
 
 camhead, source, scratch = sys.argv[1], os.path.abspath(sys.argv[2]), os.path.abspath(sys.argv[3])
 os.makedirs(scratch, exist_ok=True)
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what, flush=True)
-    if not ok:
-        failures.append(what)
+check = web_rig.Checks()
 
 
 board = web_rig.write_board(scratch, source, name="browser")
@@ -93,5 +87,4 @@ check(r is not None and near(focus, r["focus_m"], 3) and near(iris, r["f_number"
       near(zoom, r["focal_length_mm"], 1),
       "the page's frame %s shows focus %s m, f/%s, %s mm: the record's %s" %
       (frame, focus, iris, zoom, r and (r["focus_m"], r["f_number"], r["focal_length_mm"])))
-print("PASS" if not failures else "FAIL " + "; ".join(failures))
-sys.exit(1 if failures else 0)
+check.finish()

@@ -10,6 +10,7 @@ import json
 import os
 import re
 import subprocess
+import sys
 import time
 import urllib.parse
 
@@ -134,3 +135,19 @@ def mjpeg_frames(response, count):
 def read_stats(path):
     with open(path) as f:
         return [json.loads(line) for line in f if line.strip()]
+
+
+class Checks:
+    """A test's checks: a line each, then PASS or FAIL with what failed."""
+
+    def __init__(self):
+        self.failures = []
+
+    def __call__(self, ok, what):
+        print(("ok   " if ok else "FAIL ") + what, flush=True)
+        if not ok:
+            self.failures.append(what)
+
+    def finish(self):
+        print("PASS" if not self.failures else "FAIL " + "; ".join(self.failures))
+        sys.exit(1 if self.failures else 0)
