@@ -113,6 +113,12 @@ const PreviewImage &OperatorPage::preview(View view) {
 void OperatorPage::drain() {
   while (const std::optional<FeedEntry> entry = feed_.next_entry())
     history_.add(*entry);
+  // The camera's count, sampled at most ten times a second, for ten seconds.
+  const std::int64_t now = base::monotonic_ns();
+  if (in_samples_.empty() || now - in_samples_.back().first >= 100'000'000)
+    in_samples_.emplace_back(now, run_.counters.frames_in.load());
+  while (in_samples_.size() > 2 && now - in_samples_.front().first > 10'000'000'000)
+    in_samples_.pop_front();
 }
 
 std::string OperatorPage::state_json(const web_module::HttpStats &http) {
@@ -186,7 +192,13 @@ std::string OperatorPage::state_json(const web_module::HttpStats &http) {
   state["traced"] = c.traced_permille.load() / 1000.0;
   state["renderer_lost"] = c.renderer_lost.load();
 
-  // Frames in and out per second over the last ten seconds of the history.
+  // Camera frames in per second, from the page's own samples of the count.
+  state["in_fps"] = in_samples_.size() > 1 && in_samples_.back().first > in_samples_.front().first
+                        ? double(in_samples_.back().second - in_samples_.front().second) /
+                              (double(in_samples_.back().first - in_samples_.front().first) * 1e-9)
+                        : 0.0;
+  // Frames out per second (composites and fillers: what the outputs got)
+  // over the last ten seconds of the history.
   const auto &minute = history_.minute();
   double out_fps = 0.0;
   if (minute.size() > 1) {

@@ -7,10 +7,12 @@
 
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "camhead/hal/camera/camera_source.h"
@@ -74,6 +76,7 @@ private:
   RunView run_;
   WebFeed feed_;
   RunHistory history_;
+  std::deque<std::pair<std::int64_t, std::uint64_t>> in_samples_; // (when, frames in)
   PreviewImage previews_[kViews]; // the newest frame of each view, shrunk
   PageRecorder recorder_;
   std::filesystem::path marks_file_; // the calibration marks (calibration_marks.h)

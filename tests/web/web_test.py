@@ -99,8 +99,10 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + 
     state = run.state()
     seen_frame = state["frame"]
     check(state["board"]["name"] == "web" and state["camera"]["connected"] and
+          state["in_fps"] > 0 and state["out_fps"] > 0 and
           len(state["outputs"]) == 1 and "capture_to_output" in state["latency"],
-          "state: board, camera, outputs and latency per stage")
+          "state: board, camera, outputs, frames in and out per second (%.1f, %.1f), latency "
+          "per stage" % (state["in_fps"], state["out_fps"]))
 
     status, headers, body = run.get("/metrics")
     families = {f.name: f for f in text_string_to_metric_families(body.decode())}

@@ -58,6 +58,7 @@ function show(state) {
   const pose = state.pose;
   health($('pose'), pose.fresh !== false, pose.source + (pose.fresh === false ? ', held' : ''),
          pose.source + ', held (stale)');
+  text('in-fps', fixed(state.in_fps, 1));
   text('out-fps', fixed(state.out_fps, 1));
   text('executor', state.executor);
   rows($('stages'), Object.entries(state.latency).map(([name, l]) =>
