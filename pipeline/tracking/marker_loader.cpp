@@ -1,8 +1,6 @@
 // Finds and opens libcamhead_markers.so (marker_tracker.h), as the libcamera
 // camera's loader does: $CAMHEAD_MARKERS_MODULE, beside the executable, the
 // install's lib folder, then the library path. No OpenCV header here.
-#include <memory>
-#include <mutex>
 #include <string>
 
 #include "camhead/hal/module_loader.h"
@@ -18,24 +16,18 @@ constexpr const char *kOpenCvPackage = "libopencv-contrib406";
 
 // Opened once and never closed: its trackers run its code until the end.
 marker_module::Module &module() {
-  struct Opened {
-    hal::SharedLibrary *library; // kept reachable, for leak checkers too
-    marker_module::Module *module;
-  };
-  static std::mutex mutex;
-  static const Opened *opened = nullptr;
-  const std::lock_guard lock(mutex);
-  if (opened != nullptr)
-    return *opened->module;
+  static hal::ModuleOnce<marker_module::Module> once;
   const hal::ModuleSearch search =
       hal::module_search("CAMHEAD_MARKERS_MODULE", kModuleName, CAMHEAD_MARKERS_MODULE_RELDIR);
-  hal::LoadedModule<marker_module::Module> loaded = hal::load_module<marker_module::Module>(
-      search, kModuleName, kOpenCvPackage, marker_module::kFactorySymbol,
-      marker_module::kAbiVersion, "its markers module");
-  if (loaded.module != nullptr) {
-    opened = new Opened{loaded.library.release(), loaded.module}; // never closed: see above
-    return *loaded.module;
-  }
+  hal::LoadedModule<marker_module::Module> loaded;
+  if (marker_module::Module *opened = once.get(
+          [&] {
+            return hal::load_module<marker_module::Module>(
+                search, kModuleName, kOpenCvPackage, marker_module::kFactorySymbol,
+                marker_module::kAbiVersion, "its markers module");
+          },
+          loaded))
+    return *opened;
   const std::string &last_error = loaded.error;
   if (!last_error.empty())
     throw MarkerModuleError("marker tracking: " + last_error);

@@ -1,8 +1,8 @@
 // The operator page's preview of a video frame: the frame shrunk by a whole
 // factor (a box filter, so a preview pixel is the mean of the frame's) and
 // turned into 8-bit R'G'B' with the frame's own matrix and range, the bytes
-// a JPEG encoder takes. Made in the frame loop while someone watches
-// (web_feed.h), into storage made once.
+// a JPEG encoder takes. Made on the page's thread from the copy the frame
+// loop hands it (web_feed.h), into storage made once.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +20,7 @@ inline constexpr int kPreviewMaxWidth = 640;
 struct PreviewImage {
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgb; // width * height * 3 bytes, rows top down
-  std::uint64_t frame = 0;       // the output frame (record's "frame") it shows
+  std::uint64_t frame = 0;       // the composite's output frame, or the camera frame's sequence
   bool valid = false;            // false until a frame was shrunk into it
 };
 

@@ -1,8 +1,6 @@
 // Finds and opens libcamhead_web.so (web_server.h), as marker_loader.cpp
 // opens the marker module: $CAMHEAD_WEB_MODULE, beside the executable, the
 // install's lib folder, then the library path. No libevent header here.
-#include <memory>
-#include <mutex>
 #include <string>
 
 #include "camhead/hal/module_loader.h"
@@ -18,24 +16,18 @@ constexpr const char *kPackages = "libevent-2.1-7 and libturbojpeg0";
 
 // Opened once and never closed: its server threads run its code until the end.
 web_module::Module &module() {
-  struct Opened {
-    hal::SharedLibrary *library; // kept reachable, for leak checkers too
-    web_module::Module *module;
-  };
-  static std::mutex mutex;
-  static const Opened *opened = nullptr;
-  const std::lock_guard lock(mutex);
-  if (opened != nullptr)
-    return *opened->module;
+  static hal::ModuleOnce<web_module::Module> once;
   const hal::ModuleSearch search =
       hal::module_search("CAMHEAD_WEB_MODULE", kModuleName, CAMHEAD_WEB_MODULE_RELDIR);
-  hal::LoadedModule<web_module::Module> loaded = hal::load_module<web_module::Module>(
-      search, kModuleName, kPackages, web_module::kFactorySymbol, web_module::kAbiVersion,
-      "its web module");
-  if (loaded.module != nullptr) {
-    opened = new Opened{loaded.library.release(), loaded.module}; // never closed: see above
-    return *loaded.module;
-  }
+  hal::LoadedModule<web_module::Module> loaded;
+  if (web_module::Module *opened = once.get(
+          [&] {
+            return hal::load_module<web_module::Module>(search, kModuleName, kPackages,
+                                                        web_module::kFactorySymbol,
+                                                        web_module::kAbiVersion, "its web module");
+          },
+          loaded))
+    return *opened;
   const std::string &last_error = loaded.error;
   if (!last_error.empty())
     throw WebError(last_error);

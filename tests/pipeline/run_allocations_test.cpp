@@ -130,7 +130,7 @@ protected:
     std::atomic<std::uint64_t> preview_parts{0};
     std::thread watchers;
     if (watched) {
-      const std::uint16_t http_port = free_tcp_port();
+      const std::uint16_t http_port = free_port(SOCK_STREAM);
       options.web = web::WebOptions{{"127.0.0.1", http_port}, std::nullopt};
       watchers = std::thread([&, http_port] { watch_previews(http_port, ended, preview_parts); });
     }
@@ -158,18 +158,6 @@ protected:
             tracked_frames,
             reloaded_frames,
             preview_parts};
-  }
-
-  static std::uint16_t free_tcp_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof address;
-    ::bind(fd, reinterpret_cast<sockaddr *>(&address), sizeof address);
-    ::getsockname(fd, reinterpret_cast<sockaddr *>(&address), &length);
-    ::close(fd);
-    return ntohs(address.sin_port);
   }
 
   // Two preview streams (the composite and the camera) read until `ended`;

@@ -23,9 +23,9 @@
 
 namespace camhead::pipeline {
 
-// A UDP port nobody on this host listens on now.
-inline std::uint16_t free_udp_port() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+// A port of `type` (SOCK_DGRAM, SOCK_STREAM) nobody on this host listens on now.
+inline std::uint16_t free_port(int type) {
+  const int fd = ::socket(AF_INET, type, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
@@ -34,6 +34,9 @@ inline std::uint16_t free_udp_port() {
   EXPECT_EQ(::getsockname(fd, reinterpret_cast<sockaddr *>(&address), &size), 0);
   ::close(fd);
   return ntohs(address.sin_port);
+}
+inline std::uint16_t free_udp_port() {
+  return free_port(SOCK_DGRAM);
 }
 
 // Sends a pose 1 m up, panned by `pan_deg`, at 200 Hz while it lives; with

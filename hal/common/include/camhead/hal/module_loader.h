@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "camhead/hal/module_search.h"
@@ -53,5 +54,30 @@ LoadedModule<Module> load_module(const ModuleSearch &search, const char *file_na
   }
   return out;
 }
+
+// A module opened once and never closed, as the objects it makes run its
+// code until the process ends: the first get() that loads it keeps it
+// (its library kept reachable, for leak checkers too); until then each
+// get() tries again. Meant as a function-local static of its loader.
+template <class Module> class ModuleOnce {
+public:
+  // The module, or null with `loaded` (what load() gave) saying why.
+  template <class Load> Module *get(Load load, LoadedModule<Module> &loaded) {
+    const std::lock_guard lock(mutex_);
+    if (module_ == nullptr) {
+      loaded = load();
+      if (loaded.module == nullptr)
+        return nullptr;
+      library_ = loaded.library.release();
+      module_ = loaded.module;
+    }
+    return module_;
+  }
+
+private:
+  std::mutex mutex_;
+  SharedLibrary *library_ = nullptr;
+  Module *module_ = nullptr;
+};
 
 } // namespace camhead::hal
