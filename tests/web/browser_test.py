@@ -10,8 +10,10 @@ on the simulated rig.
    frame it names (the page shows one frame's record, so they match it
    exactly, to the digits shown).
 3. The lens plot has been drawn (its canvas is not blank).
-4. On a phone's screen (390x844 CSS pixels) nothing is wider than the
-   screen: no sideways scrolling.
+4. On the narrowest phone's screen in use (320x640 CSS pixels) nothing is
+   wider than the screen: no sideways scrolling, whatever the length of the
+   paths and device names the page shows. If something is, the elements
+   that stick out are named.
 Screenshots of the whole page are left in SCRATCH_DIR/page.png and
 phone.png.
 Prints a line per check, then PASS or FAIL.
@@ -69,12 +71,18 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--duration", "60",
             "return lit")
         check(blank > 100, "the lens plot is drawn (%d bright pixels)" % blank)
         driver.save_screenshot(os.path.join(scratch, "page.png"))
-        driver.set_window_size(390, 844)
+        driver.set_window_size(320, 640)
         time.sleep(1)
-        widths = driver.execute_script(
-            "return [document.documentElement.scrollWidth, window.innerWidth]")
-        check(widths[0] <= widths[1],
-              "on a phone's screen the page is no wider than it (%d <= %d px)" % tuple(widths))
+        page, screen, sticking_out = driver.execute_script(
+            "const width = document.documentElement.clientWidth, out = [];"
+            "for (const e of document.querySelectorAll('body *'))"
+            "  if (e.getBoundingClientRect().right > width + 0.5)"
+            "    out.push(e.tagName.toLowerCase() + (e.id ? '#' + e.id : '') + ' \"' +"
+            "             e.textContent.replace(/\\s+/g, ' ').trim().slice(0, 40) + '\"');"
+            "return [document.documentElement.scrollWidth, window.innerWidth, out]")
+        check(page <= screen and not sticking_out,
+              "on a phone's screen the page is no wider than it (%d <= %d px)%s" %
+              (page, screen, "; sticking out: " + ", ".join(sticking_out[:8]) if sticking_out else ""))
         driver.save_screenshot(os.path.join(scratch, "phone.png"))
     finally:
         driver.quit()
