@@ -143,7 +143,7 @@ private:
   base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
   base::BoundedQueue<Delivered> captured_{1};
   RunCounters counters_;
-  // The reload thread's (RunOptions::reload); null without reloads.
+  // The reload thread's (RunOptions::reload); none without reloads.
   std::optional<SetupReloader> reloader_;
   std::optional<RunStatus> status_; // the status line, unless options_.status is null
   std::atomic<bool> stopping_{false};
@@ -236,6 +236,11 @@ Pipeline::Pipeline(const RunOptions &options)
   if (options.status != nullptr)
     status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_,
                     pose_source_name());
+  if (options.reload != nullptr)
+    reloader_.emplace(
+        *options.reload, options.service, handover_, lens_,
+        [this](const Board &board) { return build_setup(board); },
+        [this] { return should_stop(); });
   if (options.web) {
     // The page's takes are Y4M, of the first output in a format it takes.
     for (std::size_t i = 0; i < sinks_.size() && !recording_sink_; ++i)
@@ -244,10 +249,10 @@ Pipeline::Pipeline(const RunOptions &options)
         recording_sink_ = i;
     page_ = std::make_unique<web::OperatorPage>(
         *options.web,
-        web::RunView{board_.name, board_.file.string(), board_.description, *camera_, lens_, sinks_,
-                     counters_, executor_name_, pose_source_name(), fps_, options.reload,
-                     recording_sink_ ? std::optional(sinks_[*recording_sink_]->format())
-                                     : std::nullopt},
+        web::RunView{
+            board_.name, board_.file.string(), board_.description, *camera_, lens_, sinks_,
+            counters_, executor_name_, pose_source_name(), fps_, reloader_ ? &*reloader_ : nullptr,
+            recording_sink_ ? std::optional(sinks_[*recording_sink_]->format()) : std::nullopt},
         sinks_.front()->format(), camera_->format());
     if (options.status != nullptr)
       std::fprintf(options.status, "camhead run: operator page at %s\n", page_->url().c_str());
@@ -579,11 +584,7 @@ RunSummary Pipeline::run() {
   start_ns_ = base::monotonic_ns();
   std::vector<std::thread> threads;
   try {
-    if (options_.reload != nullptr) {
-      reloader_.emplace(
-          *options_.reload, options_.service, handover_, lens_,
-          [this](const Board &board) { return build_setup(board); },
-          [this] { return should_stop(); });
+    if (reloader_) {
       threads.emplace_back([this, live = setup_->board]() mutable {
         base::name_this_thread("camhead-reload");
         reloader_->run(std::move(live));

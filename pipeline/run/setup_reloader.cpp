@@ -58,6 +58,7 @@ void SetupReloader::run(Board live) {
     if (service_ != nullptr)
       (void)service_->notify("READY=1\nSTATUS=" + note);
     const std::lock_guard lock(mutex_);
+    last_ = {last_.count + 1, note};
     note_ = std::move(note);
   }
 }
@@ -65,6 +66,11 @@ void SetupReloader::run(Board live) {
 std::optional<std::string> SetupReloader::take_note() {
   const std::lock_guard lock(mutex_);
   return std::exchange(note_, std::nullopt);
+}
+
+SetupReloader::Outcome SetupReloader::last_outcome() {
+  const std::lock_guard lock(mutex_);
+  return last_;
 }
 
 } // namespace camhead::pipeline

@@ -5,8 +5,8 @@
 // swapped on the hub. systemd hears RELOADING=1, then READY=1 with the
 // outcome as STATUS=; the status thread takes the outcome for its line.
 //
-// Thread safety: run() on the reload thread; take_note(), reloads() and
-// refused() from any thread.
+// Thread safety: run() on the reload thread; request(), take_note(),
+// last_outcome(), reloads() and refused() from any thread.
 #pragma once
 
 #include <atomic>
@@ -35,9 +35,18 @@ public:
 
   // The thread's body: `live` is the board running.
   void run(Board live);
+  // Asks for a reload, as the signal does (the operator page's button).
+  void request() { requested_.store(true); }
   // The last outcome not yet taken ("reloaded FILE: setup N", "reload
-  // refused, ...").
+  // refused, ...") for the status line.
   [[nodiscard]] std::optional<std::string> take_note();
+  // The outcomes so far and the last one (empty before the first), for
+  // the operator page: a count tells a new outcome from the same words.
+  struct Outcome {
+    std::uint64_t count = 0;
+    std::string text;
+  };
+  [[nodiscard]] Outcome last_outcome();
   [[nodiscard]] std::uint64_t reloads() const { return reloads_; }
   [[nodiscard]] std::uint64_t refused() const { return refused_; }
 
@@ -54,6 +63,7 @@ private:
   std::function<bool()> stop_;
   std::mutex mutex_;
   std::optional<std::string> note_;
+  Outcome last_;
   std::atomic<std::uint64_t> reloads_{0}, refused_{0};
 };
 

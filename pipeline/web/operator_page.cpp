@@ -133,7 +133,13 @@ std::string OperatorPage::state_json(const web_module::HttpStats &http) {
                     {"description", run_.board_description}};
   state["executor"] = run_.executor;
   state["frozen"] = frozen_;
-  state["can_reload"] = run_.reload != nullptr;
+  state["can_reload"] = run_.reloader != nullptr;
+  if (run_.reloader != nullptr) {
+    const SetupReloader::Outcome reload = run_.reloader->last_outcome();
+    state["reload"] = {{"outcomes", reload.count}, {"last", reload.text}};
+  } else {
+    state["reload"] = nullptr;
+  }
   state["can_record"] = run_.record_format.has_value();
   if (const auto take = recorder_.file())
     state["recording"] = {{"file", take->string()}, {"frames", recorder_.frames()}};
@@ -423,11 +429,11 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
                      .dump()};
   }
   if (name == "reload") {
-    if (run_.reload == nullptr)
+    if (run_.reloader == nullptr)
       return {409, json{{"error", "this run cannot reload its board"}}.dump()};
-    run_.reload->store(true);
-    return {202, json{{"reload", "requested: the board is read again between two frames; "
-                                 "the state's \"frame.setup\" counts the ones taken"}}
+    run_.reloader->request();
+    return {202, json{{"reload", "requested: the board is read again between two frames; the "
+                                 "state's \"reload\" gives the outcome"}}
                      .dump()};
   }
   return {404,

@@ -21,6 +21,7 @@
 #include "preview_image.h"
 #include "run/lens_hub.h"
 #include "run/run_counters.h"
+#include "run/setup_reloader.h"
 #include "run_history.h"
 #include "web_access.h"
 #include "web_feed.h"
@@ -38,8 +39,9 @@ struct RunView {
   std::string executor;
   std::string pose_source;
   double fps = 25.0;
-  // Set by the reload action (RunOptions::reload); null: the run cannot reload.
-  std::atomic<bool> *reload = nullptr;
+  // Asked by the reload action, and its outcome shown; null: the run
+  // cannot reload (RunOptions::reload).
+  SetupReloader *reloader = nullptr;
   // The format of the output the record button writes (yuyv or nv12);
   // none: no output of the run is in one.
   std::optional<base::VideoFormat> record_format;

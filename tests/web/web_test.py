@@ -10,6 +10,9 @@
    way, within JPEG's error (PSNR).
    Record: the record button's take holds the composites the outputs got
    while it was on, byte for byte.
+   Mark and reload: a calibration mark as `camhead calibrate` reads it;
+   the board reloaded from the page, and a board that changes what only a
+   restart may change refused, the outcome in the state.
 4. Clients: one that never reads and 20 that do, at once: the outputs get
    every composite (no output-busy drop, no repeat) while they watch, and
    the page still answers.
@@ -152,6 +155,35 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + 
                    ["iris", str(iris_mark["counts"]), "", "4", "", ""]],
           "mark: focus and iris at the lens's counts, written as camhead calibrate reads them; "
           "a wrong axis or value 400 (%s)" % rows)
+
+    # Reload: the board as it is taken; then one that changes the camera
+    # (a restart's business) is refused, named, and the run goes on.
+    def reload_outcome(previous):
+        deadline = time.time() + 30
+        while time.time() < deadline:
+            outcome = run.state()["reload"]
+            if outcome["outcomes"] > previous:
+                return outcome
+            time.sleep(0.2)
+        return outcome
+    asked = run.get("/api/reload", as_json, method="POST", body="{}")
+    taken_reload = reload_outcome(0)
+    run.wait_frames(run.state()["frame"]["frame"] + 3)
+    setup = run.state()["frame"]["setup"]
+    with open(board) as f:
+        changed = json.load(f)
+    changed["camera"]["width"] = 320
+    with open(board, "w") as f:
+        json.dump(changed, f)
+    run.get("/api/reload", as_json, method="POST", body="{}")
+    refused_reload = reload_outcome(1)
+    run.wait_frames(run.state()["frame"]["frame"] + 5)
+    web_rig.write_board(scratch, source)  # as it was, for what follows
+    check(asked[0] == 202 and taken_reload["last"] == "reloaded %s: setup 1" % board and
+          setup == 1 and refused_reload["last"].startswith("reload refused") and
+          "camera" in refused_reload["last"] and run.state()["frame"]["setup"] == 1,
+          "reload: taken (setup %s: %s), a camera change refused and the run goes on: %s"
+          % (setup, taken_reload["last"], refused_reload["last"]))
 
     # A page of another site in this machine's browser: a form's POST, and
     # a name of that site resolving here (DNS rebinding).

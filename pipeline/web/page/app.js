@@ -80,7 +80,14 @@ function show(state) {
   $('record').textContent = recording ? 'stop recording (' + recording.frames + ' frames)' : 'record';
   $('record').disabled = !state.can_record;
   $('reload').disabled = !state.can_reload;
+  // A reload's outcome (taken, or refused and why) once it comes.
+  if (state.reload) {
+    text('reload-last', state.reload.last || 'none since the start');
+    if (reloadsSeen !== null && state.reload.outcomes > reloadsSeen) text('message', state.reload.last);
+    reloadsSeen = state.reload.outcomes;
+  }
 }
+let reloadsSeen = null;
 
 // Series over the last minute on a shared time axis, each scaled to its own range.
 function plot(canvas, t, series) {
