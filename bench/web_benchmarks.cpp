@@ -62,7 +62,7 @@ void BM_FeedCompositeWatched(benchmark::State &state) {
   camhead::pipeline::FrameRecord record;
   std::uint64_t n = 0;
   for (auto _ : state) {
-    feed.composite(n, record, std::int64_t(n), frame);
+    feed.composite(n, record, std::int64_t(n), frame, {});
     (void)feed.next_entry(); // the page drains it
     (void)feed.take_frame(web::View::composite);
     ++n;
@@ -78,7 +78,7 @@ void BM_FeedCompositeUnwatched(benchmark::State &state) {
   camhead::pipeline::FrameRecord record;
   std::uint64_t n = 0;
   for (auto _ : state) {
-    feed.composite(n, record, std::int64_t(n), frame);
+    feed.composite(n, record, std::int64_t(n), frame, {});
     (void)feed.next_entry();
     ++n;
   }

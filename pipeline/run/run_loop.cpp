@@ -23,6 +23,7 @@
 #include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/frame_renderer.h"
+#include "camhead/renderer/influence_region.h"
 #include "frame_record.h"
 #include "frame_setup.h"
 #include "lens_camera.h"
@@ -52,6 +53,9 @@ using hal::output::FrameSink;
 struct Slot {
   std::vector<std::vector<std::uint8_t>> images;
   FrameRecord record;
+  // The pixels traced, for the operator page's region view (room for the
+  // most a region holds, reserved once; kept only with a page).
+  std::vector<renderer::PixelRect> region;
 };
 
 // A camera frame and when the camera handed it over. Dropped on any path,
@@ -221,9 +225,13 @@ Pipeline::Pipeline(const RunOptions &options)
   }
   // Every pipeline and buffer the loop uses, made now.
   prepare(*setup_);
-  for (Slot &slot : slots_)
+  for (Slot &slot : slots_) {
     for (const auto &sink : sinks_)
       slot.images.emplace_back(base::frame_bytes(sink->format()));
+    if (options.web)
+      slot.region.reserve(renderer::max_region_rects(std::uint32_t(board_.camera->width),
+                                                     std::uint32_t(board_.camera->height)));
+  }
   for (const auto &sink : sinks_) {
     last_frames_.emplace_back(base::frame_bytes(sink->format()));
     fill_placeholder(sink->format(), placeholders_.emplace_back(last_frames_.back().size()));
@@ -398,6 +406,10 @@ void Pipeline::render_loop() {
       (void)free_slots_.push(*slot_index);
       continue;
     }
+    if (page_) // within the room reserved (max_region_rects): no allocation
+      slot.region.assign(report.region.begin(),
+                         report.region.begin() + std::ptrdiff_t(std::min(report.region.size(),
+                                                                         slot.region.capacity())));
     r.camera_rays = report.camera_rays;
     r.traced = report.frame_pixels > 0 ? double(report.traced_pixels) / report.frame_pixels : 1.0;
     counters_.traced_permille = std::uint32_t(std::lround(1000.0 * r.traced));
@@ -512,7 +524,8 @@ void Pipeline::output_loop() {
     if (stats_ != nullptr)
       write_composite_record(stats_, output_frame, slot.record, last_output_ns_, record_fields_);
     if (page_) {
-      page_->feed().composite(output_frame, slot.record, last_output_ns_, slot.images.front());
+      page_->feed().composite(output_frame, slot.record, last_output_ns_, slot.images.front(),
+                              slot.region);
       if (recording_sink_)
         page_->recorder().submit(slot.images[*recording_sink_], slot.record.capture_ns);
     }

@@ -82,7 +82,8 @@ private:
 OperatorPage::OperatorPage(const WebOptions &options, RunView run,
                            const base::VideoFormat &composite, const base::VideoFormat &camera)
     : run_(std::move(run)),
-      feed_(composite, camera), previews_{preview_for(composite), preview_for(camera)},
+      feed_(composite, camera), previews_{preview_for(composite), preview_for(camera),
+                                          preview_for(composite)},
       recorder_(options.recordings, run_.record_format, run_.fps),
       marks_file_(options.recordings / "lens-marks.csv"), start_ns_(base::monotonic_ns()) {
   server_ = start_web_server(server_config(options), *this);
@@ -105,6 +106,8 @@ const PreviewImage &OperatorPage::preview(View view) {
   if (!frozen_ && feed_.take_frame(view)) {
     const FrameCopy &frame = feed_.frame(view);
     shrink_to_preview(frame.format, frame.bytes, preview);
+    if (view == View::region)
+      shade_outside(frame.region(), frame.format.width, frame.format.height, preview);
     preview.frame = frame.frame;
   }
   return preview;

@@ -169,4 +169,29 @@ void shrink_to_preview(const base::VideoFormat &format, std::span<const std::uin
   out.valid = true;
 }
 
+void shade_outside(std::span<const renderer::PixelRect> region, int frame_width, int frame_height,
+                   PreviewImage &preview) {
+  const int step_x = frame_width / preview.width, step_y = frame_height / preview.height;
+  // The first preview pixel of a `step` wide box whose centre is at or past
+  // frame pixel `at`.
+  const auto first_from = [](std::uint32_t at, int step) {
+    const std::uint32_t half = std::uint32_t(step / 2);
+    return at <= half ? 0 : int((at - half + std::uint32_t(step) - 1) / std::uint32_t(step));
+  };
+  std::array<bool, kPreviewMaxWidth> inside;
+  for (int py = 0; py < preview.height; ++py) {
+    const std::uint32_t y = std::uint32_t(py * step_y + step_y / 2);
+    std::fill_n(inside.begin(), preview.width, false);
+    for (const renderer::PixelRect &r : region)
+      if (r.y0 <= y && y < r.y1)
+        std::fill(inside.begin() + std::min(first_from(r.x0, step_x), preview.width),
+                  inside.begin() + std::min(first_from(r.x1, step_x), preview.width), true);
+    std::uint8_t *rgb = preview.rgb.data() + std::size_t(py) * std::size_t(preview.width) * 3;
+    for (int px = 0; px < preview.width; ++px, rgb += 3)
+      if (!inside[std::size_t(px)])
+        for (int c = 0; c < 3; ++c)
+          rgb[c] = std::uint8_t(rgb[c] / 3);
+  }
+}
+
 } // namespace camhead::pipeline::web

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "camhead/base/video_format.h"
+#include "camhead/renderer/influence_region.h"
 
 namespace camhead::pipeline::web {
 
@@ -33,5 +34,12 @@ struct PreviewImage {
 // for the same format; allocates nothing.
 void shrink_to_preview(const base::VideoFormat &format, std::span<const std::uint8_t> frame,
                        PreviewImage &out);
+
+// The region view: darkens to a third each pixel of `preview` (shrunk from
+// a frame_width x frame_height frame) whose box's centre lies outside
+// `region`, the frame's traced pixels (FrameReport::region), so that what
+// the tracer worked on stands out; allocates nothing.
+void shade_outside(std::span<const renderer::PixelRect> region, int frame_width, int frame_height,
+                   PreviewImage &preview);
 
 } // namespace camhead::pipeline::web

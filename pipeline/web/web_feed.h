@@ -19,14 +19,17 @@
 #include <vector>
 
 #include "camhead/base/video_format.h"
+#include "camhead/renderer/influence_region.h"
 #include "latest_value.h"
 #include "run/frame_record.h"
 #include "spsc_ring.h"
 
 namespace camhead::pipeline::web {
 
-enum class View { composite = 0, camera = 1 };
-inline constexpr int kViews = 2;
+// The composite, the camera frame, and the composite with the pixels the
+// tracer did not work on darkened (the influence region).
+enum class View { composite = 0, camera = 1, region = 2 };
+inline constexpr int kViews = 3;
 
 // A frame as the frame loop handed it over.
 struct FrameCopy {
@@ -34,6 +37,15 @@ struct FrameCopy {
   std::vector<std::uint8_t> bytes; // frame_bytes(format), made once
   std::uint64_t frame = 0;         // composite: the output frame; camera: its sequence
   bool valid = false;              // false until a frame was copied into it
+  // The region view's: the frame's traced pixels, the first region_size
+  // of room for the most a region holds (sized, not reserved: a copy of
+  // the value keeps its size, not its capacity).
+  std::vector<renderer::PixelRect> region_room;
+  std::size_t region_size = 0;
+
+  [[nodiscard]] std::span<const renderer::PixelRect> region() const {
+    return std::span(region_room).first(region_size);
+  }
 };
 
 // One line of the run's record, as the page's history keeps it.
@@ -51,9 +63,10 @@ public:
   // output's), `camera` the camera's.
   WebFeed(const base::VideoFormat &composite, const base::VideoFormat &camera);
 
-  // Output thread: a composite sent to the outputs as `output_frame`.
+  // Output thread: a composite sent to the outputs as `output_frame`, and
+  // the pixels its renderer traced (FrameReport::region).
   void composite(std::uint64_t output_frame, const FrameRecord &record, std::int64_t output_ns,
-                 std::span<const std::uint8_t> image);
+                 std::span<const std::uint8_t> image, std::span<const renderer::PixelRect> region);
   // Output thread: a repeat or a placeholder sent as `output_frame`.
   void filler(std::uint64_t output_frame, FeedEntry::Kind kind, std::int64_t output_ns);
   // Render thread: the camera frame `sequence` as it came (copied only
@@ -74,9 +87,10 @@ public:
   [[nodiscard]] std::uint64_t entries_dropped() const { return entries_.dropped(); }
 
 private:
-  void copy(View view, std::uint64_t frame, std::span<const std::uint8_t> image);
+  void copy(View view, std::uint64_t frame, std::span<const std::uint8_t> image,
+            std::span<const renderer::PixelRect> region = {});
 
-  std::atomic<int> watchers_[kViews] = {0, 0};
+  std::atomic<int> watchers_[kViews] = {0, 0, 0};
   LatestValue<FrameCopy> frames_[kViews];
   // Four seconds of frames at 25 fps: the page drains it ten times a second.
   SpscRing<FeedEntry> entries_{100};

@@ -16,7 +16,7 @@
 
 namespace camhead::pipeline::web_module {
 
-inline constexpr int kAbiVersion = 1;
+inline constexpr int kAbiVersion = 2; // 2: the region view
 inline constexpr const char *kFactorySymbol = "camhead_web_module";
 
 struct ServerConfig {

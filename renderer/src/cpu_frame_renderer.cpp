@@ -166,6 +166,7 @@ public:
         }
     }
     report.traced_pixels = region_->pixels();
+    report.region = region_->rects;
     report.frame_pixels = pixels_;
     // Outside the region the composite is the camera image, and in the
     // camera frame's own format the way through linear RGB and back gives

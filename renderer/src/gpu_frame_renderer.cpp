@@ -101,6 +101,7 @@ public:
         region_ = request.influence_region ? &regions_.build(frame)
                                            : &regions_.whole_frame(frame.image.x, frame.image.y);
       report.traced_pixels = region_->pixels();
+      report.region = region_->rects;
       report.frame_pixels = std::uint64_t(frame.image.x) * frame.image.y;
       const RenderResult result = tracer_.render_video(
           frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, region_,

@@ -417,6 +417,11 @@ std::uint64_t InfluenceRegion::pixels() const {
   return sum;
 }
 
+std::size_t max_region_rects(std::uint32_t width, std::uint32_t height) {
+  return std::size_t((width + CAMHEAD_TILE_X - 1) / CAMHEAD_TILE_X) *
+         ((height + CAMHEAD_TILE_Y - 1) / CAMHEAD_TILE_Y);
+}
+
 InfluenceRegion whole_frame_region(std::uint32_t width, std::uint32_t height) {
   InfluenceRegion region;
   region.width = width;

@@ -160,12 +160,12 @@ protected:
             preview_parts};
   }
 
-  // Two preview streams (the composite and the camera) read until `ended`;
+  // Three preview streams (the composite, the camera and the region) read until `ended`;
   // counts the parts that came.
   static void watch_previews(std::uint16_t port, const std::atomic<bool> &ended,
                              std::atomic<std::uint64_t> &parts) {
     std::vector<int> streams;
-    for (const char *view : {"composite", "camera"}) {
+    for (const char *view : {"composite", "camera", "region"}) {
       int fd = -1;
       while (!ended && fd < 0) { // until the page listens
         fd = ::socket(AF_INET, SOCK_STREAM, 0);

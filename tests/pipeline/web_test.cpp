@@ -1,8 +1,10 @@
 // The operator page's parts that need no server: the frame loop's hand-over
-// (a triple buffer and a ring, without locks), the preview's colours, the
+// (a triple buffer and a ring, without locks, and the feed they make), the
+// preview's colours and its region view, the
 // history's statistics, and who may reach the page (its address, its
 // password file, a board's "http"). The server itself is tested from
 // outside (tests/web: a client, and Chromium).
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -20,6 +22,7 @@
 #include "web/run_history.h"
 #include "web/spsc_ring.h"
 #include "web/web_access.h"
+#include "web/web_feed.h"
 
 #include <gtest/gtest.h>
 
@@ -215,6 +218,60 @@ TEST(PreviewImage, APreviewPixelIsTheMeanOfItsBox) {
   EXPECT_EQ(at(10, 10, 2), 0);
   EXPECT_NEAR(at(600, 300, 2), 150, 12);
   EXPECT_EQ(at(600, 300, 0), 0);
+}
+
+// The region view: a preview pixel keeps its colour where the centre of
+// the frame pixels it covers was traced, and is a third of it elsewhere,
+// with the frame shrunk by 3 (1920 wide) or not at all (320 wide), and a
+// region edge inside a box.
+TEST(PreviewImage, TheRegionViewDarkensWhatWasNotTraced) {
+  for (const int width : {1920, 320}) {
+    const base::VideoFormat f{base::PixelFormat::rgb24, width,
+                              width * 9 / 16,           0,
+                              base::ColorMatrix::bt709, base::ColorRange::full};
+    const std::vector<std::uint8_t> grey = frame_of(f, 150, 150, 150);
+    PreviewImage preview = preview_for(f);
+    const int step = preview_factor(width);
+    const std::vector<renderer::PixelRect> region = {{64, 32, 256, 97}, {8, 97, 40, 120}};
+    shrink_to_preview(f, grey, preview);
+    shade_outside(region, f.width, f.height, preview);
+    int kept = 0;
+    for (int py = 0; py < preview.height; ++py)
+      for (int px = 0; px < preview.width; ++px) {
+        const std::uint32_t x = std::uint32_t(px * step + step / 2),
+                            y = std::uint32_t(py * step + step / 2);
+        bool inside = false;
+        for (const renderer::PixelRect &r : region)
+          inside |= r.x0 <= x && x < r.x1 && r.y0 <= y && y < r.y1;
+        kept += inside;
+        for (int k = 0; k < 3; ++k)
+          ASSERT_EQ(preview.rgb[(std::size_t(py) * preview.width + px) * 3 + k], inside ? 150 : 50)
+              << width << " wide, preview pixel " << px << "," << py;
+      }
+    // As many pixels kept as the region covers, to the boxes' rounding.
+    EXPECT_NEAR(kept * step * step, 192 * 65 + 32 * 23, 0.15 * (192 * 65 + 32 * 23)) << width;
+  }
+}
+
+// The feed copies the composite and its region for the region view only
+// while someone watches it, and the copy holds both.
+TEST(WebFeed, TheRegionViewGetsTheCompositeAndItsRegion) {
+  const base::VideoFormat f{base::PixelFormat::yuyv,  64, 32, 0, base::ColorMatrix::bt709,
+                            base::ColorRange::limited};
+  WebFeed feed(f, f);
+  std::vector<std::uint8_t> image(base::frame_bytes(f), 77);
+  const std::vector<renderer::PixelRect> region = {{0, 0, 16, 8}, {8, 8, 64, 16}};
+  feed.composite(1, {}, 0, image, region);
+  EXPECT_FALSE(feed.take_frame(View::region)) << "copied while nobody watched";
+  feed.watch(View::region, 1);
+  image[5] = 9;
+  feed.composite(2, {}, 0, image, region);
+  ASSERT_TRUE(feed.take_frame(View::region));
+  const FrameCopy &copy = feed.frame(View::region);
+  EXPECT_EQ(copy.frame, 2u);
+  EXPECT_EQ(copy.bytes, image);
+  EXPECT_TRUE(std::ranges::equal(copy.region(), region));
+  EXPECT_FALSE(feed.take_frame(View::composite)) << "the composite view is not watched";
 }
 
 FeedEntry composite_at(std::int64_t output_ns, double render_ms) {

@@ -265,6 +265,55 @@ TEST_P(FramePassThrough, InfluenceRegionGivesTheSameBytes) {
   }
 }
 
+// The report names the region it traced (what the operator page shows):
+// disjoint rectangles inside the frame, as many pixels as it says it
+// traced, and every byte of the composite that is not the camera's lies in
+// them. Without a region, one rectangle: the frame.
+TEST_P(FramePassThrough, TheReportNamesTheRegionItTraced) {
+  const int w = 160, h = 96;
+  const Scene scene = scene_with_ball(w, h, {-0.6f, 0.1f, -2.5f});
+  auto renderer = make_renderer(GetParam(), scene);
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
+  const VideoFormat yuyv = format(PixelFormat::yuyv, w, h);
+  const std::vector<std::uint8_t> plate = noise_frame(yuyv, 5);
+  std::vector<std::uint8_t> out(base::frame_bytes(yuyv));
+  const VideoBuffer target{yuyv, out};
+  FrameRequest request;
+  request.camera = scene_camera(scene);
+  request.rays_per_pixel = 4;
+  FrameReport report = renderer->render(request, {yuyv, plate}, std::span(&target, 1));
+  ASSERT_EQ(report.status, FrameStatus::ok) << report.detail;
+  std::vector<int> covered(std::size_t(w * h), 0);
+  for (const PixelRect &r : report.region) {
+    ASSERT_TRUE(r.x0 < r.x1 && r.y0 < r.y1 && r.x1 <= std::uint32_t(w) && r.y1 <= std::uint32_t(h));
+    for (std::uint32_t y = r.y0; y < r.y1; ++y)
+      for (std::uint32_t x = r.x0; x < r.x1; ++x)
+        ++covered[y * std::size_t(w) + x];
+  }
+  EXPECT_LE(report.region.size(), max_region_rects(w, h));
+  EXPECT_EQ(std::count(covered.begin(), covered.end(), 1), std::ptrdiff_t(report.traced_pixels));
+  EXPECT_EQ(std::count(covered.begin(), covered.end(), 2), 0) << "rectangles overlap";
+  EXPECT_LT(report.traced_pixels, report.frame_pixels);
+  std::size_t changed = 0, changed_outside = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int byte = 0; byte < 2; ++byte) {
+        const std::size_t at = std::size_t(y) * base::row_bytes(yuyv) + std::size_t(2 * x + byte);
+        if (out[at] != plate[at]) {
+          ++changed;
+          changed_outside += covered[std::size_t(y * w + x)] == 0;
+        }
+      }
+  EXPECT_GT(changed, 100u) << "the ball changed nothing";
+  EXPECT_EQ(changed_outside, 0u);
+
+  request.influence_region = false;
+  report = renderer->render(request, {yuyv, plate}, std::span(&target, 1));
+  ASSERT_EQ(report.region.size(), 1u);
+  EXPECT_EQ(report.region[0], (PixelRect{0, 0, std::uint32_t(w), std::uint32_t(h)}));
+}
+
 TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
   auto renderer = make_renderer(GetParam(), real_only(32, 16));
   if (!renderer)

@@ -9,13 +9,15 @@ on the simulated rig.
 2. The lens values the page shows are the run's --record-stats for the
    frame it names (the page shows one frame's record, so they match it
    exactly, to the digits shown).
-3. The lens plot has been drawn (its canvas is not blank).
+3. The lens plot has been drawn (its canvas is not blank), and the
+   traced-region view, once chosen, is the picture darkened outside the
+   region.
 4. On the narrowest phone's screen in use (320x640 CSS pixels) nothing is
    wider than the screen: no sideways scrolling, whatever the length of the
    paths and device names the page shows. If something is, the elements
    that stick out are named.
-Screenshots of the whole page are left in SCRATCH_DIR/page.png and
-phone.png.
+Screenshots of the whole page are left in SCRATCH_DIR/page.png,
+region.png and phone.png.
 Prints a line per check, then PASS or FAIL.
 """
 import io
@@ -23,7 +25,7 @@ import os
 import sys
 import time
 
-from PIL import Image, ImageChops
+from PIL import Image, ImageChops, ImageStat
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
@@ -71,6 +73,17 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--duration", "60",
             "return lit")
         check(blank > 100, "the lens plot is drawn (%d bright pixels)" % blank)
         driver.save_screenshot(os.path.join(scratch, "page.png"))
+        # The traced-region view: the same picture, darkened where nothing was traced.
+        driver.find_element(By.CSS_SELECTOR, "input[name=view][value=region]").click()
+        time.sleep(2)
+        region = Image.open(io.BytesIO(preview.screenshot_as_png)).convert("L")
+        brightness = [ImageStat.Stat(image.convert("L")).mean[0] for image in (second, region)]
+        check(driver.find_element(By.ID, "preview").get_attribute("src").endswith("view=region") and
+              brightness[1] < 0.8 * brightness[0],
+              "the traced-region view is the picture darkened outside the region "
+              "(mean %.0f, composite %.0f)" % (brightness[1], brightness[0]))
+        driver.save_screenshot(os.path.join(scratch, "region.png"))
+        driver.find_element(By.CSS_SELECTOR, "input[name=view][value=composite]").click()
         driver.set_window_size(320, 640)
         time.sleep(1)
         page, screen, sticking_out = driver.execute_script(

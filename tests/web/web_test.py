@@ -7,7 +7,8 @@
 2. Metrics: /metrics parses with Prometheus's own parser (prometheus_client).
 3. Preview: the MJPEG stream's frames decode to the composite: each part
    (its X-Frame) against that frame of the run's Y4M output, shrunk the same
-   way, within JPEG's error (PSNR).
+   way, within JPEG's error (PSNR); the region view keeps the frame's
+   traced share at full brightness and darkens the rest.
    Record: the record button's take holds the composites the outputs got
    while it was on, byte for byte.
    Mark and reload: a calibration mark as `camhead calibrate` reads it;
@@ -122,6 +123,11 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + 
     c.close()
     check(response.status == 200 and len({n for n, _ in parts}) == 8,
           "preview: 8 distinct frames from /stream.mjpeg")
+    c = run.connection()
+    c.request("GET", "/stream.mjpeg?view=region")
+    response = c.getresponse()
+    region_parts = web_rig.mjpeg_frames(response, 8)
+    c.close()
 
     as_json = {"Content-Type": "application/json"}
     started = run.get("/api/record", as_json, method="POST", body='{"recording": true}')
@@ -258,6 +264,22 @@ check(len(take_frames) == take.get("frames") and first is not None,
       % (len(take_frames), take.get("frames"), first))
 check(worst >= 32.0, "preview: each JPEG is its Y4M frame within JPEG's error "
       "(worst PSNR %.1f dB; a frame 50 later: %.1f dB)" % (worst, wrong))
+# The region view is its frame where the renderer traced, a third of it
+# elsewhere: the share of the frame at full brightness is the record's
+# traced share, less a rim inside the region's edges that JPEG's ringing
+# darkens (about 0.04 of the frame here).
+shares = []
+for number, jpeg in region_parts:
+    image = numpy.asarray(Image.open(io.BytesIO(jpeg)).convert("L"), dtype=float)
+    step = frames[number][0].shape[1] // image.shape[1]
+    full = preview_of(frames[number], step).mean(axis=-1)
+    lit = full > 30  # where a third is told apart from the whole through JPEG
+    kept = numpy.abs(image - full) < numpy.abs(image - full / 3)
+    shares.append((kept[lit].mean(), by_frame[number]["traced"]))
+check(len(shares) == 8 and all(abs(shown - traced) <= 0.08 for shown, traced in shares) and
+      min(traced for _, traced in shares) < 0.9,
+      "preview: the region view keeps the traced share of its frames (shown, traced: %s)"
+      % ", ".join("%.2f, %.2f" % s for s in shares))
 
 # -- 5: access ----------------------------------------------------------------
 password_file = os.path.join(scratch, "web-password")

@@ -291,7 +291,7 @@ private:
     if (path == "/stream.mjpeg" || path == "/snapshot.jpg") {
       const std::optional<View> view = view_of(uri);
       if (!view)
-        return refuse(request, 400, "Bad Request", "view: composite or camera");
+        return refuse(request, 400, "Bad Request", "view: composite, camera or region");
       return stream(request,
                     path == "/stream.mjpeg" ? StreamClient::Kind::mjpeg
                                             : StreamClient::Kind::snapshot,
@@ -332,6 +332,8 @@ private:
       out = View::composite;
     else if (std::strcmp(view, "camera") == 0)
       out = View::camera;
+    else if (std::strcmp(view, "region") == 0)
+      out = View::region;
     evhttp_clear_headers(&fields);
     return out;
   }

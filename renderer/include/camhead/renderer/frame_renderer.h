@@ -69,8 +69,11 @@ struct FrameReport {
   FrameStatus status = FrameStatus::ok;
   std::string detail;
   std::uint64_t camera_rays = 0;
-  // Pixels traced (the influence region's) of the frame's.
+  // Pixels traced (the influence region's) of the frame's, and the region
+  // itself (influence_region.h; every pixel when the request traces
+  // without one), valid until the renderer's next render().
   std::uint64_t traced_pixels = 0;
+  std::span<const PixelRect> region;
   std::uint64_t frame_pixels = 0;
   // Accumulating frames: the samples per pixel the image holds (the mean
   // over the region), and whether this frame started a new history (the

@@ -17,6 +17,7 @@
 // computed outside it.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -30,6 +31,7 @@ namespace camhead::renderer {
 struct PixelRect {
   std::uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   [[nodiscard]] std::uint64_t pixels() const { return std::uint64_t(x1 - x0) * (y1 - y0); }
+  bool operator==(const PixelRect &) const = default;
 };
 
 struct InfluenceRegion {
@@ -45,6 +47,10 @@ struct InfluenceRegion {
     return width * height == 0 ? 0.0 : double(pixels()) / (double(width) * height);
   }
 };
+
+// The most rectangles a region of a width x height frame holds (one per
+// tile), for storage that copies regions without growing.
+[[nodiscard]] std::size_t max_region_rects(std::uint32_t width, std::uint32_t height);
 
 // Every pixel of a width x height frame: what tracing without a region does.
 [[nodiscard]] InfluenceRegion whole_frame_region(std::uint32_t width, std::uint32_t height);
