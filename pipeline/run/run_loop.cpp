@@ -255,12 +255,25 @@ Pipeline::Pipeline(const RunOptions &options)
       if (const base::PixelFormat f = sinks_[i]->format().pixel;
           f == base::PixelFormat::yuyv || f == base::PixelFormat::nv12)
         recording_sink_ = i;
+    const bool marker_pose = board_.pose && board_.pose->type == PoseType::marker;
     page_ = std::make_unique<web::OperatorPage>(
         *options.web,
-        web::RunView{
-            board_.name, board_.file.string(), board_.description, *camera_, lens_, sinks_,
-            counters_, executor_name_, pose_source_name(), fps_, reloader_ ? &*reloader_ : nullptr,
-            recording_sink_ ? std::optional(sinks_[*recording_sink_]->format()) : std::nullopt},
+        web::RunView{.board_name = board_.name,
+                     .board_file = board_.file.string(),
+                     .board_description = board_.description,
+                     .camera = *camera_,
+                     .lens = lens_,
+                     .sinks = sinks_,
+                     .counters = counters_,
+                     .executor = executor_name_,
+                     .pose_source = pose_source_name(),
+                     .fps = fps_,
+                     .reloader = reloader_ ? &*reloader_ : nullptr,
+                     .record_format = recording_sink_
+                                          ? std::optional(sinks_[*recording_sink_]->format())
+                                          : std::nullopt,
+                     .marker_board = marker_pose ? board_.pose->file : std::filesystem::path(),
+                     .lens_profile = board_.lens.profile.value_or(std::filesystem::path())},
         sinks_.front()->format(), camera_->format());
     if (options.status != nullptr)
       std::fprintf(options.status, "camhead run: operator page at %s\n", page_->url().c_str());

@@ -1,12 +1,19 @@
 #include "operator_page.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "calibration_marks.h"
+#include "camera_views.h"
 #include "camhead/base/monotonic_clock.h"
+#include "tracking/luma.h"
+#include "tracking/marker_board.h"
 #include "web_server.h"
 
 namespace camhead::pipeline::web {
@@ -84,7 +91,7 @@ OperatorPage::OperatorPage(const WebOptions &options, RunView run,
     : run_(std::move(run)),
       feed_(composite, camera), previews_{preview_for(composite), preview_for(camera),
                                           preview_for(composite)},
-      recorder_(options.recordings, run_.record_format, run_.fps),
+      recorder_(options.recordings, run_.record_format, run_.fps), recordings_(options.recordings),
       marks_file_(options.recordings / "lens-marks.csv"), start_ns_(base::monotonic_ns()) {
   server_ = start_web_server(server_config(options), *this);
 }
@@ -431,6 +438,8 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
                       {"value", value_field->get<double>()}}
                      .dump()};
   }
+  if (name == "view")
+    return capture_view();
   if (name == "reload") {
     if (run_.reloader == nullptr)
       return {409, json{{"error", "this run cannot reload its board"}}.dump()};
@@ -439,9 +448,76 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
                                  "state's \"reload\" gives the outcome"}}
                      .dump()};
   }
-  return {404,
-          json{{"error", "no action '" + std::string(name) + "' (freeze, record, mark, reload)"}}
-              .dump()};
+  return {404, json{{"error",
+                     "no action '" + std::string(name) + "' (freeze, record, mark, view, reload)"}}
+                   .dump()};
+}
+
+web_module::Reply OperatorPage::capture_view() {
+  // The next camera frame, whole: the frame loop copies camera frames while
+  // someone watches them, so the page watches until one comes, a few frame
+  // intervals at most (its event loop waits that long, once per press). A
+  // frame copied before the press is not the view asked for.
+  feed_.watch(View::camera, +1);
+  (void)feed_.take_frame(View::camera);
+  const std::int64_t wait_ns = std::max<std::int64_t>(300'000'000, std::llround(4e9 / run_.fps));
+  const std::int64_t deadline = base::monotonic_ns() + wait_ns;
+  bool fresh = false;
+  while (!(fresh = feed_.take_frame(View::camera)) && base::monotonic_ns() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  feed_.watch(View::camera, -1);
+  if (!fresh)
+    return {503,
+            json{{"error", "view: no camera frame came in " + std::to_string(wait_ns / 1'000'000) +
+                               " ms (is the camera connected?)"}}
+                .dump()};
+  const FrameCopy &frame = feed_.frame(View::camera);
+  const int w = frame.format.width, h = frame.format.height;
+  std::vector<std::uint8_t> luma(std::size_t(w) * std::size_t(h));
+  copy_luma(frame.format, frame.bytes, luma);
+  const LumaImage image{luma.data(), w, h, w};
+
+  LensPlace place;
+  if (const auto reading = run_.lens.last_reading();
+      reading && run_.lens.state_at(base::monotonic_ns()).connected)
+    place = {reading->focus, reading->zoom};
+  SavedView saved;
+  if (const std::string error = save_camera_view(recordings_, image, place, saved); !error.empty())
+    return {409, json{{"error", "view: " + error}}.dump()};
+
+  json reply{{"file", saved.file.string()}, {"views", saved.views}, {"at", saved.at}};
+  // How much of the board the view shows: a view the fit cannot use (the
+  // board blurred, cut off or too small) is better taken again now.
+  if (!run_.marker_board.empty() && !view_tracker_ && view_tracker_problem_.empty()) {
+    try {
+      const MarkerBoard board = load_marker_board(run_.marker_board);
+      if (board.type != MarkerBoardType::charuco)
+        throw MarkerModuleError(run_.marker_board.string() +
+                                ": a marker field, not a ChArUco board: views are not checked");
+      view_tracker_ = open_marker_tracker(board);
+      board_markers_ = board.squares_x * board.squares_y / 2;
+    } catch (const std::exception &e) {
+      view_tracker_problem_ = e.what();
+    }
+  }
+  if (view_tracker_) {
+    // Detection does not need the lens; a nominal camera serves the call.
+    const CameraModel nominal{double(w), double(w), 0.5 * w, 0.5 * h, {}};
+    reply["markers_seen"] = view_tracker_->track(image, nominal, nullptr).markers_seen;
+    reply["markers"] = board_markers_;
+  } else {
+    reply["unchecked"] = view_tracker_problem_.empty()
+                             ? "the board's pose has no marker board to look for"
+                             : view_tracker_problem_;
+  }
+  const std::string folder = saved.file.parent_path().string();
+  reply["command"] =
+      "camhead calibrate camera " + folder + "/*.png --board " +
+      (run_.marker_board.empty() ? std::string("BOARD.json") : run_.marker_board.string()) +
+      " --profile " +
+      (run_.lens_profile.empty() ? std::string("PROFILE.json") : run_.lens_profile.string()) +
+      " --at " + saved.at;
+  return {200, reply.dump()};
 }
 
 } // namespace camhead::pipeline::web

@@ -23,6 +23,7 @@
 #include "run/run_counters.h"
 #include "run/setup_reloader.h"
 #include "run_history.h"
+#include "tracking/marker_tracker.h"
 #include "web_access.h"
 #include "web_feed.h"
 #include "web_module_abi.h"
@@ -31,7 +32,9 @@ namespace camhead::pipeline::web {
 
 // What the page reads of the run; each must outlive the page.
 struct RunView {
-  std::string board_name, board_file, board_description;
+  std::string board_name;
+  std::string board_file;
+  std::string board_description;
   const hal::camera::CameraSource &camera;
   const LensHub &lens;
   const std::vector<std::unique_ptr<hal::output::FrameSink>> &sinks;
@@ -45,6 +48,11 @@ struct RunView {
   // The format of the output the record button writes (yuyv or nv12);
   // none: no output of the run is in one.
   std::optional<base::VideoFormat> record_format;
+  // For the camera-calibration views: a marker pose's board file (the views
+  // are checked for its markers; empty: none), and the lens profile the
+  // fit writes into (empty: the board has none).
+  std::filesystem::path marker_board;
+  std::filesystem::path lens_profile;
 };
 
 class OperatorPage final : public web_module::Host {
@@ -74,6 +82,9 @@ public:
 private:
   // Takes the record lines the frame loop sent since the last call.
   void drain();
+  // The "view" action: the next camera frame saved for `calibrate camera`
+  // (camera_views.h), checked for the marker board's markers.
+  web_module::Reply capture_view();
 
   RunView run_;
   WebFeed feed_;
@@ -81,7 +92,13 @@ private:
   std::deque<std::pair<std::int64_t, std::uint64_t>> in_samples_; // (when, frames in)
   PreviewImage previews_[kViews]; // the newest frame of each view, shrunk
   PageRecorder recorder_;
+  std::filesystem::path recordings_;
   std::filesystem::path marks_file_; // the calibration marks (calibration_marks.h)
+  // The views' check: a tracker of the marker board, opened at the first
+  // view (or why it cannot be), and how many markers the board has.
+  std::unique_ptr<MarkerTracker> view_tracker_;
+  std::string view_tracker_problem_;
+  int board_markers_ = 0;
   std::int64_t start_ns_;
   bool frozen_ = false;                        // the preview holds its frame (the outputs go on)
   std::unique_ptr<web_module::Server> server_; // last: stopped first

@@ -17,6 +17,8 @@
 #include <unistd.h>
 
 #include "board.h"
+#include "tracking/calibration_views.h"
+#include "web/camera_views.h"
 #include "web/latest_value.h"
 #include "web/preview_image.h"
 #include "web/run_history.h"
@@ -327,6 +329,44 @@ TEST(WebAccess, AnAddressIsAPortOrAnAddressAndAPort) {
   EXPECT_FALSE(is_loopback("0.0.0.0"));
   EXPECT_FALSE(is_loopback("192.168.1.20"));
   EXPECT_FALSE(is_loopback("::"));
+}
+
+// A calibration view is the camera's luma exactly, as `calibrate camera`
+// reads it back; the views of one lens position share a folder, numbered
+// on from the highest there; without the focus counts nothing is saved.
+TEST(CameraViews, EachViewIsTheLumaInTheFolderOfItsLensPosition) {
+  const fs::path dir = fs::temp_directory_path() / ("camhead_views_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  std::vector<std::uint8_t> luma(64 * 48);
+  for (std::size_t i = 0; i < luma.size(); ++i)
+    luma[i] = std::uint8_t(i * 7 % 251);
+  const LumaImage image{luma.data(), 64, 48, 64};
+  SavedView first, second, zoomed, none;
+  ASSERT_EQ(save_camera_view(dir, image, {9400, std::nullopt}, first), "");
+  EXPECT_EQ(first.file, fs::absolute(dir / "camera-views" / "focus-9400" / "view-001.png"));
+  EXPECT_EQ(first.at, "focus=9400");
+  EXPECT_EQ(first.views, 1);
+  fs::remove(first.file.parent_path() / "view-001.png");
+  std::ofstream(first.file.parent_path() / "view-007.png") << "a view taken before";
+  ASSERT_EQ(save_camera_view(dir, image, {9400, std::nullopt}, second), "");
+  EXPECT_EQ(second.file.filename(), "view-008.png");
+  EXPECT_EQ(second.views, 2);
+  ASSERT_EQ(save_camera_view(dir, image, {9400, 120}, zoomed), "");
+  EXPECT_EQ(zoomed.file.parent_path().filename(), "focus-9400-zoom-120");
+  EXPECT_EQ(zoomed.at, "focus=9400,zoom=120");
+  const std::vector<CalibrationPicture> read = read_calibration_views({second.file}, 1);
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_EQ(read[0].width, 64);
+  EXPECT_EQ(read[0].height, 48);
+  EXPECT_EQ(read[0].luma, luma);
+  EXPECT_FALSE(fs::exists(second.file.string() + ".partial"));
+  EXPECT_NE(save_camera_view(dir, image, {}, none).find("no focus counts"), std::string::npos);
+  // A folder that cannot be made: named.
+  std::ofstream(dir / "blocked") << "a file where the folder would go";
+  EXPECT_NE(save_camera_view(dir / "blocked", image, {9400, std::nullopt}, none)
+                .find((dir / "blocked").string()),
+            std::string::npos);
+  fs::remove_all(dir);
 }
 
 class PasswordFile : public ::testing::Test {

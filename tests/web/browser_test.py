@@ -11,7 +11,8 @@ on the simulated rig.
    exactly, to the digits shown).
 3. The lens plot has been drawn (its canvas is not blank), and the
    traced-region view, once chosen, is the picture darkened outside the
-   region.
+   region; the calibration-view button names the view saved and the
+   command that fits it.
 4. On the narrowest phone's screen in use (320x640 CSS pixels) nothing is
    wider than the screen: no sideways scrolling, whatever the length of the
    paths and device names the page shows. If something is, the elements
@@ -22,6 +23,7 @@ Prints a line per check, then PASS or FAIL.
 """
 import io
 import os
+import re
 import sys
 import time
 
@@ -84,6 +86,12 @@ with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--duration", "60",
               "(mean %.0f, composite %.0f)" % (brightness[1], brightness[0]))
         driver.save_screenshot(os.path.join(scratch, "region.png"))
         driver.find_element(By.CSS_SELECTOR, "input[name=view][value=composite]").click()
+        driver.find_element(By.ID, "capture").click()
+        wait.until(lambda d: d.find_element(By.ID, "message").text != "")
+        message = driver.find_element(By.ID, "message").text
+        check(re.search(r"^view \d+ at focus=\d+", message) and "calibrate camera" in message,
+              "the calibration-view button says where the view went and how to fit it: " +
+              message)
         driver.set_window_size(320, 640)
         time.sleep(1)
         page, screen, sticking_out = driver.execute_script(

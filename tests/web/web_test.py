@@ -22,6 +22,9 @@
    it every endpoint answers 401, a wrong one 401 and after five 429 for the
    sender; traversal, oversized headers, bad JSON and a flood are refused
    with the right status and the run goes on.
+6. Calibration views: the camera frame's luma saved whole for `calibrate
+   camera` in a folder per lens position, checked for the marker board's
+   markers where the run has one, and read by the command the reply names.
 Prints a line per check, then PASS or FAIL.
 """
 import io
@@ -45,6 +48,8 @@ camhead, source, scratch = sys.argv[1], os.path.abspath(sys.argv[2]), os.path.ab
 # A sanitizer build does not hold the camera's rate: the outputs repeat
 # frames with or without clients, so only what the page could cause counts.
 sanitized = "--sanitized" in sys.argv[4:]
+# The marker module was built: the calibration views are checked for the board.
+markers = "--markers" in sys.argv[4:]
 os.makedirs(scratch, exist_ok=True)
 check = web_rig.Checks()
 
@@ -368,4 +373,66 @@ with web_rig.Run(camhead, board, "--http", "0.0.0.0:0", "--http-password", passw
         if f.name == "camhead_http_refused").samples}
     check(refused["wrong_credentials"] >= 7 and refused["no_credentials"] >= len(codes),
           "access: the refusals counted %s" % refused)
+
+# -- 6: calibration views ------------------------------------------------------
+# The loopback rig has no marker board: a view is saved unchecked.
+with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--duration", "30") as run:
+    run.wait_frames(3)
+    status, _, body = run.get("/api/view", {"Content-Type": "application/json"}, method="POST",
+                              body="{}")
+    view = json.loads(body)
+    picture = Image.open(view["file"]) if status == 200 else None
+    check(status == 200 and picture.mode == "L" and picture.size == (192, 144) and
+          "no marker board" in view.get("unchecked", "") and
+          ("--profile " + os.path.join(source, "scenes", "lenses", "example_35mm.json")) in
+          view["command"],
+          "view: the camera frame's luma saved whole (%s), unchecked without a marker board: %s"
+          % (picture and picture.size, view))
+
+if markers:
+    # A moving camera over the printed ChArUco board, the lens held still:
+    # each view is checked for the board's markers, all go into the folder
+    # of that lens position, and `calibrate camera` reads them.
+    trace = os.path.join(scratch, "still_lens.csv")
+    with open(trace, "w") as f:
+        f.write("# camhead lens trace v1\nt_s,focus,iris,zoom\n")
+        f.writelines("%.2f,8000,1900,0\n" % (i / 100) for i in range(6000))
+    profile = os.path.join(scratch, "views_profile.json")
+    shutil.copy(os.path.join(source, "scenes", "lenses", "example_35mm.json"), profile)
+    with open(os.path.join(source, "board", "sim-moving.json")) as f:
+        moving = json.load(f)
+    scenes = os.path.join(source, "scenes")
+    moving.update(
+        lens={"profile": profile, "sources": [{"name": "still", "type": "trace", "file": trace}]},
+        scene=os.path.join(scenes, "sim_tracked.json"), outputs=["null"],
+        pose={"type": "marker", "board": os.path.join(scenes, "markers", "floor_board.json")},
+        render={"executor": "cpu", "min_rays_per_pixel": 1, "max_rays_per_pixel": 4})
+    moving["camera"].update(width=360, height=288, path=os.path.join(scenes, "paths", "sim_dolly.csv"))
+    moving_board = os.path.join(scratch, "views_board.json")
+    with open(moving_board, "w") as f:
+        json.dump(moving, f)
+    shutil.rmtree(os.path.join(scratch, "recordings", "camera-views"), ignore_errors=True)
+    views = []
+    with web_rig.Run(camhead, moving_board, "--http", "127.0.0.1:0", "--duration", "60") as run:
+        run.wait_frames(2)
+        for _ in range(6):
+            status, _, body = run.get("/api/view", {"Content-Type": "application/json"},
+                                      method="POST", body="{}")
+            views.append(json.loads(body) if status == 200 else {"status": status})
+            time.sleep(0.6)
+    folder = os.path.join(scratch, "recordings", "camera-views", "focus-8000-zoom-0")
+    seen = [v.get("markers_seen") for v in views]
+    check([os.path.basename(v.get("file", "")) for v in views] ==
+          ["view-%03d.png" % n for n in range(1, 7)] and
+          all(os.path.dirname(v["file"]) == folder and v["markers"] == 17 and
+              v["at"] == "focus=8000,zoom=0" for v in views) and max(seen) >= 2,
+          "view: six views in the folder of the lens's position, markers seen of 17: %s" % seen)
+    command = views[-1]["command"].split()
+    fit = subprocess.run([camhead] + command[1:3] + sorted(
+        os.path.join(folder, n) for n in os.listdir(folder)) + command[4:],
+        capture_output=True, text=True, timeout=120)
+    check(command[:3] == ["camhead", "calibrate", "camera"] and
+          "6 views of floor board" in fit.stderr and fit.returncode in (0, 3),
+          "view: `%s` reads the six (exit %d: %s)"
+          % (" ".join(command), fit.returncode, fit.stderr.strip().splitlines()[-1]))
 check.finish()

@@ -37,6 +37,15 @@ void append_bytes(void *context, void *data, int size) {
   out->insert(out->end(), bytes, bytes + size);
 }
 
+bool encode_png(std::span<const std::uint8_t> pixels, int width, int height, int channels,
+                std::size_t stride, std::vector<std::uint8_t> &png) {
+  png.clear();
+  if (stride > std::size_t(INT_MAX) || pixels.size() < stride * std::size_t(height))
+    return false;
+  return stbi_write_png_to_func(&append_bytes, &png, width, height, channels, pixels.data(),
+                                static_cast<int>(stride)) != 0;
+}
+
 } // namespace
 
 std::optional<PngSize> png_size(std::span<const std::uint8_t> file, std::string &error) {
@@ -58,11 +67,12 @@ bool decode_png_rgb(std::span<const std::uint8_t> file, PngSize expected,
 
 bool encode_png_rgb(std::span<const std::uint8_t> rgb, int width, int height, std::size_t stride,
                     std::vector<std::uint8_t> &png) {
-  png.clear();
-  if (stride > std::size_t(INT_MAX) || rgb.size() < stride * std::size_t(height))
-    return false;
-  return stbi_write_png_to_func(&append_bytes, &png, width, height, 3, rgb.data(),
-                                static_cast<int>(stride)) != 0;
+  return encode_png(rgb, width, height, 3, stride, png);
+}
+
+bool encode_png_grey(std::span<const std::uint8_t> grey, int width, int height, std::size_t stride,
+                     std::vector<std::uint8_t> &png) {
+  return encode_png(grey, width, height, 1, stride, png);
 }
 
 } // namespace camhead::hal::video_file

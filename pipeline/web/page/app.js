@@ -155,6 +155,13 @@ $('record').addEventListener('click', async () => {
   if (answer.file) text('message', (answer.recording ? 'recording to ' : 'recorded ') + answer.file +
       (answer.frames !== undefined ? ' (' + answer.frames + ' frames)' : ''));
 });
+$('capture').addEventListener('click', async () => {
+  const answer = await act('view', {});
+  if (answer.file) text('message', 'view ' + answer.views + ' at ' + answer.at + ' saved (' +
+      (answer.markers !== undefined ? answer.markers_seen + ' of ' + answer.markers + ' markers seen'
+                                    : 'not checked: ' + answer.unchecked) +
+      '): ' + answer.file + '. Fit the folder\'s views with: ' + answer.command);
+});
 for (const radio of document.querySelectorAll('input[name=view]')) {
   radio.addEventListener('change', () => {
     $('preview').src = '/stream.mjpeg?view=' + radio.value;

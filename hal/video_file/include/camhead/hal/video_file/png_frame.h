@@ -40,5 +40,8 @@ struct PngSize {
 // when stb cannot (out of memory).
 [[nodiscard]] bool encode_png_rgb(std::span<const std::uint8_t> rgb, int width, int height,
                                   std::size_t stride, std::vector<std::uint8_t> &png);
+// The same for 8-bit grey rows (a luma plane).
+[[nodiscard]] bool encode_png_grey(std::span<const std::uint8_t> grey, int width, int height,
+                                   std::size_t stride, std::vector<std::uint8_t> &png);
 
 } // namespace camhead::hal::video_file
