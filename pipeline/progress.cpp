@@ -6,8 +6,8 @@
 
 namespace camhead::cli {
 
-ProgressLine::ProgressLine(std::string label)
-    : label_(std::move(label)), terminal_(isatty(STDERR_FILENO) != 0),
+ProgressLine::ProgressLine(std::string label, std::string unit)
+    : label_(std::move(label)), unit_(std::move(unit)), terminal_(isatty(STDERR_FILENO) != 0),
       start_(std::chrono::steady_clock::now()) {}
 
 void ProgressLine::update(int done, int total) {
@@ -22,17 +22,17 @@ void ProgressLine::update(int done, int total) {
     constexpr int width = 30;
     const int filled = int(fraction * width + 0.5);
     const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-    std::fprintf(stderr, "\r%s [%-*s] %3d%%  %d/%d rpp  %.1f s, about %.0f s left ", label_.c_str(),
-                 width, std::string(filled, '#').c_str(), int(fraction * 100), done, total, elapsed,
-                 eta);
+    std::fprintf(stderr, "\r%s [%-*s] %3d%%  %d/%d %s  %.1f s, about %.0f s left ", label_.c_str(),
+                 width, std::string(filled, '#').c_str(), int(fraction * 100), done, total,
+                 unit_.c_str(), elapsed, eta);
     std::fflush(stderr);
     return;
   }
   const int decile = int(fraction * 10.0);
   if (decile > last_decile_) {
     last_decile_ = decile;
-    std::fprintf(stderr, "%s: %d/%d rpp (%d%%), %.1f s\n", label_.c_str(), done, total,
-                 int(fraction * 100), elapsed);
+    std::fprintf(stderr, "%s: %d/%d %s (%d%%), %.1f s\n", label_.c_str(), done, total,
+                 unit_.c_str(), int(fraction * 100), elapsed);
   }
 }
 

@@ -8,7 +8,8 @@ namespace camhead::cli {
 
 class ProgressLine {
 public:
-  explicit ProgressLine(std::string label);
+  // `unit` names what update() counts ("rpp": the samples of a render).
+  explicit ProgressLine(std::string label, std::string unit = "rpp");
   // Redraws on a terminal (at most ten times a second); elsewhere, such as in
   // a service log, prints a line at every tenth of the work.
   void update(int done, int total);
@@ -16,6 +17,7 @@ public:
 
 private:
   std::string label_;
+  std::string unit_;
   bool terminal_;
   int last_decile_ = -1;
   std::chrono::steady_clock::time_point start_, last_draw_;

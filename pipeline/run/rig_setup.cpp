@@ -26,6 +26,7 @@
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "lens_camera.h"
+#include "progress.h"
 #include "trace_lens.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
@@ -138,18 +139,19 @@ std::shared_ptr<renderer::FrameRenderer> make_world_renderer(const renderer::Sce
   return renderer::make_cpu_frame_renderer(world, threads);
 }
 
-// Tells the user why the simulated camera starts slowly, if it does: it
-// renders its world anew for each lens state (WorldPictures) until it has
-// every state of its looped trace, and meanwhile delivers fewer frames than
-// its rate, which the run counts as camera drops. And when the loop's
-// frames cannot all be kept, or never repeat, it says so and why.
-// With a camera path, its loop and the lens's repeat together only where
-// one is a whole number of the other.
-void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &format,
-                         const std::optional<TraceLens> &truth,
-                         const std::optional<PoseTrace> &path, const WorldPictures &cache) {
+// The frames of the simulated world's loop (its lens's, and its path's
+// where it has one: together they repeat only where one is a whole number
+// of the other), when they repeat on the camera's frame clock and the
+// cache (WorldPictures) keeps them all: then the camera can render them
+// once and replay them. Otherwise empty, and the user is told why its
+// world is rendered for every frame, or for the frames the cache cannot
+// keep.
+std::optional<long> world_loop_frames(const SimCameraConfig &sim, const base::VideoFormat &format,
+                                      const std::optional<TraceLens> &truth,
+                                      const std::optional<PoseTrace> &path,
+                                      const WorldPictures &cache) {
   if (!truth || !truth->loop_period_s())
-    return;
+    return std::nullopt;
   double period_s = *truth->loop_period_s();
   if (path) {
     const double path_s = double(path->rows().back().t_ns - path->rows().front().t_ns) * 1e-9;
@@ -160,35 +162,36 @@ void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &fo
                    "camhead run: the simulated camera renders its world for every frame: its "
                    "path's loop (%.3f s) and its lens's (%.3f s) do not repeat together\n",
                    path_s, period_s);
-      return;
+      return std::nullopt;
     }
     period_s = longer;
   }
   const double frames = period_s * sim.fps;
   const long states = std::lround(frames);
   if (sim.cache_mb == 0 || states < 1)
-    return;
+    return std::nullopt;
   if (std::abs(frames - double(states)) > 1e-6) {
     std::fprintf(stderr,
                  "camhead run: the simulated camera renders its world for every frame: its "
                  "lens loop (%.3f s) is not a whole number of its frames (%.3f at %g fps), so "
                  "its frames meet the loop at new instants each time round\n",
                  period_s, frames, sim.fps);
-    return;
+    return std::nullopt;
   }
   const std::size_t picture = base::frame_bytes(format);
   const long kept = long(std::min<std::size_t>(std::size_t(states), cache.holds(picture)));
-  std::fprintf(stderr,
-               "camhead run: the simulated camera renders its world anew for each of the %ld "
-               "%s of its %.1f s loop, then replays them; until then, where a picture "
-               "takes longer than a frame to render, it delivers fewer than %g frames a second "
-               "(counted as camera drops)\n",
-               states, path ? "poses and lens states" : "lens states", period_s, sim.fps);
-  if (kept < states)
+  if (kept < states) {
     std::fprintf(stderr,
-                 "camhead run: the simulated camera keeps %ld of them in camera.cache_mb = %u "
-                 "and renders the rest every loop; %zu would keep them all\n",
-                 kept, sim.cache_mb, (std::size_t(states) * picture + (1u << 20) - 1) >> 20);
+                 "camhead run: the simulated camera renders its world anew for each of the %ld "
+                 "%s of its %.1f s loop; it keeps %ld of them in camera.cache_mb = %u and "
+                 "renders the rest every loop; %zu would keep them all (where a picture takes "
+                 "longer than a frame, it delivers fewer than %g frames a second, counted as "
+                 "camera drops)\n",
+                 states, path ? "poses and lens states" : "lens states", period_s, kept,
+                 sim.cache_mb, (std::size_t(states) * picture + (1u << 20) - 1) >> 20, sim.fps);
+    return std::nullopt;
+  }
+  return states;
 }
 
 // The simulated camera's picture: the scene's real objects through the lens
@@ -198,10 +201,12 @@ void explain_world_cache(const SimCameraConfig &sim, const base::VideoFormat &fo
 // says. It films from its path where it has one (the physical truth of a
 // moving rig), else from the board's pose: a tracker's moves it (the
 // simulated world is where the tracker says the camera is).
-std::unique_ptr<CameraSource>
-open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
-                const renderer::Scene &scene, const renderer::FrameCamera &pose,
-                const LensHub &lens, std::optional<TraceLens> truth, int threads) {
+std::unique_ptr<CameraSource> open_sim_camera(const SimCameraConfig &sim,
+                                              const base::VideoFormat &format,
+                                              const renderer::Scene &scene,
+                                              const renderer::FrameCamera &pose,
+                                              const LensHub &lens, std::optional<TraceLens> truth,
+                                              int threads, const RunLength &length) {
   auto world = make_world_renderer(real_world_of(scene), threads);
   hal::camera::SimulatedCameraOptions options;
   options.format = format;
@@ -214,7 +219,38 @@ open_sim_camera(const SimCameraConfig &sim, const base::VideoFormat &format,
   std::optional<PoseTrace> path;
   if (sim.path)
     path = load_pose_trace(*sim.path);
-  explain_world_cache(sim, format, truth, path, *cache);
+  // A world the tracker moves does not loop.
+  const std::optional<long> loop = lens.tracks_pose() && !path
+                                       ? std::nullopt
+                                       : world_loop_frames(sim, format, truth, path, *cache);
+  if (loop) {
+    const double loop_s = double(*loop) / sim.fps;
+    const char *states = path ? "poses and lens states" : "lens states";
+    if ((length.frames > 0 && length.frames < std::uint64_t(*loop)) ||
+        (length.duration_s > 0.0 && length.duration_s < loop_s)) {
+      // A run shorter than the loop: rendering it all first would cost more.
+      std::fprintf(stderr,
+                   "camhead run: the simulated camera renders its world anew for each of the "
+                   "%ld %s of its %.1f s loop, then replays them; until then, where a picture "
+                   "takes longer than a frame to render, it delivers fewer than %g frames a "
+                   "second (counted as camera drops)\n",
+                   *loop, states, loop_s, sim.fps);
+    } else {
+      std::fprintf(stderr,
+                   "camhead run: the simulated camera renders its world for each of the %ld %s "
+                   "of its %.1f s loop before it starts, then replays them: its frames come at "
+                   "%g a second from the first\n",
+                   *loop, states, loop_s, sim.fps);
+      options.warm_up_frames = std::uint64_t(*loop);
+      auto progress =
+          std::make_shared<cli::ProgressLine>("camhead run: the simulated world", "pictures");
+      options.warm_up_progress = [progress](std::uint64_t drawn, std::uint64_t of) {
+        progress->update(int(drawn), int(of));
+        if (drawn == of)
+          progress->finish();
+      };
+    }
+  }
   auto generator = [world, cache, format, pose, rest = pose_of(pose), samples, &lens,
                     truth = std::move(truth),
                     path = std::move(path)](std::int64_t start_ns, std::int64_t exposure_ns,
@@ -306,14 +342,15 @@ std::unique_ptr<renderer::FrameRenderer> make_renderer(const Board &board, Execu
 
 std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Scene &scene,
                                           const renderer::FrameCamera &pose, const LensHub &lens,
-                                          int threads) {
+                                          int threads, const RunLength &length) {
   const CameraConfig &c = *board.camera;
   base::VideoFormat format;
   format.pixel = c.format;
   format.width = c.width;
   format.height = c.height;
   if (const auto *sim = std::get_if<SimCameraConfig>(&c.kind))
-    return open_sim_camera(*sim, format, scene, pose, lens, TraceLens::of_board(board), threads);
+    return open_sim_camera(*sim, format, scene, pose, lens, TraceLens::of_board(board), threads,
+                           length);
   if (const auto *v4l2 = std::get_if<V4l2CameraConfig>(&c.kind))
     return hal::camera::open_v4l2_camera({.device = v4l2->device,
                                           .format = c.format,

@@ -37,12 +37,23 @@ class MarkerPoseSource;
 [[nodiscard]] std::unique_ptr<renderer::FrameRenderer>
 make_renderer(const Board &board, Executor wanted, const renderer::Scene &scene, int threads);
 
+// How much a run is asked for (0: no limit).
+struct RunLength {
+  std::uint64_t frames = 0;
+  double duration_s = 0.0;
+};
+
 // The board's camera. The simulated one renders the scene's real objects
 // through the lens at each exposure (trace_lens.h, or `lens`) with Vulkan,
-// or without a Vulkan device on `threads` of the CPU reference.
+// or without a Vulkan device on `threads` of the CPU reference. Where its
+// lens (and path) loop on its frame clock and its cache keeps the whole
+// loop, it renders the loop before it opens, with a progress line, so that
+// its frames come at its rate from the first (what a real camera does;
+// without this its first loop is slower, and a video of it plays too
+// fast), unless `length` asks for less than a loop.
 [[nodiscard]] std::unique_ptr<hal::camera::CameraSource>
 open_camera(const Board &board, const renderer::Scene &scene, const renderer::FrameCamera &pose,
-            const LensHub &lens, int threads);
+            const LensHub &lens, int threads, const RunLength &length);
 
 // A marker pose's tracker for frames of `format` (its board loaded, the
 // OpenCV module opened: throws MarkerBoardError, MarkerModuleError); null

@@ -190,8 +190,8 @@ const Board &checked_board(const RunOptions &options) {
 // board before anything of that size is allocated.
 Pipeline::Pipeline(const RunOptions &options)
     : options_(options), board_(checked_board(options)), setup_(load_frame_setup(board_)),
-      lens_(board_),
-      camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_, options.threads)),
+      lens_(board_), camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_,
+                                         options.threads, {options.frames, options.duration_s})),
       markers_(open_marker_source(board_, camera_->format(), setup_->base_camera, lens_,
                                   offline_take(board_),
                                   lens_wait_ns(offline_take(board_), camera_fps(*camera_)))),

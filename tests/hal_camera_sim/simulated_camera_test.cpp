@@ -1,7 +1,8 @@
 // The simulated camera behaves as a camera does for the code above it:
 // exposures a frame interval apart, stamped at their start; no frame while
 // every buffer is held; a frame it had no time for lost as a sequence gap;
-// the disconnect fault reported and recovered from.
+// the disconnect fault reported and recovered from; a warm-up that draws
+// the loop first and a clock that keeps to its grid.
 #include <chrono>
 #include <cstdint>
 #include <span>
@@ -10,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "camhead/base/monotonic_clock.h"
 #include "camhead/hal/camera/sim/simulated_camera.h"
 
 #include <gtest/gtest.h>
@@ -98,6 +100,41 @@ TEST(SimulatedCamera, TheDisconnectFaultIsReportedAndRecoveredFrom) {
   ASSERT_EQ(r, CaptureResult::frame);
   EXPECT_TRUE(camera->status().connected);
   EXPECT_EQ(camera->status().reconnects, 1u);
+}
+
+// Warm-up: the generator draws the loop's exposures as the camera opens,
+// one interval apart, and every frame after it is an exposure of that
+// grid, so that a generator keeping its pictures has each one at hand.
+TEST(SimulatedCamera, AWarmUpDrawsTheLoopFirstAndTheFramesKeepToItsGrid) {
+  std::vector<std::int64_t> drawn;
+  std::vector<std::uint64_t> heard;
+  SimulatedCameraOptions o = small(true);
+  o.warm_up_frames = 4;
+  o.warm_up_progress = [&](std::uint64_t n, std::uint64_t of) {
+    EXPECT_EQ(of, 4u);
+    heard.push_back(n);
+  };
+  auto camera = open_simulated_camera(
+      o, [&](std::int64_t start, std::int64_t exposure, std::span<std::uint8_t> out) {
+        drawn.push_back(start);
+        stamp(start, exposure, out);
+      });
+  ASSERT_EQ(drawn.size(), 4u) << "drawn as the camera opened";
+  const std::vector<std::int64_t> warm_up = drawn;
+  EXPECT_EQ(heard, (std::vector<std::uint64_t>{1, 2, 3, 4}));
+  for (std::size_t k = 1; k < warm_up.size(); ++k)
+    EXPECT_EQ(warm_up[k] - warm_up[k - 1], 20'000'000);
+  std::this_thread::sleep_for(33ms); // off the grid, as a pipeline's set-up is
+  const std::int64_t asked = base::monotonic_ns();
+  for (int k = 0; k < 3; ++k) {
+    CapturedFrame f;
+    ASSERT_EQ(camera->wait_frame(200ms, f), CaptureResult::frame);
+    EXPECT_EQ((f.timestamp_ns - warm_up.front()) % 20'000'000, 0)
+        << "frame " << k << " is " << (f.timestamp_ns - warm_up.front()) << " ns after the warm-up";
+    EXPECT_GE(f.timestamp_ns, asked) << "the first exposure starts once the camera is asked";
+    EXPECT_EQ(f.sequence, std::uint64_t(k));
+    camera->release(f);
+  }
 }
 
 TEST(SimulatedCamera, RefusesWhatNoCameraCouldBe) {

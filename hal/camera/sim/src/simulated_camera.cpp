@@ -3,6 +3,7 @@
 #include <cmath>
 #include <ctime>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -30,6 +31,15 @@ public:
     buffers_.assign(std::size_t(options_.buffers), std::vector<std::uint8_t>(bytes));
     held_.assign(std::size_t(options_.buffers), false);
     status_.connected = true;
+    if (options_.realtime && options_.warm_up_frames > 0) {
+      const std::int64_t grid = base::monotonic_ns();
+      grid_ns_ = grid;
+      for (std::uint64_t k = 0; k < options_.warm_up_frames; ++k) {
+        generator_(grid + std::int64_t(k) * interval_ns_, exposure_ns_, buffers_.front());
+        if (options_.warm_up_progress)
+          options_.warm_up_progress(k + 1, options_.warm_up_frames);
+      }
+    }
   }
 
   std::string name() const override { return "sim " + base::describe(options_.format); }
@@ -39,8 +49,10 @@ public:
   CaptureResult wait_frame(std::chrono::milliseconds timeout, CapturedFrame &out) override {
     const std::int64_t now = base::monotonic_ns();
     const std::int64_t deadline = now + std::int64_t(timeout.count()) * 1'000'000;
-    if (start_ns_ == 0)
-      start_ns_ = now;
+    if (start_ns_ == 0) // on the warm-up's grid, if there was one: its next instant
+      start_ns_ =
+          grid_ns_ ? *grid_ns_ + (now - *grid_ns_ + interval_ns_ - 1) / interval_ns_ * interval_ns_
+                   : now;
     if (gone_until_ns_ != 0) {
       if (now < gone_until_ns_) {
         sleep_until_ns(std::min(deadline, gone_until_ns_));
@@ -151,8 +163,9 @@ private:
   const std::int64_t exposure_ns_;
   std::vector<std::vector<std::uint8_t>> buffers_;
   std::int64_t start_ns_ = 0;
-  std::uint64_t next_ = 0;      // sequence number of the next frame
-  std::uint64_t delivered_ = 0; // for the fault option
+  std::optional<std::int64_t> grid_ns_; // the warm-up's first exposure
+  std::uint64_t next_ = 0;              // sequence number of the next frame
+  std::uint64_t delivered_ = 0;         // for the fault option
   std::int64_t gone_until_ns_ = 0;
   bool fault_done_ = false;
   mutable std::mutex mutex_; // guards held_ and status_

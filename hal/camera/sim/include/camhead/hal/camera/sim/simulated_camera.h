@@ -46,6 +46,16 @@ struct SimulatedCameraOptions {
   // ... or, silent, it only stops sending (wait_frame times out, the status
   // stays connected), as a capture card that lost its signal does.
   bool disconnect_silently = false;
+  // Warm-up (real time only): as it opens, the camera has the generator
+  // draw this many exposures one frame interval apart from an instant
+  // chosen then, and its frames keep to that grid (each exposure starts a
+  // whole number of intervals after it). A generator whose pictures repeat
+  // every warm_up_frames intervals and that keeps what it drew (the
+  // simulated world: pipeline/run/rig_setup.cpp) then has every picture at
+  // hand from the first frame, which comes at the camera's rate.
+  // `warm_up_progress` hears each exposure drawn.
+  std::uint64_t warm_up_frames = 0;
+  std::function<void(std::uint64_t drawn, std::uint64_t of)> warm_up_progress;
 };
 
 // Throws std::invalid_argument for a format check_video_format() refuses, a
