@@ -24,7 +24,7 @@
 
 #include "camhead/renderer/image.h"
 #include "camhead/renderer/image_io.h"
-#include "chart_plot.h"
+#include "chart/chart_plot.h"
 #include "synthetic_view.h"
 #include "tracking/marker_board.h"
 #include "tracking/marker_tracker.h"

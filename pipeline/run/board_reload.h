@@ -13,7 +13,7 @@
 
 #include <stdexcept>
 
-#include "board.h"
+#include "config/board.h"
 
 namespace camhead::pipeline {
 

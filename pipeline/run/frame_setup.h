@@ -11,11 +11,11 @@
 #include <memory>
 #include <mutex>
 
-#include "board.h"
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/frame_camera.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/scene.h"
+#include "config/board.h"
 #include "tracking/camera_pose.h"
 
 namespace camhead::pipeline {

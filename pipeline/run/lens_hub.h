@@ -18,7 +18,7 @@
 
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/lens_control/lens_state.h"
-#include "lens_sources.h"
+#include "config/lens_sources.h"
 
 namespace camhead::pipeline {
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "camhead/base/config_error.h"
+#include "camhead/base/progress_line.h"
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/camera/libcamera/libcamera_camera.h"
 #include "camhead/hal/camera/sim/simulated_camera.h"
@@ -26,7 +27,6 @@
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
 #include "lens_camera.h"
-#include "progress.h"
 #include "trace_lens.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
@@ -243,7 +243,7 @@ std::unique_ptr<CameraSource> open_sim_camera(const SimCameraConfig &sim,
                    *loop, states, loop_s, sim.fps);
       options.warm_up_frames = std::uint64_t(*loop);
       auto progress =
-          std::make_shared<cli::ProgressLine>("camhead run: the simulated world", "pictures");
+          std::make_shared<base::ProgressLine>("camhead run: the simulated world", "pictures");
       options.warm_up_progress = [progress](std::uint64_t drawn, std::uint64_t of) {
         progress->update(int(drawn), int(of));
         if (drawn == of)

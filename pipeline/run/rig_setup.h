@@ -8,12 +8,12 @@
 #include <cstdint>
 #include <memory>
 
-#include "board.h"
 #include "camhead/hal/camera/camera_source.h"
 #include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_camera.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/scene.h"
+#include "config/board.h"
 #include "lens_hub.h"
 #include "output_uri.h"
 

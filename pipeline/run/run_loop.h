@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "board.h"
+#include "config/board.h"
 #include "web/web_access.h"
 
 namespace camhead::pipeline {

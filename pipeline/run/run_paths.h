@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "board.h"
 #include "camhead/renderer/scene.h"
+#include "config/board.h"
 #include "output_uri.h"
 
 namespace camhead::pipeline {

@@ -8,7 +8,7 @@
 
 #include "board_reload.h"
 #include "camhead/base/monotonic_clock.h"
-#include "lens_sources.h"
+#include "config/lens_sources.h"
 
 namespace camhead::pipeline {
 

@@ -17,7 +17,7 @@
 #include <optional>
 #include <string>
 
-#include "board.h"
+#include "config/board.h"
 #include "frame_setup.h"
 #include "lens_hub.h"
 #include "service/service_notifier.h"

@@ -3,7 +3,7 @@
 #include <variant>
 
 #include "camhead/hal/lens/trace/trace_replay.h"
-#include "lens_sources.h"
+#include "config/lens_sources.h"
 
 namespace camhead::pipeline {
 

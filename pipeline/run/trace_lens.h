@@ -14,10 +14,10 @@
 #include <cstdint>
 #include <optional>
 
-#include "board.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/lens_control/lens_state.h"
-#include "trace_curve.h"
+#include "config/board.h"
+#include "config/trace_curve.h"
 
 namespace camhead::pipeline {
 

@@ -1,5 +1,5 @@
 // The last frames' camera samples, kept so that a frame after a lens change
-// starts with them rather than with nothing (issue 24: a focus pull at the
+// starts with them rather than with nothing (a focus pull at the
 // camera's rate; Lehtinen et al. 2011 reproject samples the same way).
 //
 // While the pose holds, a thin-lens sample is one ray of the world: it left

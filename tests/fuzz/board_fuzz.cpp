@@ -1,4 +1,4 @@
-// libFuzzer target for the board-file reader (pipeline/board.h) and what
+// libFuzzer target for the board-file reader (pipeline/config/board.h) and what
 // `camhead run` builds from a board before it opens a device: the output
 // URIs, the check of every path the run reads and writes against the others
 // (run_paths.h; it only looks at paths, with stat()), the camera's size,
@@ -13,9 +13,9 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "board.h"
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/scene.h"
+#include "config/board.h"
 #include "fuzz_check.h"
 #include "run/output_uri.h"
 #include "run/run_paths.h"

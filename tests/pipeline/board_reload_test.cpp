@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "board.h"
+#include "config/board.h"
 #include "run/board_reload.h"
 
 #include <gtest/gtest.h>

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "board.h"
-#include "data_dir.h"
+#include "config/board.h"
+#include "config/data_dir.h"
 #include "run/output_uri.h"
 
 #include <gtest/gtest.h>

@@ -1,9 +1,9 @@
-// The chart's drawing and CSV (pipeline/chart_plot.h): every label the chart
+// The chart's drawing and CSV (pipeline/chart/chart_plot.h): every label the chart
 // writes has glyphs, series land in their colours, CSV fields are quoted.
 #include <string>
 #include <vector>
 
-#include "chart_plot.h"
+#include "chart/chart_plot.h"
 
 #include <gtest/gtest.h>
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <thread>
 
-#include "board.h"
 #include "camhead/hal/lens/monotonic_clock.h"
-#include "lens_sources.h"
+#include "config/board.h"
+#include "config/lens_sources.h"
 
 #include <gtest/gtest.h>
 

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "board.h"
 #include "camhead/hal/lens/trace/lens_trace.h"
 #include "camhead/lens_control/lens_profile.h"
+#include "config/board.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
 

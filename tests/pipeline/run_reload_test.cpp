@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "board.h"
+#include "config/board.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
 

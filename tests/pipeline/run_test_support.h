@@ -17,7 +17,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "board.h"
+#include "config/board.h"
 #include "tracking/camera_pose.h"
 
 #include <gtest/gtest.h>

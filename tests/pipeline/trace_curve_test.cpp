@@ -1,7 +1,7 @@
 // One axis of a lens trace over time: linear between rows, held or looped
 // at the ends as the trace's replay loops, rows without the axis skipped.
 #include "camhead/hal/lens/trace/trace_replay.h"
-#include "trace_curve.h"
+#include "config/trace_curve.h"
 
 #include <gtest/gtest.h>
 

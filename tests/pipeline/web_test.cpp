@@ -16,7 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "board.h"
+#include "config/board.h"
 #include "tracking/calibration_views.h"
 #include "web/camera_views.h"
 #include "web/latest_value.h"

@@ -6,7 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "commands.h"
+#include "cli/commands.h"
 
 int main(int argc, char **argv) {
   // A write past a file-size limit (ulimit -f) fails with EFBIG, which the

@@ -15,7 +15,7 @@
 // list is in board/README.md; the loader checks every field the way the scene
 // and lens-profile readers do and throws BoardError("FILE: FIELD: REASON").
 //
-// Plain data only: pipeline/lens_sources.h turns a LensSourceConfig into a
+// Plain data only: pipeline/config/lens_sources.h turns a LensSourceConfig into a
 // hal::lens::LensEncoder.
 #pragma once
 

@@ -14,7 +14,7 @@
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/image.h"
 #include "camhead/renderer/scene.h"
-#include "chart_plot.h"
+#include "chart/chart_plot.h"
 
 namespace camhead::cli::chart {
 

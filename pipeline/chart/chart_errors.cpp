@@ -1,5 +1,5 @@
 // See chart_errors.h.
-#include "chart_errors.h"
+#include "chart/chart_errors.h"
 
 #include <algorithm>
 #include <cmath>

@@ -12,11 +12,11 @@
 #include <utility>
 #include <vector>
 
-#include "board.h"
 #include "camhead/hal/lens/lens_encoder.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/lens_control/lens_state.h"
 #include "camhead/lens_control/lens_tracker.h"
+#include "config/board.h"
 #include "tracking/pose_timeline.h"
 
 namespace camhead::pipeline {

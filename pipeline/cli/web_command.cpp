@@ -7,7 +7,7 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include "commands.h"
+#include "cli/commands.h"
 #include "web/web_access.h"
 #include "web/web_server.h"
 

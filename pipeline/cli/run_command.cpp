@@ -11,14 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "board.h"
 #include "camhead/base/config_error.h"
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/output/file/file_sink.h"
 #include "camhead/lens_control/lens_profile.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/scene_loader.h"
-#include "commands.h"
+#include "cli/commands.h"
+#include "config/board.h"
 #include "run/output_uri.h"
 #include "run/run_loop.h"
 #include "run/run_paths.h"

@@ -23,7 +23,7 @@
 #include "camhead/base/partial_file.h"
 #include "camhead/lens_control/calibration.h"
 #include "camhead/lens_control/lens_profile.h"
-#include "commands.h"
+#include "cli/commands.h"
 #include "run/run_paths.h"
 #include "tracking/calibration_views.h"
 #include "tracking/camera_profile.h"

@@ -1,4 +1,4 @@
-#include "trace_curve.h"
+#include "config/trace_curve.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,6 @@
 // camhead bench live: the live frame's virtual image as a viewer sees it, as
-// error against time (issue 24's targets). For each lens state the live
+// error against time (a still shot within 1 s as clean as 49 rays per pixel,
+// a focus pull as clean as 9, without ghosting). For each lens state the live
 // renderer (the CPU reference frame renderer that `camhead run` drives)
 // renders a still shot frame after frame at the rays per frame the rig holds
 // at the camera's rate, accumulating (frame_history.h), and each frame's
@@ -26,6 +27,7 @@
 #include <CLI/CLI.hpp>
 #include <glm/geometric.hpp>
 
+#include "camhead/base/progress_line.h"
 #include "camhead/base/video_format.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
@@ -34,10 +36,9 @@
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/scene_loader.h"
-#include "chart_plot.h"
-#include "commands.h"
-#include "data_dir.h"
-#include "progress.h"
+#include "chart/chart_plot.h"
+#include "cli/commands.h"
+#include "config/data_dir.h"
 
 namespace camhead::cli {
 namespace {
@@ -108,7 +109,8 @@ public:
         for (std::uint32_t x = r.x0; x < r.x1; ++x)
           region_pixels_.push_back(std::size_t(y) * std::size_t(scene.render.width) + x);
 
-    ProgressLine progress(lens.name + ": reference, " + std::to_string(args.ref_rpp) + " rpp");
+    base::ProgressLine progress(lens.name + ": reference, " + std::to_string(args.ref_rpp) +
+                                " rpp");
     FrameRequest reference;
     reference.camera = camera_;
     reference.rays_per_pixel = std::uint32_t(args.ref_rpp);

@@ -1,10 +1,10 @@
-#include "progress.h"
+#include "camhead/base/progress_line.h"
 
 #include <cstdio>
 
 #include <unistd.h>
 
-namespace camhead::cli {
+namespace camhead::base {
 
 ProgressLine::ProgressLine(std::string label, std::string unit)
     : label_(std::move(label)), unit_(std::move(unit)), terminal_(isatty(STDERR_FILENO) != 0),
@@ -42,4 +42,4 @@ void ProgressLine::finish() {
   }
 }
 
-} // namespace camhead::cli
+} // namespace camhead::base

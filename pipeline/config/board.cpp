@@ -2,7 +2,7 @@
 // checked for every field, and the first problem is thrown as
 // BoardError("FILE: FIELD: REASON"), by base's strict JSON reader
 // (config_json.h), as the scene and profile readers do.
-#include "board.h"
+#include "config/board.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,7 +18,7 @@
 #include "camhead/base/config_json.h"
 #include "camhead/base/path_text.h"
 #include "camhead/renderer/frame_camera.h"
-#include "data_dir.h"
+#include "config/data_dir.h"
 
 namespace camhead::pipeline {
 

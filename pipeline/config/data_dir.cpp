@@ -1,4 +1,4 @@
-#include "data_dir.h"
+#include "config/data_dir.h"
 
 #include <cstdlib>
 #include <system_error>

@@ -1,6 +1,6 @@
 // camhead bench chart: the speed-versus-accuracy chart (chart_command.cpp),
 // and camhead bench live: the live frame's error against time
-// (live_bench_command.cpp).
+// (cli/live_bench_command.cpp).
 #pragma once
 
 #include <CLI/CLI.hpp>

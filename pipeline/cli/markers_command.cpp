@@ -6,7 +6,7 @@
 
 #include "camhead/renderer/image.h"
 #include "camhead/renderer/image_io.h"
-#include "commands.h"
+#include "cli/commands.h"
 #include "tracking/marker_board.h"
 #include "tracking/marker_tracker.h"
 

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "camhead/base/partial_file.h"
+#include "camhead/base/progress_line.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/frame_settings.h"
@@ -18,8 +19,7 @@
 #include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/mesh_io.h"
 #include "camhead/renderer/scene_loader.h"
-#include "commands.h"
-#include "progress.h"
+#include "cli/commands.h"
 #include "run/run_paths.h"
 
 namespace camhead::cli {
@@ -130,7 +130,7 @@ int run_render(const RenderArgs &args) {
     std::string executor;
     if (args.cpu) {
       executor = "CPU reference";
-      ProgressLine progress("render (CPU)");
+      base::ProgressLine progress("render (CPU)");
       const ProgressFn report = [&](int done, int total) { progress.update(done, total); };
       result = args.adaptive
                    ? render_cpu_adaptive(compiled, frame, {}, report, args.threads, &region)
@@ -139,7 +139,7 @@ int run_render(const RenderArgs &args) {
     } else {
       GpuTracer tracer(args.device);
       executor = tracer.device_name();
-      ProgressLine progress("render (" + executor + ")");
+      base::ProgressLine progress("render (" + executor + ")");
       tracer.load(compiled);
       const ProgressFn report = [&](int done, int total) { progress.update(done, total); };
       result = args.adaptive ? tracer.render_adaptive(frame, {}, report, {}, &region)

@@ -5,12 +5,12 @@
 // For each scene: a converged reference from the CPU reference tracer (cached
 // in the output folder), a mask of the pixels near depth edges, then every
 // method of kMethods at each of its budgets: the median frame time on the GPU
-// (bench_command.cpp's approach: repeated frames after warm-up, each from the
+// (cli/bench_command.cpp's approach: repeated frames after warm-up, each from the
 // first kernel to the 8-bit display image in host memory, by the device's
 // timestamps where it has them) and the relative RMSE of
 // its composite against the reference, over all pixels and over the edge
 // mask. Writes chart.csv and one chart_<scene>.png per scene.
-#include "chart_command.h"
+#include "chart/chart_command.h"
 
 #include <algorithm>
 #include <chrono>
@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "camhead/base/progress_line.h"
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/cpu_tracer.h"
 #include "camhead/renderer/dof_gather.h"
@@ -33,11 +34,10 @@
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/image_io.h"
 #include "camhead/renderer/scene_loader.h"
-#include "chart_errors.h"
-#include "chart_methods.h"
-#include "chart_plot.h"
-#include "commands.h"
-#include "progress.h"
+#include "chart/chart_errors.h"
+#include "chart/chart_methods.h"
+#include "chart/chart_plot.h"
+#include "cli/commands.h"
 
 namespace camhead::cli {
 namespace {
@@ -95,7 +95,7 @@ Image cached_render(const fs::path &cache, const CompiledScene &compiled,
       single.data[i] = image.data[i * 3];
     return single;
   }
-  ProgressLine progress(label);
+  base::ProgressLine progress(label);
   RenderResult r = render_cpu(
       compiled, frame, [&](int done, int total) { progress.update(done, total); }, args.threads);
   progress.finish();

@@ -20,13 +20,13 @@
 
 #include <unistd.h>
 
-#include "board.h"
 #include "camhead/hal/lens/monotonic_clock.h"
 #include "camhead/hal/lens/network/opentrackio_sender.h"
 #include "camhead/hal/lens/trace/trace_recorder.h"
 #include "camhead/lens_control/lens_profile.h"
-#include "commands.h"
-#include "lens_sources.h"
+#include "cli/commands.h"
+#include "config/board.h"
+#include "config/lens_sources.h"
 #include "run/run_paths.h"
 #include "tracking/tracker_axes.h"
 

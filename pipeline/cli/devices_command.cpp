@@ -9,7 +9,7 @@
 #include "camhead/hal/discovery/devices.h"
 #include "camhead/hal/lens/usb/usb_lens_protocol.h"
 #include "camhead/renderer/gpu_tracer.h"
-#include "commands.h"
+#include "cli/commands.h"
 #include "tracking/marker_tracker.h"
 #include "web/web_server.h"
 

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <string>
 
-namespace camhead::cli {
+namespace camhead::base {
 
 class ProgressLine {
 public:
@@ -23,4 +23,4 @@ private:
   std::chrono::steady_clock::time_point start_, last_draw_;
 };
 
-} // namespace camhead::cli
+} // namespace camhead::base

@@ -1,5 +1,5 @@
 // See chart_methods.h.
-#include "chart_methods.h"
+#include "chart/chart_methods.h"
 
 #include <algorithm>
 #include <functional>

@@ -1,4 +1,4 @@
-#include "chart_plot.h"
+#include "chart/chart_plot.h"
 
 #include <algorithm>
 #include <array>

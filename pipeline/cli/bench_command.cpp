@@ -22,8 +22,8 @@
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/scene_loader.h"
-#include "chart_command.h"
-#include "commands.h"
+#include "chart/chart_command.h"
+#include "cli/commands.h"
 
 namespace camhead::cli {
 namespace {

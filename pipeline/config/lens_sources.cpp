@@ -1,4 +1,4 @@
-#include "lens_sources.h"
+#include "config/lens_sources.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "camhead/hal/lens/trace/trace_replay.h"
 #include "camhead/hal/lens/usb/simulated_usb_lens.h"
 #include "camhead/hal/lens/usb/usb_lens.h"
-#include "trace_curve.h"
+#include "config/trace_curve.h"
 #include "tracking/tracker_axes.h"
 
 namespace camhead::pipeline {
