@@ -455,12 +455,13 @@ web_module::Reply OperatorPage::action(std::string_view name, std::string_view b
 
 web_module::Reply OperatorPage::capture_view() {
   // The next camera frame, whole: the frame loop copies camera frames while
-  // someone watches them, so the page watches until one comes, a few frame
-  // intervals at most (its event loop waits that long, once per press). A
-  // frame copied before the press is not the view asked for.
+  // someone watches them (as each is rendered), so the page watches until
+  // one comes, a second or four frame intervals at most (its event loop
+  // waits that long, once per press). A frame copied before the press is
+  // not the view asked for.
   feed_.watch(View::camera, +1);
   (void)feed_.take_frame(View::camera);
-  const std::int64_t wait_ns = std::max<std::int64_t>(300'000'000, std::llround(4e9 / run_.fps));
+  const std::int64_t wait_ns = std::max<std::int64_t>(1'000'000'000, std::llround(4e9 / run_.fps));
   const std::int64_t deadline = base::monotonic_ns() + wait_ns;
   bool fresh = false;
   while (!(fresh = feed_.take_frame(View::camera)) && base::monotonic_ns() < deadline)

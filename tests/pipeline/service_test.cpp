@@ -238,6 +238,9 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
   const auto run = [&](std::optional<std::uint64_t> stall, double seconds) {
     RunOptions options;
     options.board = load_board(resolve_board("sim"));
+    // No cache, so no warm-up before the first frame (rig_setup.h): what
+    // is judged is the run's watchdog, from its first frame.
+    std::get<SimCameraConfig>(options.board.camera->kind).cache_mb = 0;
     options.outputs = {"null"};
     options.duration_s = seconds;
     options.status = status;
@@ -297,9 +300,8 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
   EXPECT_GE(running, 1);
   // Long enough for the stall to be judged on a loaded machine, where the
   // first frames take seconds (a sanitizer suite beside it: 3 composites
-  // in the first 3 s), and shorter than the simulated camera's 6 s loop,
-  // which it would otherwise render before its first frame (rig_setup.h).
-  const auto [stuck, stuck_tail] = run(2, 5.5);
+  // in the first 3 s).
+  const auto [stuck, stuck_tail] = run(2, 6.0);
   // The run went on for more than a window after its last composite (the
   // status kept coming), so a watchdog fed by a live main thread alone
   // would have been pinged meanwhile: the check above says it was not.
