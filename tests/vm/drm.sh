@@ -8,7 +8,7 @@
 # read on the host (screen_helper.py, over /dev/ttyS1). bochs stays loaded:
 # fbcon holds it.
 results="drm_master_busy drm_frame_too_large drm_open drm_placeholder drm_frame drm_flip
-drm_close_restores_crtc drm_console_back drm_full_frame drm_destructor_restores"
+drm_close_restores_crtc drm_console_back drm_full_frame drm_destructor_restores drm_card_back"
 fail() {
   for name in $results; do
     echo "RESULT $name: FAIL $1"

@@ -26,10 +26,17 @@
 //                            (screendump)
 //   drm_destructor_restores  a sink destroyed without close() also puts the
 //                            console back
+//   drm_card_back            the card unplugged and back (PCI remove and
+//                            rescan), 20 times: frames skipped and said
+//                            while it is away, and going out again once it
+//                            is back, each time (by the driver's name)
 //
 //   camhead_drm_vm_check CONTROL_TTY
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <climits>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -61,6 +68,8 @@ constexpr int kModeWidth = 1280;
 constexpr int kModeHeight = 800;
 constexpr int kFrameWidth = 640;
 constexpr int kFrameHeight = 480;
+// Unplugs and replugs of the card (drm_card_back).
+constexpr int kCardCycles = 20;
 
 // The test pattern of frame `seed` at pixel (x, y) of the frame; every pixel
 // differs from its neighbours in each direction and from the pixel 256 away,
@@ -267,6 +276,92 @@ std::string send_frame(FrameSink &sink, int seed) {
   return {};
 }
 
+bool write_sysfs(const std::string &path, const char *value) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0)
+    return false;
+  const bool written = ::write(fd, value, std::strlen(value)) == ssize_t(std::strlen(value));
+  ::close(fd);
+  return written;
+}
+
+// The card unplugged and back `cycles` times: the VGA removed from the PCI
+// bus and found again by a rescan, which unbinds bochs and binds it anew
+// as an unplug and a replug do (the card comes back under another number
+// while the observer holds the old one). While it is away the sink skips
+// frames and says so; once it is back it finds the card again by its
+// driver's name and frames go out. Last: the screen is not checked after.
+void card_unplugged(int cycles) {
+  char device[4096] = {};
+  if (::realpath("/sys/class/drm/card0/device", device) == nullptr) {
+    print_result("drm_card_back", false, "no /sys/class/drm/card0/device");
+    return;
+  }
+  std::unique_ptr<FrameSink> sink;
+  try {
+    sink = open_drm_sink(DrmSinkOptions{"bochs-drm", "", kFrameWidth, kFrameHeight, "1280x800"});
+  } catch (const std::exception &e) {
+    print_result("drm_card_back", false, e.what());
+    return;
+  }
+  const auto format = sink->format();
+  std::vector<std::uint8_t> frame(camhead::base::frame_bytes(format));
+  fill(frame, format.width, format.height, camhead::base::row_bytes(format), 4);
+  std::vector<double> back_ms;
+  std::string problem, gone_detail;
+  for (int cycle = 0; cycle < cycles && problem.empty(); ++cycle) {
+    if (!sink->submit(frame, 0)) {
+      problem = "cycle " + std::to_string(cycle) +
+                ": no frame before the unplug: " + sink->status().detail;
+      break;
+    }
+    if (!write_sysfs(std::string(device) + "/remove", "1")) {
+      problem = std::string("cannot write ") + device + "/remove: " + std::strerror(errno);
+      break;
+    }
+    // Frames at 25 a second while it is away: skipped, and said.
+    bool seen_gone = false;
+    for (int k = 0; k < 25 && !seen_gone; ++k) {
+      seen_gone = !sink->submit(frame, 0) && !sink->status().connected;
+      ::usleep(40'000);
+    }
+    gone_detail = sink->status().detail;
+    if (!seen_gone) {
+      problem =
+          "cycle " + std::to_string(cycle) + ": the sink did not see the card go: " + gone_detail;
+      break;
+    }
+    if (!write_sysfs("/sys/bus/pci/rescan", "1")) {
+      problem = std::string("cannot write /sys/bus/pci/rescan: ") + std::strerror(errno);
+      break;
+    }
+    const std::int64_t rescanned = camhead::base::monotonic_ns();
+    bool back = false;
+    while (!back && camhead::base::monotonic_ns() - rescanned < 10'000'000'000) {
+      back = sink->submit(frame, 0);
+      if (!back)
+        ::usleep(40'000);
+    }
+    if (!back) {
+      problem = "cycle " + std::to_string(cycle) +
+                ": not back 10 s after the rescan: " + sink->status().detail;
+      break;
+    }
+    back_ms.push_back(double(camhead::base::monotonic_ns() - rescanned) * 1e-6);
+  }
+  std::string detail = problem;
+  if (!back_ms.empty()) {
+    std::vector<double> sorted = back_ms;
+    std::sort(sorted.begin(), sorted.end());
+    detail +=
+        (detail.empty() ? "" : "; ") + std::to_string(back_ms.size()) + " of " +
+        std::to_string(cycles) + " back, median " + std::to_string(int(sorted[sorted.size() / 2])) +
+        " ms, worst " + std::to_string(int(sorted.back())) +
+        " ms after the rescan; while away: " + gone_detail + "; back: " + sink->status().detail;
+  }
+  print_result("drm_card_back", problem.empty() && int(back_ms.size()) == cycles, detail);
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -408,5 +503,6 @@ int main(int argc, char **argv) {
     print_result("drm_full_frame", false, e.what());
     print_result("drm_destructor_restores", false, "not run: the sink did not open");
   }
+  card_unplugged(kCardCycles);
   return 0;
 }

@@ -297,19 +297,28 @@ void paint_placeholder(const DumbBuffer &buffer, int mode_height, Placement at, 
   }
 }
 
+// A display set up as open_drm_sink() describes, and the frames it takes.
+struct OpenedDisplay {
+  std::unique_ptr<Display> display;
+  base::VideoFormat format;
+  bool full_frame = false;
+  std::string summary;
+};
+
+OpenedDisplay open_display(const DrmSinkOptions &options);
+
 class DrmSink final : public FrameSink {
 public:
-  DrmSink(std::unique_ptr<Display> display, base::VideoFormat format, bool full_frame,
-          const std::string &summary)
-      : display_(std::move(display)), format_(format), full_frame_(full_frame),
+  DrmSink(const DrmSinkOptions &options, OpenedDisplay opened)
+      : options_(options), display_(std::move(opened.display)), format_(opened.format),
+        full_frame_(opened.full_frame),
+        name_("drm " + display_->label + " " + display_->connector_name),
         next_check_ns_(base::monotonic_ns() + kConnectorCheckNs) {
     status_.connected = true;
-    status_.detail = name() + ": ready, " + summary;
+    status_.detail = name() + ": ready, " + opened.summary;
   }
 
-  std::string name() const override {
-    return "drm " + display_->label + " " + display_->connector_name;
-  }
+  std::string name() const override { return name_; }
   base::VideoFormat format() const override { return format_; }
 
   bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
@@ -340,7 +349,7 @@ public:
       return fail("closed twice");
     closed_ = true;
     std::string error;
-    const bool restored = display_->teardown(error);
+    const bool restored = display_ == nullptr || display_->teardown(error);
     const std::lock_guard lock(mutex_);
     status_.connected = false;
     if (!restored) {
@@ -416,7 +425,7 @@ private:
   bool lost(const char *what, int err) {
     const std::string reason = std::string(what) + ": " + errno_text(err);
     if (err == ENODEV)
-      return go_dark("the card is gone (" + reason + "); reopen the sink when it is back");
+      return card_gone(reason);
     if (err == EACCES || err == EPERM) {
       display_->master = false;
       return go_dark("DRM master was taken (" + reason +
@@ -430,6 +439,20 @@ private:
     return fail(reason + "; frame dropped");
   }
 
+  // The card itself went away (unplugged, its driver unbound): every ioctl
+  // on it fails with ENODEV. It is let go of at once, since a card that
+  // comes back while this one is still open is given another number, and
+  // looked for every 0.5 s.
+  bool card_gone(const std::string &reason) {
+    display_.reset();
+    live_ = false;
+    next_check_ns_ = base::monotonic_ns() + kConnectorCheckNs;
+    return fail("the card is gone (" + reason + "); looking for " + options_.card + " every 0.5 s");
+  }
+
+  // Whether an ioctl that failed did so because the card is gone.
+  static bool gone(const CardFile &card) { return driver_name(card).empty() && errno == ENODEV; }
+
   bool go_dark(const std::string &why) {
     live_ = false;
     display_->flip_pending = false;
@@ -442,28 +465,42 @@ private:
     std::string error;
     const std::optional<Connector> state =
         get_connector(display_->card, display_->connector.id, false, error);
-    if (!state) {
+    if (!state && gone(display_->card)) {
+      (void)card_gone(error);
+    } else if (!state) {
       (void)go_dark(error);
     } else if (state->connection == kDisconnected) {
       (void)go_dark("connector unplugged; waiting for it, every 0.5 s");
     }
   }
 
-  // Every 0.5 s while dark: master back, connector back, mode set again.
+  // Every 0.5 s while dark: the card back (opened again as at open, by the
+  // name it was opened by), master back, connector back, mode set again.
   bool resume(std::int64_t now) {
     if (now < next_check_ns_)
       return false;
     next_check_ns_ = now + kConnectorCheckNs;
+    if (display_ == nullptr)
+      return reopen();
     Display &d = *display_;
     std::string error;
     if (!d.master) {
       int unused = 0;
-      if (!d.card.ioctl(DRM_IOCTL_SET_MASTER, unused, true))
-        return still_dark("DRM master is still held by another program (" + errno_text(errno) +
-                          ")");
+      if (!d.card.ioctl(DRM_IOCTL_SET_MASTER, unused, true)) {
+        const int err = errno;
+        if (err == ENODEV) {
+          (void)card_gone("DRM_IOCTL_SET_MASTER: " + errno_text(err));
+          return false;
+        }
+        return still_dark("DRM master is still held by another program (" + errno_text(err) + ")");
+      }
       d.master = true;
     }
     const std::optional<Connector> state = get_connector(d.card, d.connector.id, false, error);
+    if (!state && gone(d.card)) {
+      (void)card_gone(error);
+      return false;
+    }
     if (!state)
       return still_dark(error);
     if (state->connection == kDisconnected)
@@ -474,6 +511,24 @@ private:
     const std::lock_guard lock(mutex_);
     status_.connected = true;
     status_.detail = name() + ": back, " + describe_mode(d.mode_summary) + note_;
+    return true;
+  }
+
+  bool reopen() {
+    try {
+      OpenedDisplay opened = open_display(options_);
+      if (opened.format != format_)
+        return still_dark("the card is back, but takes " + base::describe(opened.format) +
+                          " frames, not " + base::describe(format_) + ": restart to use it");
+      display_ = std::move(opened.display);
+    } catch (const DrmSinkError &e) {
+      return still_dark(std::string("the card is gone; looking for it every 0.5 s: ") + e.what());
+    }
+    live_ = true;
+    const std::lock_guard lock(mutex_);
+    status_.connected = true;
+    status_.detail = name() + ": the card is back (" + display_->label + "), " +
+                     describe_mode(display_->mode_summary) + note_;
     return true;
   }
 
@@ -492,9 +547,11 @@ private:
     return false;
   }
 
-  const std::unique_ptr<Display> display_;
+  const DrmSinkOptions options_;
+  std::unique_ptr<Display> display_; // null while the card is gone
   const base::VideoFormat format_;
   const bool full_frame_;
+  const std::string name_;
   std::int64_t next_check_ns_;
   bool live_ = true;
   bool closed_ = false;
@@ -504,9 +561,7 @@ private:
   SinkStatus status_;
 };
 
-} // namespace
-
-std::unique_ptr<FrameSink> open_drm_sink(const DrmSinkOptions &options) {
+OpenedDisplay open_display(const DrmSinkOptions &options) {
   if (options.card.empty())
     fail_open("drm", "no card named (a path, \"card0\" or a driver name)");
   base::VideoFormat format;
@@ -579,7 +634,13 @@ std::unique_ptr<FrameSink> open_drm_sink(const DrmSinkOptions &options) {
                std::to_string(d.placement.y) +
                ") with black borders, copied into the back buffer each frame";
   summary += ", page flips; mid-grey until the first frame";
-  return std::make_unique<DrmSink>(std::move(display), format, full_frame, summary);
+  return {std::move(display), format, full_frame, summary};
+}
+
+} // namespace
+
+std::unique_ptr<FrameSink> open_drm_sink(const DrmSinkOptions &options) {
+  return std::make_unique<DrmSink>(options, open_display(options));
 }
 
 } // namespace camhead::hal::output
