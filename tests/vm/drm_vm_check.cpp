@@ -27,7 +27,7 @@
 //   drm_destructor_restores  a sink destroyed without close() also puts the
 //                            console back
 //   drm_card_back            the card unplugged and back (PCI remove and
-//                            rescan), 20 times: frames skipped and said
+//                            rescan), 100 times: frames skipped and said
 //                            while it is away, and going out again once it
 //                            is back, each time (by the driver's name)
 //
@@ -69,7 +69,7 @@ constexpr int kModeHeight = 800;
 constexpr int kFrameWidth = 640;
 constexpr int kFrameHeight = 480;
 // Unplugs and replugs of the card (drm_card_back).
-constexpr int kCardCycles = 20;
+constexpr int kCardCycles = 100;
 
 // The test pattern of frame `seed` at pixel (x, y) of the frame; every pixel
 // differs from its neighbours in each direction and from the pixel 256 away,
