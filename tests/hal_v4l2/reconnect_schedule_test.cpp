@@ -15,26 +15,26 @@ TEST(ReconnectSchedule, NothingIsDueBeforeALoss) {
   EXPECT_FALSE(schedule.due(1'000'000 * kMs));
 }
 
-TEST(ReconnectSchedule, FirstTryHalfASecondAfterTheLoss) {
+TEST(ReconnectSchedule, FirstTryAQuarterSecondAfterTheLoss) {
   ReconnectSchedule schedule;
   schedule.lost(1000 * kMs);
   EXPECT_TRUE(schedule.waiting());
   EXPECT_FALSE(schedule.due(1000 * kMs));
-  EXPECT_FALSE(schedule.due(1499 * kMs));
-  EXPECT_TRUE(schedule.due(1500 * kMs));
-  EXPECT_EQ(schedule.next_ns(), 1500 * kMs);
+  EXPECT_FALSE(schedule.due(1249 * kMs));
+  EXPECT_TRUE(schedule.due(1250 * kMs));
+  EXPECT_EQ(schedule.next_ns(), 1250 * kMs);
 }
 
-TEST(ReconnectSchedule, FailedTriesRepeatEveryHalfSecond) {
+TEST(ReconnectSchedule, FailedTriesRepeatEveryQuarterSecond) {
   ReconnectSchedule schedule;
   schedule.lost(0);
-  std::int64_t t = 500 * kMs;
+  std::int64_t t = 250 * kMs;
   for (int i = 1; i <= 5; ++i) {
     ASSERT_TRUE(schedule.due(t));
     schedule.failed(t);
     EXPECT_EQ(schedule.failures(), std::uint64_t(i));
-    EXPECT_FALSE(schedule.due(t + 499 * kMs));
-    t += 500 * kMs;
+    EXPECT_FALSE(schedule.due(t + 249 * kMs));
+    t += 250 * kMs;
     EXPECT_TRUE(schedule.due(t));
   }
 }
@@ -42,11 +42,11 @@ TEST(ReconnectSchedule, FailedTriesRepeatEveryHalfSecond) {
 TEST(ReconnectSchedule, ALateTryDoesNotBringTheNextForward) {
   ReconnectSchedule schedule;
   schedule.lost(0);
-  // The caller came back 3 s late: one try now, the next half a second on,
-  // not six at once to make up.
+  // The caller came back 3 s late: one try now, the next a quarter second
+  // on, not twelve at once to make up.
   schedule.failed(3500 * kMs);
   EXPECT_FALSE(schedule.due(3600 * kMs));
-  EXPECT_TRUE(schedule.due(4000 * kMs));
+  EXPECT_TRUE(schedule.due(3750 * kMs));
 }
 
 TEST(ReconnectSchedule, SuccessEndsTheWaitUntilTheNextLoss) {
@@ -58,7 +58,7 @@ TEST(ReconnectSchedule, SuccessEndsTheWaitUntilTheNextLoss) {
   EXPECT_FALSE(schedule.due(10'000 * kMs));
   EXPECT_EQ(schedule.failures(), 0u);
   schedule.lost(20'000 * kMs);
-  EXPECT_TRUE(schedule.due(20'500 * kMs));
+  EXPECT_TRUE(schedule.due(20'250 * kMs));
 }
 
 TEST(ReconnectSchedule, IntervalIsConfigurable) {

@@ -4,7 +4,7 @@
 # its error-injection controls (Disconnect, Inject V4L2_BUF_FLAG_ERROR) on,
 # and unloaded at the end, leaving the lab as it was.
 results="v4l2_vivid_yuyv v4l2_vivid_nv12 v4l2_vivid_wrong_size v4l2_vivid_error_buffer
-v4l2_vivid_disconnect v4l2_vivid_reconnect"
+v4l2_vivid_disconnect v4l2_vivid_reconnect v4l2_vivid_reconnect_100"
 fail() {
   for name in $results; do
     echo "RESULT $name: FAIL $1"

@@ -24,6 +24,9 @@
 //                          the camera, which closed it on the loss, reopens it
 //                          by path: frames again, one reconnect counted, the
 //                          sequence going on from before
+//   v4l2_vivid_reconnect_100  the same 100 times in a row: each loss
+//                          reported and frames back, with the time from the
+//                          loss to the first frame after it (median, worst)
 //
 //   camhead_v4l2_vivid_check DEVICE
 #include <algorithm>
@@ -43,6 +46,9 @@
 #include "vm_result.h"
 
 namespace {
+
+// Unplugs in a row (v4l2_vivid_reconnect_100).
+constexpr int kUnplugs = 100;
 
 using namespace camhead::hal::camera;
 using camhead::base::monotonic_ns;
@@ -151,6 +157,58 @@ void check_format(const std::string &device, camhead::base::PixelFormat format,
                    run.mark + "; " + status.detail);
 }
 
+// The camera unplugged (vivid's Disconnect) and back `count` times: each
+// time the loss is reported and frames come again, with the time from the
+// loss to the first frame after it (the camera closes the node on the loss,
+// vivid registers it again at once, and the camera reopens it on its
+// reconnect schedule).
+void unplugged_again_and_again(CameraSource &camera, const std::string &device, int count) {
+  std::vector<double> back_ms;
+  std::string problem;
+  const std::uint64_t reconnects_before = camera.status().reconnects;
+  for (int k = 0; k < count && problem.empty(); ++k) {
+    problem = press(device, kVividDisconnect);
+    bool lost = false;
+    const std::int64_t give_up = monotonic_ns() + 5'000'000'000;
+    while (problem.empty() && !lost && monotonic_ns() < give_up) {
+      CapturedFrame frame;
+      const CaptureResult result = camera.wait_frame(200ms, frame);
+      if (result == CaptureResult::frame)
+        camera.release(frame);
+      lost = result == CaptureResult::disconnected;
+    }
+    if (problem.empty() && !lost)
+      problem = "unplug " + std::to_string(k + 1) + ": no loss reported within 5 s";
+    const std::int64_t lost_at = monotonic_ns();
+    bool back = false;
+    while (problem.empty() && !back && monotonic_ns() - lost_at < 10'000'000'000) {
+      CapturedFrame frame;
+      if (camera.wait_frame(200ms, frame) == CaptureResult::frame) {
+        camera.release(frame);
+        back = true;
+      }
+    }
+    if (problem.empty() && !back)
+      problem = "unplug " + std::to_string(k + 1) +
+                ": no frame within 10 s of the loss: " + camera.status().detail;
+    if (back)
+      back_ms.push_back(double(monotonic_ns() - lost_at) * 1e-6);
+  }
+  const CameraStatus status = camera.status();
+  if (problem.empty() && status.reconnects - reconnects_before != std::uint64_t(count))
+    problem = std::to_string(status.reconnects - reconnects_before) + " reconnects counted for " +
+              std::to_string(count) + " unplugs";
+  std::string detail = problem;
+  if (!back_ms.empty()) {
+    std::sort(back_ms.begin(), back_ms.end());
+    detail += (detail.empty() ? "" : "; ") + std::to_string(back_ms.size()) + " of " +
+              std::to_string(count) + " back, first frame after the loss: median " +
+              std::to_string(int(back_ms[back_ms.size() / 2])) + " ms, worst " +
+              std::to_string(int(back_ms.back())) + " ms; " + status.detail;
+  }
+  print_result("v4l2_vivid_reconnect_100", problem.empty() && int(back_ms.size()) == count, detail);
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -253,5 +311,9 @@ int main(int argc, char **argv) {
   print_result("v4l2_vivid_reconnect", problem.empty(),
                problem + (problem.empty() ? "" : "; ") + "sequence " + std::to_string(before) +
                    " then " + std::to_string(again.last_sequence) + "; " + status.detail);
+  if (problem.empty())
+    unplugged_again_and_again(*camera, device, kUnplugs);
+  else
+    print_result("v4l2_vivid_reconnect_100", false, "not run: " + problem);
   return 0;
 }

@@ -262,7 +262,7 @@ bool V4l2Camera::reconnect(std::int64_t deadline) {
   if (!stream) {
     schedule_.failed(base::monotonic_ns());
     const std::lock_guard lock(mutex_);
-    status_.detail = name_ + ": disconnected, reopening every 0.5 s; last try: " + error;
+    status_.detail = name_ + ": disconnected, reopening every 0.25 s; last try: " + error;
     return false;
   }
   schedule_.succeeded();
@@ -287,7 +287,7 @@ void V4l2Camera::lose(const std::string &reason) {
   current_ = {};
   broken_.clear();
   status_.connected = false;
-  status_.detail = name_ + ": disconnected (" + reason + "); reopening every 0.5 s";
+  status_.detail = name_ + ": disconnected (" + reason + "); reopening every 0.25 s";
 }
 
 void V4l2Camera::read_exposure(const CaptureStream &stream, std::int64_t now) {

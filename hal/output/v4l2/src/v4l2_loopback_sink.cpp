@@ -186,7 +186,7 @@ private:
     if (v4l2::is_device_gone(err) || err == EIO) {
       file_.close();
       schedule_.lost(base::monotonic_ns());
-      return fail("write: " + errno_text(err) + "; disconnected, reopening every 0.5 s");
+      return fail("write: " + errno_text(err) + "; disconnected, reopening every 0.25 s");
     }
     return fail("write: " + errno_text(err));
   }
@@ -205,7 +205,7 @@ private:
     const std::lock_guard lock(mutex_);
     if (!opened) {
       schedule_.failed(now);
-      status_.detail = name() + ": disconnected, reopening every 0.5 s; last try: " + error;
+      status_.detail = name() + ": disconnected, reopening every 0.25 s; last try: " + error;
       return false;
     }
     schedule_.succeeded();

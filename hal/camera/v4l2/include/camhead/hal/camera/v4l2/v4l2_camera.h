@@ -30,7 +30,7 @@
 // Loss: an ioctl answering ENODEV (unplugged), or poll() reporting an error
 // or a hang-up, closes the device and wait_frame() answers `disconnected`.
 // Later calls reopen it by the name it was opened with (a /dev/v4l/by-id
-// link finds a webcam on another /dev/videoN after a replug) every 0.5 s,
+// link finds a webcam on another /dev/videoN after a replug) every 0.25 s,
 // with the same format, and count a reconnect when it is back. Frames the
 // caller still holds stay readable until released. A reopen is a handful of
 // ioctls, which on UVC can take longer than a short timeout.

@@ -22,7 +22,7 @@
 // capture_ns is therefore not passed on.
 //
 // Loss: a write failing with ENODEV (the module unloaded) marks the sink
-// disconnected; submit() then tries to reopen the device every 0.5 s, and
+// disconnected; submit() then tries to reopen the device every 0.25 s, and
 // skips the frames until it is back.
 //
 // close(): writes one black frame, so that readers are left with a neutral
