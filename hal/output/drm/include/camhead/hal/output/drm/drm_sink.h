@@ -43,10 +43,10 @@
 // mode is set again and frames resume. A card that went away itself
 // (ENODEV: unplugged, its driver unbound) is closed at once and opened
 // again every 0.5 s as at open, by the name it was opened by: a driver's
-// name finds it under whatever number it comes back as (tested in the
-// hardware lab: 100 unplugs, each back within 0.47 s of the card's return),
-// a path only at that path. One that comes back taking frames of another
-// layout is refused until a restart.
+// name finds it under whatever number it comes back as, a path only at that
+// path (the hardware lab unplugs and replugs a card 100 times: each back
+// within about half a second, bench/RESULTS.md). One that comes back taking
+// frames of another layout is refused until a restart.
 //
 // close(), and the destructor of a sink never closed: the saved CRTC state is
 // put back (the framebuffer that was there, so the text console or the
