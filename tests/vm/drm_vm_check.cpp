@@ -53,6 +53,7 @@
 
 #include "camhead/base/monotonic_clock.h"
 #include "camhead/hal/output/drm/drm_sink.h"
+#include "sysfs_attribute.h"
 #include "vm_result.h"
 
 namespace {
@@ -63,6 +64,7 @@ using camhead::hal::output::DrmSinkOptions;
 using camhead::hal::output::FrameSink;
 using camhead::hal::output::open_drm_sink;
 using camhead::vm::print_result;
+using camhead::vm::write_attribute;
 
 constexpr int kModeWidth = 1280;
 constexpr int kModeHeight = 800;
@@ -276,15 +278,6 @@ std::string send_frame(FrameSink &sink, int seed) {
   return {};
 }
 
-bool write_sysfs(const std::string &path, const char *value) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-  if (fd < 0)
-    return false;
-  const bool written = ::write(fd, value, std::strlen(value)) == ssize_t(std::strlen(value));
-  ::close(fd);
-  return written;
-}
-
 // The card unplugged and back `cycles` times: the VGA removed from the PCI
 // bus and found again by a rescan, which unbinds bochs and binds it anew
 // as an unplug and a replug do (the card comes back under another number
@@ -315,8 +308,10 @@ void card_unplugged(int cycles) {
                 ": no frame before the unplug: " + sink->status().detail;
       break;
     }
-    if (!write_sysfs(std::string(device) + "/remove", "1")) {
-      problem = std::string("cannot write ") + device + "/remove: " + std::strerror(errno);
+    try {
+      write_attribute(std::string(device) + "/remove", "1");
+    } catch (const std::exception &e) {
+      problem = e.what();
       break;
     }
     // Frames at 25 a second while it is away: skipped, and said.
@@ -331,8 +326,10 @@ void card_unplugged(int cycles) {
           "cycle " + std::to_string(cycle) + ": the sink did not see the card go: " + gone_detail;
       break;
     }
-    if (!write_sysfs("/sys/bus/pci/rescan", "1")) {
-      problem = std::string("cannot write /sys/bus/pci/rescan: ") + std::strerror(errno);
+    try {
+      write_attribute("/sys/bus/pci/rescan", "1");
+    } catch (const std::exception &e) {
+      problem = e.what();
       break;
     }
     const std::int64_t rescanned = camhead::base::monotonic_ns();

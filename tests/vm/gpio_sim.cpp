@@ -2,12 +2,13 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include "sysfs_attribute.h"
 
 namespace camhead::vm {
 namespace {
@@ -25,27 +26,6 @@ void make_directory(const std::string &path) {
 }
 
 } // namespace
-
-void write_attribute(const std::string &path, const std::string &text) {
-  // One write() call: configfs and sysfs attributes take the value in one go.
-  std::ofstream file(path);
-  if (!file) {
-    fail("cannot open", path);
-  }
-  file << text << std::flush;
-  if (!file) {
-    fail("cannot write '" + text + "' to", path);
-  }
-}
-
-std::string read_attribute(const std::string &path) {
-  std::ifstream file(path);
-  std::string line;
-  if (!file || !std::getline(file, line)) {
-    fail("cannot read", path);
-  }
-  return line;
-}
 
 GpioSim::GpioSim(const std::string &name, unsigned num_lines, const std::string &label)
     : config_dir_(std::string(kConfigRoot) + "/" + name), bank_dir_(config_dir_ + "/bank0"),

@@ -44,9 +44,4 @@ private:
   std::string config_dir_, bank_dir_, sysfs_dir_, chip_name_, label_;
 };
 
-// Writes `text` to a sysfs or configfs attribute; throws naming the file.
-void write_attribute(const std::string &path, const std::string &text);
-// The attribute's first line, without the newline.
-[[nodiscard]] std::string read_attribute(const std::string &path);
-
 } // namespace camhead::vm

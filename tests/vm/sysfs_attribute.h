@@ -1,0 +1,16 @@
+// sysfs and configfs attributes, as the lab's checks set up their devices
+// (gpio-sim's banks, a PCI device's remove and rescan). Errors throw
+// std::runtime_error naming the file and errno.
+#pragma once
+
+#include <string>
+
+namespace camhead::vm {
+
+// Writes `text` to the attribute in one write(), as sysfs and configfs
+// take a value.
+void write_attribute(const std::string &path, const std::string &text);
+// The attribute's first line, without the newline.
+[[nodiscard]] std::string read_attribute(const std::string &path);
+
+} // namespace camhead::vm
