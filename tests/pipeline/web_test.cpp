@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "config/board.h"
+#include "counting_new.h"
 #include "tracking/calibration_views.h"
 #include "web/camera_views.h"
 #include "web/latest_value.h"
@@ -235,8 +236,12 @@ TEST(PreviewImage, TheRegionViewDarkensWhatWasNotTraced) {
     PreviewImage preview = preview_for(f);
     const int step = preview_factor(width);
     const std::vector<renderer::PixelRect> region = {{64, 32, 256, 97}, {8, 97, 40, 120}};
+    // Both into storage made before (preview_image.h): nothing allocated.
+    camhead::test::counting_new::start([] { return 0; });
     shrink_to_preview(f, grey, preview);
     shade_outside(region, f.width, f.height, preview);
+    camhead::test::counting_new::stop();
+    EXPECT_EQ(camhead::test::counting_new::count(0), 0u) << width << " wide";
     int kept = 0;
     for (int py = 0; py < preview.height; ++py)
       for (int px = 0; px < preview.width; ++px) {
