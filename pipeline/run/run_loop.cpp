@@ -33,8 +33,8 @@
 #include "rig_setup.h"
 #include "run_paths.h"
 #include "run_status.h"
-#include "service/service_heartbeat.h"
 #include "setup_reloader.h"
+#include "status_thread.h"
 #include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
 #include "tracking/pose_trace.h"
@@ -91,7 +91,6 @@ private:
   void capture_loop();
   void render_loop();
   void output_loop();
-  void status_loop();
   // A reload's setup of `board`, its renderer made and prepared.
   std::unique_ptr<FrameSetup> build_setup(const Board &board) const;
   // Every pipeline and buffer `setup`'s renderer uses, made for the camera's
@@ -568,44 +567,6 @@ void Pipeline::prepare(FrameSetup &setup) const {
   setup.renderer->prepare(first, camera_->format(), formats);
 }
 
-// The status line (run_status.h), a line a second, and what systemd hears
-// (RunOptions::service).
-void Pipeline::status_loop() {
-  if (status_)
-    status_->start();
-  ServiceHeartbeat heartbeat(options_.service, counters_);
-  std::uint64_t last_in = 0, last_out = 0;
-  std::int64_t last_ns = start_ns_;
-  std::string refused; // the last reload's refusal, until one is taken
-  // Awake often, so that a run ends as soon as its last frame is out (it
-  // lingered up to a second), and a line a second.
-  while (!should_stop() && !(captured_.closed() && ready_slots_.closed())) {
-    std::this_thread::sleep_for(20ms);
-    const std::int64_t now = base::monotonic_ns();
-    heartbeat.tick(now);
-    if (status_ && reloader_)
-      if (std::optional<std::string> note = reloader_->take_note()) {
-        // A refusal stays in systemd's status until a reload is taken:
-        // `systemctl status` must show why the board on disk is not the
-        // one running.
-        refused = note->rfind("reload refused", 0) == 0 ? *note : std::string();
-        status_->note(*note);
-      }
-    if (!status_ || now - last_ns < 1'000'000'000)
-      continue;
-    const std::uint64_t in = counters_.frames_in, out = counters_.frames_out;
-    status_->second(now, double(now - last_ns) * 1e-9, in - last_in, out - last_out);
-    heartbeat.status(refused.empty() ? status_->last_line()
-                                     : status_->last_line() + "; " + refused);
-    last_in = in;
-    last_out = out;
-    last_ns = now;
-  }
-  heartbeat.stopping();
-  if (status_)
-    status_->end();
-}
-
 RunSummary Pipeline::run() {
   start_ns_ = base::monotonic_ns();
   std::vector<std::thread> threads;
@@ -639,7 +600,9 @@ RunSummary Pipeline::run() {
       thread.join();
     throw;
   }
-  status_loop();
+  run_status_thread(
+      status_ ? &*status_ : nullptr, options_.service, counters_, reloader_ ? &*reloader_ : nullptr,
+      start_ns_, [this] { return should_stop() || (captured_.closed() && ready_slots_.closed()); });
   stopping_ = true;
   for (std::thread &thread : threads)
     thread.join();
