@@ -119,6 +119,9 @@ private:
   // What frames are rendered with (the scene, the static pose, the render
   // settings, the renderer): the render thread's, replaced by reloads.
   std::unique_ptr<FrameSetup> setup_;
+  // The outputs asked for, their paths checked beside the inputs' before
+  // anything slow is opened (a simulated camera's warm-up takes seconds).
+  std::vector<OutputSpec> output_specs_;
   SetupHandover handover_;
   LensHub lens_;
   std::unique_ptr<CameraSource> camera_;
@@ -161,12 +164,19 @@ private:
   std::unique_ptr<web::OperatorPage> page_;
 };
 
-std::vector<OutputSpec> output_specs(const RunOptions &options) {
+// The run's outputs, and every path it reads or writes checked.
+std::vector<OutputSpec> checked_outputs(const RunOptions &options, const renderer::Scene &scene) {
   std::vector<OutputSpec> specs =
       parse_output_uris(options.outputs.empty() ? options.board.outputs : options.outputs);
   if (specs.empty())
     throw OutputError(options.board.file.string(),
                       "no output: give --output URI, or \"outputs\" in the board");
+  std::vector<RunPath> paths = run_inputs(options.board, scene);
+  for (RunPath &output : run_outputs(specs))
+    paths.push_back(std::move(output));
+  if (options.stats_file)
+    paths.push_back({"--record-stats", *options.stats_file, true, false});
+  check_run_paths(paths);
   return specs;
 }
 
@@ -183,14 +193,17 @@ const Board &checked_board(const RunOptions &options) {
   return options.board;
 }
 
-// Everything that can fail is opened here, before the first frame, and the
-// outputs last (a file output is only created once the rest stands). The
+// Everything that can fail is opened here, before the first frame: the
+// outputs' names and every path checked first (before a simulated camera's
+// warm-up), the outputs opened last (a file output is only created once the
+// rest stands). The
 // camera comes before the renderer: a take's size is checked against the
 // board before anything of that size is allocated.
 Pipeline::Pipeline(const RunOptions &options)
     : options_(options), board_(checked_board(options)), setup_(load_frame_setup(board_)),
-      lens_(board_), camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_,
-                                         options.threads, {options.frames, options.duration_s})),
+      output_specs_(checked_outputs(options, setup_->scene)), lens_(board_),
+      camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_, options.threads,
+                          {options.frames, options.duration_s})),
       markers_(open_marker_source(board_, camera_->format(), setup_->base_camera, lens_,
                                   offline_take(board_),
                                   lens_wait_ns(offline_take(board_), camera_fps(*camera_)))),
@@ -202,14 +215,7 @@ Pipeline::Pipeline(const RunOptions &options)
                                    setup_->scene, options.threads);
   executor_name_ = setup_->renderer->executor();
   record_fields_ = {json_string(executor_name_), json_string(pose_source_name())};
-  const std::vector<OutputSpec> specs = output_specs(options);
-  std::vector<RunPath> paths = run_inputs(board_, setup_->scene);
-  for (RunPath &output : run_outputs(specs))
-    paths.push_back(std::move(output));
-  if (options.stats_file)
-    paths.push_back({"--record-stats", *options.stats_file, true, false});
-  check_run_paths(paths);
-  for (const OutputSpec &spec : specs) {
+  for (const OutputSpec &spec : output_specs_) {
     sinks_.push_back(open_output(spec, board_.camera->width, board_.camera->height, fps_));
     file_sinks_.push_back(spec.kind == OutputKind::y4m || spec.kind == OutputKind::png);
   }

@@ -247,12 +247,17 @@ TEST_F(RunLoop, RefusesABoardWithoutCameraOrOutput) {
   EXPECT_THROW(run_pipeline(options), std::runtime_error);
   options.board = load_board(resolve_board("sim"));
   options.board.outputs.clear();
+  // Refused before the camera opens: the simulated one would first render
+  // its world's loop (seconds) and say so.
+  testing::internal::CaptureStderr();
   try {
     run_pipeline(options);
     ADD_FAILURE() << "ran without an output";
   } catch (const std::runtime_error &e) {
     EXPECT_NE(std::string(e.what()).find("no output"), std::string::npos) << e.what();
   }
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said.find("simulated camera"), std::string::npos) << said;
 }
 
 } // namespace
