@@ -68,15 +68,6 @@ inline cv::Matx33d supersampled(const CameraModel &camera) {
           0.0,           1.0};
 }
 
-// The light on the sensor at `size` (video-range luma, not yet quantized)
-// from a supersampled canvas of 0..255 values (128 where nothing was drawn).
-inline cv::Mat expose(const cv::Mat &canvas, cv::Size size) {
-  cv::Mat wide, small;
-  canvas.convertTo(wide, CV_32F, 190.0 / 255.0, 30.0);
-  cv::resize(wide, small, size, 0.0, 0.0, cv::INTER_AREA);
-  return small;
-}
-
 // One frame of that light: Gaussian sensor noise of `noise` digital
 // numbers, quantized to 8 bits.
 inline cv::Mat frame(const cv::Mat &light, double noise, std::mt19937 &random) {
@@ -89,38 +80,97 @@ inline cv::Mat frame(const cv::Mat &light, double noise, std::mt19937 &random) {
   return out;
 }
 
-// A supersampled `canvas` drawn through the ideal pinhole of `camera`'s
-// matrix, seen through its distortion: each pixel takes the ideal picture at
-// its preimage (OpenCV's undistortPoints, converged), the map computed at
-// the picture's pixels and spread over the canvas's linearly.
-inline cv::Mat distorted(const cv::Mat &canvas, const CameraModel &camera) {
-  if (std::all_of(camera.distortion.begin(), camera.distortion.end(),
-                  [](double k) { return k == 0.0; }))
-    return canvas;
-  const cv::Size size(canvas.cols / kSupersample, canvas.rows / kSupersample);
-  std::vector<cv::Point2d> pixels;
-  for (int v = 0; v < size.height; ++v)
-    for (int u = 0; u < size.width; ++u)
-      pixels.emplace_back(u, v);
-  const cv::Matx33d k(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
-  std::vector<cv::Point2d> ideal;
-  cv::undistortPoints(pixels, ideal, k,
-                      std::vector<double>(camera.distortion.begin(), camera.distortion.end()),
-                      cv::noArray(), k,
-                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-14));
-  cv::Mat map_x(size, CV_32F), map_y(size, CV_32F);
+// The light on the sensor at `size` (video-range luma, not yet quantized)
+// from a supersampled `canvas` of 0..255 values (128 where nothing was
+// drawn) made through the ideal pinhole of `camera`'s matrix, seen through
+// its distortion: each pixel takes the ideal picture at its preimage
+// (OpenCV's undistortPoints, converged), the map computed at the picture's
+// pixels and spread over the canvas's linearly, and each pixel's block of
+// the canvas averaged. Done a band of rows at a time, so that the canvas-
+// sized maps and floats (hundreds of MB at 960x540) are never made whole.
+inline cv::Mat expose(const cv::Mat &canvas, const CameraModel &camera, cv::Size size) {
+  const bool ideal = std::all_of(camera.distortion.begin(), camera.distortion.end(),
+                                 [](double k) { return k == 0.0; });
   const double s = kSupersample, o = (s - 1.0) / 2.0;
-  for (int v = 0; v < size.height; ++v)
-    for (int u = 0; u < size.width; ++u) {
-      const cv::Point2d &p = ideal[std::size_t(v) * size.width + u];
-      map_x.at<float>(v, u) = float(s * p.x + o);
-      map_y.at<float>(v, u) = float(s * p.y + o);
+  // Where each picture pixel's centre comes from on the canvas.
+  cv::Mat from_x(size, CV_32F), from_y(size, CV_32F);
+  if (!ideal) {
+    std::vector<cv::Point2d> pixels;
+    for (int v = 0; v < size.height; ++v)
+      for (int u = 0; u < size.width; ++u)
+        pixels.emplace_back(u, v);
+    const cv::Matx33d k(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
+    std::vector<cv::Point2d> preimage;
+    cv::undistortPoints(
+        pixels, preimage, k,
+        std::vector<double>(camera.distortion.begin(), camera.distortion.end()), cv::noArray(), k,
+        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-14));
+    for (int v = 0; v < size.height; ++v)
+      for (int u = 0; u < size.width; ++u) {
+        const cv::Point2d &p = preimage[std::size_t(v) * size.width + u];
+        from_x.at<float>(v, u) = float(s * p.x + o);
+        from_y.at<float>(v, u) = float(s * p.y + o);
+      }
+  }
+  // Canvas sample `i` between picture pixels `i0` and `i0 + 1`, at `f`:
+  // cv::resize's INTER_LINEAR in its float arithmetic, clamped at the edges.
+  const auto between = [](int i, int n, int &i0, float &f) {
+    f = float((i + 0.5) / kSupersample - 0.5);
+    i0 = int(std::floor(f));
+    f -= float(i0);
+    if (i0 < 0) {
+      i0 = 0;
+      f = 0.0f;
+    } else if (i0 >= n - 1) {
+      i0 = n - 1;
+      f = 0.0f;
     }
-  cv::Mat big_x, big_y, out;
-  cv::resize(map_x, big_x, canvas.size(), 0.0, 0.0, cv::INTER_LINEAR);
-  cv::resize(map_y, big_y, canvas.size(), 0.0, 0.0, cv::INTER_LINEAR);
-  cv::remap(canvas, out, big_x, big_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
-  return out;
+  };
+  struct Column {
+    int c0, c1;
+    float f;
+  };
+  std::vector<Column> columns(std::size_t(canvas.cols));
+  for (int x = 0; x < canvas.cols; ++x) {
+    Column &c = columns[std::size_t(x)];
+    between(x, size.width, c.c0, c.f);
+    c.c1 = std::min(c.c0 + 1, size.width - 1);
+  }
+  constexpr int kBandRows = 16; // picture rows per band
+  cv::Mat light(size, CV_32F);
+  cv::Mat map_x, map_y, seen, wide, small;
+  for (int v0 = 0; v0 < size.height; v0 += kBandRows) {
+    const int rows = std::min(kBandRows, size.height - v0);
+    const cv::Range canvas_rows(v0 * kSupersample, (v0 + rows) * kSupersample);
+    if (ideal) {
+      seen = canvas.rowRange(canvas_rows);
+    } else {
+      map_x.create(canvas_rows.size(), canvas.cols, CV_32F);
+      map_y.create(canvas_rows.size(), canvas.cols, CV_32F);
+      for (int y = canvas_rows.start; y < canvas_rows.end; ++y) {
+        int r0;
+        float fy;
+        between(y, size.height, r0, fy);
+        const int r1 = std::min(r0 + 1, size.height - 1);
+        const auto mix = [&](const cv::Mat &m, float *out) {
+          const float *top = m.ptr<float>(r0), *bottom = m.ptr<float>(r1);
+          for (int x = 0; x < canvas.cols; ++x) {
+            const Column &c = columns[std::size_t(x)];
+            const float upper = top[c.c0] * (1.0f - c.f) + top[c.c1] * c.f;
+            const float lower = bottom[c.c0] * (1.0f - c.f) + bottom[c.c1] * c.f;
+            out[x] = upper * (1.0f - fy) + lower * fy;
+          }
+        };
+        mix(from_x, map_x.ptr<float>(y - canvas_rows.start));
+        mix(from_y, map_y.ptr<float>(y - canvas_rows.start));
+      }
+      cv::remap(canvas, seen, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
+    }
+    seen.convertTo(wide, CV_32F, 190.0 / 255.0, 30.0);
+    cv::resize(wide, small, cv::Size(size.width, rows), 0.0, 0.0, cv::INTER_AREA);
+    small.copyTo(light.rowRange(v0, v0 + rows));
+  }
+  return light;
 }
 
 // A ChArUco board where marker_board.h puts it, seen from `pose` through
@@ -151,7 +201,7 @@ inline cv::Mat charuco_view(const MarkerBoard &board, const CameraModel &camera,
   cv::warpPerspective(page, canvas, cv::Mat(h),
                       cv::Size(size.width * kSupersample, size.height * kSupersample),
                       cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
-  return expose(distorted(canvas, camera), size);
+  return expose(canvas, camera, size);
 }
 
 // A marker field's markers, each with a white quiet zone of one cell around
@@ -205,7 +255,11 @@ inline cv::Mat field_view(const MarkerBoard &board, const CameraModel &camera,
                            255);
       }
   }
-  return expose(canvas, size);
+  // The field's pictures are the ideal pinhole's (its markers projected
+  // without distortion).
+  CameraModel pinhole = camera;
+  std::fill(pinhole.distortion.begin(), pinhole.distortion.end(), 0.0);
+  return expose(canvas, pinhole, size);
 }
 
 } // namespace camhead::pipeline::test
