@@ -27,9 +27,10 @@
 //   drm_destructor_restores  a sink destroyed without close() also puts the
 //                            console back
 //   drm_card_back            the card unplugged and back (PCI remove and
-//                            rescan), 100 times: frames skipped and said
-//                            while it is away, and going out again once it
-//                            is back, each time (by the driver's name)
+//                            rescan), 100 times (10 under the sanitizers):
+//                            frames skipped and said while it is away, and
+//                            going out again once it is back, each time (by
+//                            the driver's name)
 //
 //   camhead_drm_vm_check CONTROL_TTY
 #include <algorithm>
@@ -70,8 +71,9 @@ constexpr int kModeWidth = 1280;
 constexpr int kModeHeight = 800;
 constexpr int kFrameWidth = 640;
 constexpr int kFrameHeight = 480;
-// Unplugs and replugs of the card (drm_card_back).
-constexpr int kCardCycles = 100;
+// Unplugs and replugs of the card (drm_card_back): 100, or 10 in the
+// sanitizer build (tests/vm/CMakeLists.txt).
+constexpr int kCardCycles = CAMHEAD_LAB_FAULT_CYCLES;
 
 // The test pattern of frame `seed` at pixel (x, y) of the frame; every pixel
 // differs from its neighbours in each direction and from the pixel 256 away,
