@@ -147,7 +147,7 @@ private:
     };
     if (type == "sim") {
       d.object({"type"}, with_common({"fps", "samples", "cache_mb", "disconnect_after_frames",
-                                      "disconnect_s", "disconnect_silently", "path"}));
+                                      "disconnect_s", "disconnect_silently", "path", "realtime"}));
       SimCameraConfig sim;
       if (d.has("path"))
         sim.path = d.at("path").path();
@@ -164,6 +164,8 @@ private:
         sim.disconnect_s = d.at("disconnect_s").number(Range::within(0.0, 3600.0));
       if (d.has("disconnect_silently"))
         sim.disconnect_silently = d.at("disconnect_silently").boolean();
+      if (d.has("realtime"))
+        sim.realtime = d.at("realtime").boolean();
       camera.kind = sim;
     } else if (type == "file") {
       d.object({"type", "path"}, with_common({"loop", "realtime"}));

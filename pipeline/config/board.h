@@ -128,6 +128,9 @@ struct SimCameraConfig {
   // A camera path (pipeline/tracking/pose_trace.h) the camera moves along;
   // else it stands at the board's pose.
   std::optional<std::filesystem::path> path;
+  // false: every frame rendered and taken, stamped 1 / fps apart, however
+  // long each takes (a reproducible run, as a file camera's offline take).
+  bool realtime = true;
 };
 
 // A Y4M video or PNG sequence played as the camera (hal/camera/file).

@@ -214,13 +214,15 @@ std::unique_ptr<CameraSource> open_sim_camera(const SimCameraConfig &sim,
   options.disconnect_after_frames = sim.disconnect_after_frames;
   options.disconnect_s = sim.disconnect_s;
   options.disconnect_silently = sim.disconnect_silently;
+  options.realtime = sim.realtime;
   const std::uint32_t samples = sim.samples;
   auto cache = std::make_shared<WorldPictures>(std::size_t(sim.cache_mb) << 20);
   std::optional<PoseTrace> path;
   if (sim.path)
     path = load_pose_trace(*sim.path);
-  // A world the tracker moves does not loop.
-  const std::optional<long> loop = lens.tracks_pose() && !path
+  // A world the tracker moves does not loop; one not filmed in real time
+  // has no clock to keep, so nothing to render ahead.
+  const std::optional<long> loop = !sim.realtime || (lens.tracks_pose() && !path)
                                        ? std::nullopt
                                        : world_loop_frames(sim, format, truth, path, *cache);
   if (loop) {

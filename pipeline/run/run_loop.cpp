@@ -180,10 +180,14 @@ std::vector<OutputSpec> checked_outputs(const RunOptions &options, const rendere
   return specs;
 }
 
-// A take played as fast as it is composited: every frame is rendered.
+// A take played as fast as it is composited (a file, or the simulated
+// world, not in real time): every frame is rendered.
 bool offline_take(const Board &board) {
-  const auto *file = std::get_if<FileCameraConfig>(&board.camera->kind);
-  return file != nullptr && !file->realtime;
+  if (const auto *file = std::get_if<FileCameraConfig>(&board.camera->kind))
+    return !file->realtime;
+  if (const auto *sim = std::get_if<SimCameraConfig>(&board.camera->kind))
+    return !sim->realtime;
+  return false;
 }
 
 const Board &checked_board(const RunOptions &options) {

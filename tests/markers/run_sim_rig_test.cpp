@@ -80,7 +80,8 @@ TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) 
       "name": "moving", "lens": {"sources": [{"type": "trace", "file": ")" +
                                                    lens.string() + R"(", "loop": true}]},
       "camera": {"type": "sim", "width": 640, "height": 360, "fps": 10, "samples": 16,
-                 "cache_mb": 0, "path": ")" + path.string() +
+                 "cache_mb": 0, "realtime": false, "path": ")" +
+                                                   path.string() +
                                                    R"("},
       "scene": ")" + scene.string() + R"(",
       "pose": {"type": "marker", "board": ")" + markers.string() +
@@ -117,7 +118,10 @@ TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) 
   }
   std::printf("%d frames with the pose from the markers: registration within %.3f px\n", found,
               worst);
-  EXPECT_GE(found, 7) << "the board was found in too few frames";
+  // Filmed not in real time, so every frame waits for its tracker: under
+  // load too, each one's pose is the markers' (in real time a late tracker
+  // sends the frame out with the predicted pose: run_markers_test's).
+  EXPECT_EQ(found, 10) << "frames whose pose did not come from the markers";
 }
 
 // The moving simulated rig (board/sim-moving.json) films the board its
