@@ -4,12 +4,12 @@
 #include <cerrno>
 #include <cstring>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
 
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/hal/output/sink_base.h"
 #include "drm_display.h"
 
 namespace camhead::hal::output {
@@ -20,25 +20,20 @@ using namespace drm;
 constexpr std::int64_t kConnectorCheckNs = 500'000'000;
 constexpr std::uint32_t kDisconnected = 2; // DRM_MODE_DISCONNECTED
 
-class DrmSink final : public FrameSink {
+class DrmSink final : public SinkBase {
 public:
   DrmSink(const DrmSinkOptions &options, OpenedDisplay opened)
-      : options_(options), display_(std::move(opened.display)), format_(opened.format),
+      : SinkBase(opened.format), options_(options), display_(std::move(opened.display)),
         full_frame_(opened.full_frame),
         name_("drm " + display_->label + " " + display_->connector_name),
         next_check_ns_(base::monotonic_ns() + kConnectorCheckNs) {
-    status_.connected = true;
-    status_.detail = name() + ": ready, " + opened.summary;
+    ready("ready, " + opened.summary);
   }
 
   std::string name() const override { return name_; }
-  base::VideoFormat format() const override { return format_; }
 
-  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
-    if (closed_)
-      return fail("submit after close");
-    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
-      return fail(wrong);
+private:
+  bool send(std::span<const std::uint8_t> frame, std::int64_t) override {
     const std::int64_t now = base::monotonic_ns();
     if (live_ && now >= next_check_ns_)
       check_connector(now);
@@ -50,37 +45,19 @@ public:
         stop_flipping(error);
     }
     copy_into(back(), frame);
-    if (!present())
-      return false;
-    const std::lock_guard lock(mutex_);
-    ++status_.frames;
-    return true;
+    return present();
   }
 
-  bool close() override {
-    if (closed_)
-      return fail("closed twice");
-    closed_ = true;
+  bool finish() override {
     std::string error;
-    const bool restored = display_ == nullptr || display_->teardown(error);
-    const std::lock_guard lock(mutex_);
-    status_.connected = false;
-    if (!restored) {
-      ++status_.errors;
-      status_.detail = name() + ": closed, but " + error;
-      return false;
-    }
-    status_.detail = name() + ": closed after " + std::to_string(status_.frames) +
-                     " frames; the picture that was there before is back";
-    return true;
+    if (display_ != nullptr && !display_->teardown(error))
+      return fail("closed, but " + error);
+    return closed("closed after " + std::to_string(frames()) +
+                  " frames; the picture that was there before is back");
   }
 
-  SinkStatus status() const override {
-    const std::lock_guard lock(mutex_);
-    return status_;
-  }
+  bool writable() const override { return live_; }
 
-private:
   DumbBuffer &back() { return display_->buffers[static_cast<std::size_t>(1 - display_->front)]; }
 
   // The frame into the buffer's frame area: one copy where the frame is the
@@ -90,9 +67,9 @@ private:
       std::memcpy(buffer.bytes().data(), frame.data(), frame.size());
       return;
     }
-    const std::size_t row = base::row_bytes(format_);
+    const std::size_t row = base::row_bytes(format());
     const Placement at = display_->placement;
-    for (int y = 0; y < format_.height; ++y)
+    for (int y = 0; y < format().height; ++y)
       std::memcpy(buffer.bytes().data() + static_cast<std::size_t>(y + at.y) * buffer.pitch() +
                       static_cast<std::size_t>(at.x) * 4,
                   frame.data() + static_cast<std::size_t>(y) * row, row);
@@ -126,11 +103,8 @@ private:
   // Page flips do not work here: SETCRTC per frame from now on.
   void stop_flipping(const std::string &why) {
     display_->page_flips = false;
-    const std::lock_guard lock(mutex_);
     note_ = "; " + why + ", so each frame is set with SETCRTC (blocking, may tear)";
-    status_.detail = name() + ": " + why +
-                     "; presenting each frame with SETCRTC from now on "
-                     "(blocking, may tear)";
+    say(why + "; presenting each frame with SETCRTC from now on (blocking, may tear)");
   }
 
   // A presentation failed: the device gone, master taken, the connector
@@ -205,7 +179,7 @@ private:
           (void)card_gone("DRM_IOCTL_SET_MASTER: " + errno_text(err));
           return false;
         }
-        return still_dark("DRM master is still held by another program (" + errno_text(err) + ")");
+        return away("DRM master is still held by another program (" + errno_text(err) + ")");
       }
       d.master = true;
     }
@@ -215,63 +189,39 @@ private:
       return false;
     }
     if (!state)
-      return still_dark(error);
+      return away(error);
     if (state->connection == kDisconnected)
-      return still_dark("connector unplugged; waiting for it, every 0.5 s");
+      return away("connector unplugged; waiting for it, every 0.5 s");
     if (!d.show(d.front, error))
-      return still_dark("connector back, but " + error);
+      return away("connector back, but " + error);
     live_ = true;
-    const std::lock_guard lock(mutex_);
-    status_.connected = true;
-    status_.detail = name() + ": back, " + describe_mode(d.mode_summary) + note_;
+    ready("back, " + describe_mode(d.mode_summary) + note_);
     return true;
   }
 
   bool reopen() {
     try {
       OpenedDisplay opened = open_display(options_);
-      if (opened.format != format_)
-        return still_dark("the card is back, but takes " + base::describe(opened.format) +
-                          " frames, not " + base::describe(format_) + ": restart to use it");
+      if (opened.format != format())
+        return away("the card is back, but takes " + base::describe(opened.format) +
+                    " frames, not " + base::describe(format()) + ": restart to use it");
       display_ = std::move(opened.display);
     } catch (const DrmSinkError &e) {
-      return still_dark(std::string("the card is gone; looking for it every 0.5 s: ") + e.what());
+      return away(std::string("the card is gone; looking for it every 0.5 s: ") + e.what());
     }
     live_ = true;
-    const std::lock_guard lock(mutex_);
-    status_.connected = true;
-    status_.detail = name() + ": the card is back (" + display_->label + "), " +
-                     describe_mode(display_->mode_summary) + note_;
+    ready("the card is back (" + display_->label + "), " + describe_mode(display_->mode_summary) +
+          note_);
     return true;
-  }
-
-  bool still_dark(const std::string &why) {
-    const std::lock_guard lock(mutex_);
-    status_.connected = false;
-    status_.detail = name() + ": " + why;
-    return false;
-  }
-
-  bool fail(const std::string &reason) {
-    const std::lock_guard lock(mutex_);
-    ++status_.errors;
-    status_.detail = name() + ": " + reason;
-    status_.connected = live_ && !closed_;
-    return false;
   }
 
   const DrmSinkOptions options_;
   std::unique_ptr<Display> display_; // null while the card is gone
-  const base::VideoFormat format_;
   const bool full_frame_;
   const std::string name_;
   std::int64_t next_check_ns_;
   bool live_ = true;
-  bool closed_ = false;
   std::string note_; // what changed since open, for later status lines
-
-  mutable std::mutex mutex_; // guards status_
-  SinkStatus status_;
 };
 
 } // namespace

@@ -1,11 +1,11 @@
 // The PNG sequence sink; see file_sink.h.
-#include <mutex>
 #include <optional>
 #include <system_error>
 #include <vector>
 
 #include "camhead/base/partial_file.h"
 #include "camhead/hal/output/file/file_sink.h"
+#include "camhead/hal/output/sink_base.h"
 #include "camhead/hal/video_file/frame_pattern.h"
 #include "camhead/hal/video_file/png_frame.h"
 
@@ -14,24 +14,19 @@ namespace {
 
 using video_file::FramePattern;
 
-class PngSequenceSink final : public FrameSink {
+class PngSequenceSink final : public SinkBase {
 public:
   PngSequenceSink(FramePattern pattern, base::VideoFormat format)
-      : pattern_(std::move(pattern)), format_(format) {
-    status_.connected = true;
-    status_.detail = name() + ": ready";
+      : SinkBase(format), pattern_(std::move(pattern)) {
+    ready("ready");
   }
 
   std::string name() const override { return "png " + pattern_.text(); }
-  base::VideoFormat format() const override { return format_; }
 
-  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
-    if (closed_)
-      return fail("submit after close");
-    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
-      return fail(wrong);
-    if (!video_file::encode_png_rgb(frame, format_.width, format_.height, base::row_bytes(format_),
-                                    png_))
+private:
+  bool send(std::span<const std::uint8_t> frame, std::int64_t) override {
+    const base::VideoFormat f = format();
+    if (!video_file::encode_png_rgb(frame, f.width, f.height, base::row_bytes(f), png_))
       return fail("cannot encode PNG (out of memory)");
     const std::filesystem::path target = pattern_.path(next_);
     std::string error;
@@ -39,42 +34,14 @@ public:
     if (!file || !file->write(png_, error) || !file->commit(false, error))
       return fail(target.string() + ": " + error);
     ++next_;
-    const std::lock_guard lock(mutex_);
-    ++status_.frames;
     return true;
   }
 
-  bool close() override {
-    if (closed_)
-      return fail("closed twice");
-    closed_ = true;
-    const std::lock_guard lock(mutex_);
-    status_.connected = false;
-    status_.detail = name() + ": " + std::to_string(status_.frames) + " frames written";
-    return true;
-  }
-
-  SinkStatus status() const override {
-    const std::lock_guard lock(mutex_);
-    return status_;
-  }
-
-private:
-  bool fail(const std::string &reason) {
-    const std::lock_guard lock(mutex_);
-    ++status_.errors;
-    status_.detail = name() + ": " + reason;
-    return false;
-  }
+  bool finish() override { return closed(std::to_string(frames()) + " frames written"); }
 
   const FramePattern pattern_;
-  const base::VideoFormat format_;
   std::vector<std::uint8_t> png_;
   std::uint64_t next_ = 0; // frames written, and the next file's number
-  bool closed_ = false;
-
-  mutable std::mutex mutex_;
-  SinkStatus status_;
 };
 
 } // namespace

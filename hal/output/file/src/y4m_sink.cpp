@@ -1,12 +1,12 @@
 // The Y4M file sink; see file_sink.h.
 #include <algorithm>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <vector>
 
 #include "camhead/base/partial_file.h"
 #include "camhead/hal/output/file/file_sink.h"
+#include "camhead/hal/output/sink_base.h"
 #include "camhead/hal/video_file/y4m_header.h"
 #include "camhead/hal/video_file/y4m_planes.h"
 
@@ -15,26 +15,23 @@ namespace {
 
 constexpr std::string_view kFrameLine = "FRAME\n";
 
-class Y4mSink final : public FrameSink {
+class Y4mSink final : public SinkBase {
 public:
   Y4mSink(std::string name, base::VideoFormat format, base::PartialFile file)
-      : name_(std::move(name)), format_(format), file_(std::move(file)),
+      : SinkBase(format), name_(std::move(name)), file_(std::move(file)),
         record_(kFrameLine.size() + video_file::y4m_plane_bytes(format)) {
     // Every frame record is "FRAME\n" and the planes: one write each.
     std::copy(kFrameLine.begin(), kFrameLine.end(), record_.begin());
-    status_.connected = true;
-    status_.detail = this->name() + ": writing " + file_.partial_path().string();
+    ready("writing " + file_.partial_path().string());
   }
 
   std::string name() const override { return "file " + name_; }
-  base::VideoFormat format() const override { return format_; }
 
-  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
-    if (closed_ || broken_)
-      return fail(closed_ ? "submit after close" : "the file is broken, no more frames");
-    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
-      return fail(wrong);
-    video_file::frame_to_y4m_planes(frame, format_, std::span(record_).subspan(kFrameLine.size()));
+private:
+  bool send(std::span<const std::uint8_t> frame, std::int64_t) override {
+    if (broken_)
+      return fail("the file is broken, no more frames");
+    video_file::frame_to_y4m_planes(frame, format(), std::span(record_).subspan(kFrameLine.size()));
     const off_t good = file_.size();
     std::string error;
     if (!file_.write(record_, error)) {
@@ -45,21 +42,16 @@ public:
       }
       return fail(error);
     }
-    const std::lock_guard lock(mutex_);
-    ++status_.frames;
     return true;
   }
 
-  bool close() override {
-    if (closed_)
-      return fail("closed twice");
-    closed_ = true;
+  bool finish() override {
     std::string error;
     if (broken_) {
       file_.discard();
       return fail("not written: an earlier write failed and could not be undone");
     }
-    if (status().frames == 0) {
+    if (frames() == 0) {
       // A run stopped before its first frame (Ctrl-C while it started)
       // must not replace a take with a file no player opens.
       file_.discard();
@@ -67,36 +59,15 @@ public:
     }
     if (!file_.commit(true, error))
       return fail(error);
-    const std::lock_guard lock(mutex_);
-    status_.connected = false;
-    status_.detail = name() + ": " + std::to_string(status_.frames) + " frames written";
-    return true;
+    return closed(std::to_string(frames()) + " frames written");
   }
 
-  SinkStatus status() const override {
-    const std::lock_guard lock(mutex_);
-    return status_;
-  }
-
-private:
-  bool fail(const std::string &reason) {
-    const std::lock_guard lock(mutex_);
-    ++status_.errors;
-    status_.detail = name() + ": " + reason;
-    if (closed_ || broken_)
-      status_.connected = false;
-    return false;
-  }
+  bool writable() const override { return !broken_; }
 
   const std::string name_;
-  const base::VideoFormat format_;
   base::PartialFile file_;
   std::vector<std::uint8_t> record_;
-  bool closed_ = false;
   bool broken_ = false;
-
-  mutable std::mutex mutex_;
-  SinkStatus status_;
 };
 
 } // namespace

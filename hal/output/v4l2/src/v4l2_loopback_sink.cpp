@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -11,6 +10,7 @@
 #include <unistd.h>
 
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/hal/output/sink_base.h"
 #include "camhead/hal/v4l2/device_file.h"
 #include "camhead/hal/v4l2/pixel_formats.h"
 #include "camhead/hal/v4l2/reconnect_schedule.h"
@@ -119,56 +119,37 @@ void fill_black(std::span<std::uint8_t> frame, const base::VideoFormat &format) 
   std::fill(frame.begin() + static_cast<std::ptrdiff_t>(luma), frame.end(), std::uint8_t{128});
 }
 
-class V4l2LoopbackSink final : public FrameSink {
+class V4l2LoopbackSink final : public SinkBase {
 public:
   V4l2LoopbackSink(std::string device, base::VideoFormat asked, double fps, OpenedDevice opened)
-      : device_(std::move(device)), asked_(asked), fps_(fps), format_(opened.format),
+      : SinkBase(opened.format), device_(std::move(device)), asked_(asked), fps_(fps),
         file_(std::move(opened.file)) {
-    status_.connected = true;
-    status_.detail = name() + ": ready, " + opened.summary;
+    ready("ready, " + opened.summary);
   }
 
   std::string name() const override { return "v4l2 " + device_; }
-  base::VideoFormat format() const override { return format_; }
-
-  bool submit(std::span<const std::uint8_t> frame, std::int64_t) override {
-    if (closed_)
-      return fail("submit after close");
-    if (std::string wrong = wrong_frame_size(frame, format_); !wrong.empty())
-      return fail(wrong);
-    if (!file_.is_open() && !reopen())
-      return false; // skipped while it is away; status() says so
-    if (!write_frame(frame))
-      return false;
-    const std::lock_guard lock(mutex_);
-    ++status_.frames;
-    return true;
-  }
-
-  bool close() override {
-    if (closed_)
-      return fail("closed twice");
-    closed_ = true;
-    if (!file_.is_open())
-      return fail("closed while disconnected: nothing left on the device");
-    std::vector<std::uint8_t> black(base::frame_bytes(format_));
-    fill_black(black, format_);
-    const bool written = write_frame(black);
-    file_.close();
-    const std::lock_guard lock(mutex_);
-    status_.connected = false;
-    if (written)
-      status_.detail = name() + ": closed after " + std::to_string(status_.frames) +
-                       " frames, left showing black";
-    return written;
-  }
-
-  SinkStatus status() const override {
-    const std::lock_guard lock(mutex_);
-    return status_;
-  }
 
 private:
+  bool send(std::span<const std::uint8_t> frame, std::int64_t) override {
+    if (!file_.is_open() && !reopen())
+      return false; // skipped while it is away; status() says so
+    return write_frame(frame);
+  }
+
+  bool finish() override {
+    if (!file_.is_open())
+      return fail("closed while disconnected: nothing left on the device");
+    std::vector<std::uint8_t> black(base::frame_bytes(format()));
+    fill_black(black, format());
+    const bool written = write_frame(black);
+    file_.close();
+    if (!written)
+      return false;
+    return closed("closed after " + std::to_string(frames()) + " frames, left showing black");
+  }
+
+  bool writable() const override { return file_.is_open(); }
+
   // One write() is one frame to v4l2loopback: never split, never resumed.
   bool write_frame(std::span<const std::uint8_t> frame) {
     ssize_t n = 0;
@@ -197,42 +178,26 @@ private:
       return false;
     std::string error;
     std::optional<OpenedDevice> opened = open_output(device_, asked_, fps_, error);
-    if (opened && opened->format != format_) {
+    if (opened && opened->format != format()) {
       error = "it is back but takes " + base::describe(opened->format) + ", not " +
-              base::describe(format_);
+              base::describe(format());
       opened.reset();
     }
-    const std::lock_guard lock(mutex_);
     if (!opened) {
       schedule_.failed(now);
-      status_.detail = name() + ": disconnected, reopening every 0.25 s; last try: " + error;
-      return false;
+      return away("disconnected, reopening every 0.25 s; last try: " + error);
     }
     schedule_.succeeded();
     file_ = std::move(opened->file);
-    status_.connected = true;
-    status_.detail = name() + ": reconnected, " + opened->summary;
+    ready("reconnected, " + opened->summary);
     return true;
-  }
-
-  bool fail(const std::string &reason) {
-    const std::lock_guard lock(mutex_);
-    ++status_.errors;
-    status_.detail = name() + ": " + reason;
-    status_.connected = file_.is_open() && !closed_;
-    return false;
   }
 
   const std::string device_;
   const base::VideoFormat asked_;
   const double fps_;
-  const base::VideoFormat format_;
   v4l2::DeviceFile file_;
   v4l2::ReconnectSchedule schedule_;
-  bool closed_ = false;
-
-  mutable std::mutex mutex_; // guards status_
-  SinkStatus status_;
 };
 
 } // namespace

@@ -12,7 +12,8 @@
 // display needs (its scanout memory is read while the next frame renders).
 // A repeat of the last frame is the same buffer submitted again: no copy.
 // As hal/camera, a backend never throws once opened: a write that fails, or
-// a device that went away, is a status, and the frame loop goes on.
+// a device that went away, is a status, and the frame loop goes on. The
+// backends share that state machine (sink_base.h).
 //
 // Thread safety: one thread calls submit() and close(); status() from any
 // thread.
