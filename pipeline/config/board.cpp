@@ -55,6 +55,33 @@ std::string device_name(const JsonValue &v) {
   return name;
 }
 
+// One kind of a board's backends (a camera, a lens source): the name its
+// "type" gives, and the reader of its object, which checks its own keys.
+template <typename Variant> struct Kind {
+  std::string_view type;
+  Variant (*read)(const JsonValue &d);
+};
+
+// "a, b, c or d": the types a table knows, for messages.
+template <typename Variant, std::size_t N> std::string type_names(const Kind<Variant> (&kinds)[N]) {
+  std::string names;
+  for (std::size_t i = 0; i < N; ++i)
+    names += std::string(i == 0 ? "" : i + 1 == N ? " or " : ", ") + std::string(kinds[i].type);
+  return names;
+}
+
+// The object `d` read by the kind its "type" names.
+template <typename Variant, std::size_t N>
+Variant read_kind(const JsonValue &d, const Kind<Variant> (&kinds)[N], std::string_view what) {
+  const std::string names = type_names(kinds);
+  const JsonValue type_value = d.at("type", names);
+  const std::string type = type_value.string();
+  for (const Kind<Variant> &kind : kinds)
+    if (kind.type == type)
+      return kind.read(d);
+  type_value.fail("unknown " + std::string(what) + " \"" + type + "\" (" + names + ")");
+}
+
 std::array<double, 3> vec3(const JsonValue &v) {
   const std::vector<double> xs = v.numbers(3, Range::within(-1e7, 1e7));
   return {xs[0], xs[1], xs[2]};
@@ -136,66 +163,76 @@ private:
     return http;
   }
 
+  // The keys every camera takes beside its type's own.
+  static Keys camera_keys(Keys own) {
+    for (const std::string_view k : {"format", "width", "height", "sensor_width_mm"})
+      own.push_back(k);
+    return own;
+  }
+
+  static CameraKind read_sim_camera(const JsonValue &d) {
+    d.object({"type"}, camera_keys({"fps", "samples", "cache_mb", "disconnect_after_frames",
+                                    "disconnect_s", "disconnect_silently", "path", "realtime"}));
+    SimCameraConfig sim;
+    if (d.has("path"))
+      sim.path = d.at("path").path();
+    if (d.has("fps"))
+      sim.fps = d.at("fps").number(Range::within(1.0, 240.0));
+    if (d.has("samples"))
+      sim.samples = std::uint32_t(d.at("samples").integer(1, 4096));
+    if (d.has("cache_mb"))
+      sim.cache_mb = std::uint32_t(d.at("cache_mb").integer(0, 65536));
+    if (d.has("disconnect_after_frames"))
+      sim.disconnect_after_frames =
+          std::uint64_t(d.at("disconnect_after_frames").integer(0, 1 << 30));
+    if (d.has("disconnect_s"))
+      sim.disconnect_s = d.at("disconnect_s").number(Range::within(0.0, 3600.0));
+    if (d.has("disconnect_silently"))
+      sim.disconnect_silently = d.at("disconnect_silently").boolean();
+    if (d.has("realtime"))
+      sim.realtime = d.at("realtime").boolean();
+    return sim;
+  }
+
+  static CameraKind read_file_camera(const JsonValue &d) {
+    d.object({"type", "path"}, camera_keys({"loop", "realtime"}));
+    FileCameraConfig file;
+    file.path = d.at("path").path();
+    if (d.has("loop"))
+      file.loop = d.at("loop").boolean();
+    if (d.has("realtime"))
+      file.realtime = d.at("realtime").boolean();
+    return file;
+  }
+
+  static CameraKind read_v4l2_camera(const JsonValue &d) {
+    d.object({"type", "device"}, camera_keys({"fps", "buffers"}));
+    V4l2CameraConfig v4l2;
+    v4l2.device = device_name(d.at("device"));
+    if (d.has("fps"))
+      v4l2.fps = d.at("fps").number(Range::within(0.0, 1000.0));
+    if (d.has("buffers"))
+      v4l2.buffers = int(d.at("buffers").integer(2, 8));
+    return v4l2;
+  }
+
+  static CameraKind read_libcamera_camera(const JsonValue &d) {
+    d.object({"type"}, camera_keys({"camera_id", "buffers"}));
+    LibcameraCameraConfig libcamera;
+    if (d.has("camera_id"))
+      libcamera.camera_id = d.at("camera_id").string();
+    if (d.has("buffers"))
+      libcamera.buffers = int(d.at("buffers").integer(2, 8));
+    return libcamera;
+  }
+
   static CameraConfig read_camera(const JsonValue &d) {
-    const JsonValue type_value = d.at("type", "sim, file, v4l2 or libcamera");
-    const std::string type = type_value.string();
+    static constexpr Kind<CameraKind> kCameras[] = {{"sim", read_sim_camera},
+                                                    {"file", read_file_camera},
+                                                    {"v4l2", read_v4l2_camera},
+                                                    {"libcamera", read_libcamera_camera}};
     CameraConfig camera;
-    const auto with_common = [](Keys own) {
-      for (const std::string_view k : {"format", "width", "height", "sensor_width_mm"})
-        own.push_back(k);
-      return own;
-    };
-    if (type == "sim") {
-      d.object({"type"}, with_common({"fps", "samples", "cache_mb", "disconnect_after_frames",
-                                      "disconnect_s", "disconnect_silently", "path", "realtime"}));
-      SimCameraConfig sim;
-      if (d.has("path"))
-        sim.path = d.at("path").path();
-      if (d.has("fps"))
-        sim.fps = d.at("fps").number(Range::within(1.0, 240.0));
-      if (d.has("samples"))
-        sim.samples = std::uint32_t(d.at("samples").integer(1, 4096));
-      if (d.has("cache_mb"))
-        sim.cache_mb = std::uint32_t(d.at("cache_mb").integer(0, 65536));
-      if (d.has("disconnect_after_frames"))
-        sim.disconnect_after_frames =
-            std::uint64_t(d.at("disconnect_after_frames").integer(0, 1 << 30));
-      if (d.has("disconnect_s"))
-        sim.disconnect_s = d.at("disconnect_s").number(Range::within(0.0, 3600.0));
-      if (d.has("disconnect_silently"))
-        sim.disconnect_silently = d.at("disconnect_silently").boolean();
-      if (d.has("realtime"))
-        sim.realtime = d.at("realtime").boolean();
-      camera.kind = sim;
-    } else if (type == "file") {
-      d.object({"type", "path"}, with_common({"loop", "realtime"}));
-      FileCameraConfig file;
-      file.path = d.at("path").path();
-      if (d.has("loop"))
-        file.loop = d.at("loop").boolean();
-      if (d.has("realtime"))
-        file.realtime = d.at("realtime").boolean();
-      camera.kind = file;
-    } else if (type == "v4l2") {
-      d.object({"type", "device"}, with_common({"fps", "buffers"}));
-      V4l2CameraConfig v4l2;
-      v4l2.device = device_name(d.at("device"));
-      if (d.has("fps"))
-        v4l2.fps = d.at("fps").number(Range::within(0.0, 1000.0));
-      if (d.has("buffers"))
-        v4l2.buffers = int(d.at("buffers").integer(2, 8));
-      camera.kind = v4l2;
-    } else if (type == "libcamera") {
-      d.object({"type"}, with_common({"camera_id", "buffers"}));
-      LibcameraCameraConfig libcamera;
-      if (d.has("camera_id"))
-        libcamera.camera_id = d.at("camera_id").string();
-      if (d.has("buffers"))
-        libcamera.buffers = int(d.at("buffers").integer(2, 8));
-      camera.kind = libcamera;
-    } else {
-      type_value.fail("unknown camera \"" + type + "\" (sim, file, v4l2 or libcamera)");
-    }
+    camera.kind = read_kind(d, kCameras, "camera");
     if (const auto format = d.find("format")) {
       if (std::holds_alternative<FileCameraConfig>(camera.kind))
         format->fail("a file camera's frames are in the file's own format (Y4M 4:2:2 yuyv, "
@@ -364,63 +401,73 @@ private:
     return render;
   }
 
-  static LensSourceConfig read_source(const JsonValue &d) {
-    const JsonValue type_value = d.at("type", "trace, usb, gpio, freed or opentrackio");
-    const std::string type = type_value.string();
-    LensSourceConfig source;
-    if (type == "trace") {
-      d.object({"type", "file"}, {"name", "delay_ms", "loop", "speed", "clock_origin"});
-      TraceSourceConfig trace;
-      trace.file = d.at("file").path();
-      if (const auto clock_origin = d.find("clock_origin")) {
-        const std::string origin = clock_origin->string();
-        if (origin != "start" && origin != "monotonic")
-          clock_origin->fail("must be \"start\" or \"monotonic\", not \"" + origin + "\"");
-        trace.monotonic_origin = origin == "monotonic";
-      }
-      if (d.has("loop"))
-        trace.loop = d.at("loop").boolean();
-      if (d.has("speed"))
-        trace.speed = d.at("speed").number(Range::within(0.01, 100.0));
-      // Time 0 at the machine's boot, played once: over before any run
-      // starts, and every frame would get the profile's rest state.
-      if (trace.monotonic_origin && !trace.loop)
-        d.fail_member("loop", "false with clock_origin \"monotonic\": the trace would start at "
-                              "the machine's boot and be over before the run; loop it, or use "
-                              "clock_origin \"start\"");
-      source.kind = trace;
-    } else if (type == "usb") {
-      d.object({"type", "vendor_id", "product_id"}, {"name", "delay_ms", "serial", "simulate"});
-      UsbSourceConfig usb;
-      usb.vendor_id = usb_id(d.at("vendor_id"));
-      usb.product_id = usb_id(d.at("product_id"));
-      if (d.has("serial"))
-        usb.serial = d.at("serial").string();
-      if (d.has("simulate"))
-        usb.simulate = d.at("simulate").path();
-      source.kind = usb;
-    } else if (type == "gpio") {
-      d.object({"type", "chip", "axes"}, {"name", "delay_ms", "bias", "simulate"});
-      source.kind = read_gpio(d);
-    } else if (type == "freed") {
-      d.object({"type"}, {"name", "delay_ms", "bind", "port", "camera_id"});
-      FreedSourceConfig freed;
-      read_socket(d, freed.bind_address, freed.port);
-      if (d.has("camera_id"))
-        freed.camera_id = std::uint8_t(d.at("camera_id").integer(0, 255));
-      source.kind = freed;
-    } else if (type == "opentrackio") {
-      d.object({"type"}, {"name", "delay_ms", "bind", "port", "multicast_group"});
-      OpenTrackIoSourceConfig otio;
-      read_socket(d, otio.bind_address, otio.port);
-      if (d.has("multicast_group"))
-        otio.multicast_group = d.at("multicast_group").string();
-      source.kind = otio;
-    } else {
-      type_value.fail("unknown lens source \"" + type +
-                      "\" (trace, usb, gpio, freed or opentrackio)");
+  static LensSourceKind read_trace_source(const JsonValue &d) {
+    d.object({"type", "file"}, {"name", "delay_ms", "loop", "speed", "clock_origin"});
+    TraceSourceConfig trace;
+    trace.file = d.at("file").path();
+    if (const auto clock_origin = d.find("clock_origin")) {
+      const std::string origin = clock_origin->string();
+      if (origin != "start" && origin != "monotonic")
+        clock_origin->fail("must be \"start\" or \"monotonic\", not \"" + origin + "\"");
+      trace.monotonic_origin = origin == "monotonic";
     }
-    source.name = d.has("name") ? d.at("name").string() : type;
+    if (d.has("loop"))
+      trace.loop = d.at("loop").boolean();
+    if (d.has("speed"))
+      trace.speed = d.at("speed").number(Range::within(0.01, 100.0));
+    // Time 0 at the machine's boot, played once: over before any run
+    // starts, and every frame would get the profile's rest state.
+    if (trace.monotonic_origin && !trace.loop)
+      d.fail_member("loop", "false with clock_origin \"monotonic\": the trace would start at "
+                            "the machine's boot and be over before the run; loop it, or use "
+                            "clock_origin \"start\"");
+    return trace;
+  }
+
+  static LensSourceKind read_usb_source(const JsonValue &d) {
+    d.object({"type", "vendor_id", "product_id"}, {"name", "delay_ms", "serial", "simulate"});
+    UsbSourceConfig usb;
+    usb.vendor_id = usb_id(d.at("vendor_id"));
+    usb.product_id = usb_id(d.at("product_id"));
+    if (d.has("serial"))
+      usb.serial = d.at("serial").string();
+    if (d.has("simulate"))
+      usb.simulate = d.at("simulate").path();
+    return usb;
+  }
+
+  static LensSourceKind read_gpio_source(const JsonValue &d) {
+    d.object({"type", "chip", "axes"}, {"name", "delay_ms", "bias", "simulate"});
+    return read_gpio(d);
+  }
+
+  static LensSourceKind read_freed_source(const JsonValue &d) {
+    d.object({"type"}, {"name", "delay_ms", "bind", "port", "camera_id"});
+    FreedSourceConfig freed;
+    read_socket(d, freed.bind_address, freed.port);
+    if (d.has("camera_id"))
+      freed.camera_id = std::uint8_t(d.at("camera_id").integer(0, 255));
+    return freed;
+  }
+
+  static LensSourceKind read_opentrackio_source(const JsonValue &d) {
+    d.object({"type"}, {"name", "delay_ms", "bind", "port", "multicast_group"});
+    OpenTrackIoSourceConfig otio;
+    read_socket(d, otio.bind_address, otio.port);
+    if (d.has("multicast_group"))
+      otio.multicast_group = d.at("multicast_group").string();
+    return otio;
+  }
+
+  static LensSourceConfig read_source(const JsonValue &d) {
+    static constexpr Kind<LensSourceKind> kSources[] = {{"trace", read_trace_source},
+                                                        {"usb", read_usb_source},
+                                                        {"gpio", read_gpio_source},
+                                                        {"freed", read_freed_source},
+                                                        {"opentrackio", read_opentrackio_source}};
+    LensSourceConfig source;
+    source.kind = read_kind(d, kSources, "lens source");
+    source.name = d.has("name") ? d.at("name").string() : d.at("type").string();
     if (d.has("delay_ms"))
       source.delay_ms = d.at("delay_ms").number(Range::within(-1000.0, 1000.0));
     return source;

@@ -23,7 +23,7 @@ namespace {
 namespace hl = hal::lens;
 using Axis = TraceCurve::Axis;
 
-std::unique_ptr<hl::LensEncoder> open_trace(const TraceSourceConfig &c) {
+std::unique_ptr<hl::LensEncoder> open_backend(const TraceSourceConfig &c) {
   hl::TraceReplayOptions options;
   options.loop = c.loop;
   options.speed = c.speed;
@@ -32,7 +32,7 @@ std::unique_ptr<hl::LensEncoder> open_trace(const TraceSourceConfig &c) {
   return hl::TraceReplay::open(c.file, options);
 }
 
-std::unique_ptr<hl::LensEncoder> open_usb(const UsbSourceConfig &c) {
+std::unique_ptr<hl::LensEncoder> open_backend(const UsbSourceConfig &c) {
   const hl::UsbLensConfig config{.vid = c.vendor_id, .pid = c.product_id, .serial = c.serial};
   if (!c.simulate)
     return hl::open_usb_lens(config);
@@ -109,7 +109,7 @@ simulated_axis(const hl::LensTrace &trace, Axis axis, const GpioAxisConfig &a) {
   return sim;
 }
 
-std::unique_ptr<hl::LensEncoder> open_gpio(const GpioSourceConfig &c) {
+std::unique_ptr<hl::LensEncoder> open_backend(const GpioSourceConfig &c) {
   if (c.simulate) {
     const hl::LensTrace trace = hl::read_lens_trace(*c.simulate);
     hl::gpio::SimulatedQuadratureConfig config;
@@ -146,12 +146,12 @@ std::unique_ptr<hl::LensEncoder> open_gpio(const GpioSourceConfig &c) {
   return hl::gpio::open_gpio_quadrature(config);
 }
 
-std::unique_ptr<hl::LensEncoder> open_freed(const FreedSourceConfig &c) {
+std::unique_ptr<hl::LensEncoder> open_backend(const FreedSourceConfig &c) {
   return std::make_unique<hl::FreedReceiver>(hl::FreedReceiverConfig{
       .bind_address = c.bind_address, .port = c.port, .camera_id = c.camera_id});
 }
 
-std::unique_ptr<hl::LensEncoder> open_opentrackio(const OpenTrackIoSourceConfig &c) {
+std::unique_ptr<hl::LensEncoder> open_backend(const OpenTrackIoSourceConfig &c) {
   hl::OpenTrackIoReceiverConfig config;
   config.bind_address = c.bind_address;
   config.port = c.port;
@@ -163,21 +163,8 @@ std::unique_ptr<hl::LensEncoder> open_opentrackio(const OpenTrackIoSourceConfig 
 
 std::unique_ptr<hal::lens::LensEncoder> open_lens_source(const LensSourceConfig &source) {
   try {
-    return std::visit(
-        [](const auto &c) -> std::unique_ptr<hl::LensEncoder> {
-          using T = std::decay_t<decltype(c)>;
-          if constexpr (std::is_same_v<T, TraceSourceConfig>)
-            return open_trace(c);
-          else if constexpr (std::is_same_v<T, UsbSourceConfig>)
-            return open_usb(c);
-          else if constexpr (std::is_same_v<T, GpioSourceConfig>)
-            return open_gpio(c);
-          else if constexpr (std::is_same_v<T, FreedSourceConfig>)
-            return open_freed(c);
-          else
-            return open_opentrackio(c);
-        },
-        source.kind);
+    // One open_backend per kind of source: a kind without one does not compile.
+    return std::visit([](const auto &c) { return open_backend(c); }, source.kind);
   } catch (const std::exception &e) {
     throw std::runtime_error("lens source \"" + source.name + "\": " + e.what());
   }

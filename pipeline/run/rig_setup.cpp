@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "camhead/base/config_error.h"
+#include "camhead/base/overloaded.h"
 #include "camhead/base/progress_line.h"
 #include "camhead/hal/camera/file/file_camera.h"
 #include "camhead/hal/camera/libcamera/libcamera_camera.h"
@@ -346,36 +347,44 @@ std::unique_ptr<CameraSource> open_camera(const Board &board, const renderer::Sc
                                           const renderer::FrameCamera &pose, const LensHub &lens,
                                           int threads, const RunLength &length) {
   const CameraConfig &c = *board.camera;
-  base::VideoFormat format;
-  format.pixel = c.format;
-  format.width = c.width;
-  format.height = c.height;
-  if (const auto *sim = std::get_if<SimCameraConfig>(&c.kind))
-    return open_sim_camera(*sim, format, scene, pose, lens, TraceLens::of_board(board), threads,
-                           length);
-  if (const auto *v4l2 = std::get_if<V4l2CameraConfig>(&c.kind))
-    return hal::camera::open_v4l2_camera({.device = v4l2->device,
-                                          .format = c.format,
-                                          .width = c.width,
-                                          .height = c.height,
-                                          .fps = v4l2->fps,
-                                          .buffers = v4l2->buffers,
-                                          .mjpeg = v4l2->mjpeg});
-  if (const auto *libcamera = std::get_if<LibcameraCameraConfig>(&c.kind))
-    return hal::camera::open_libcamera_camera({.camera_id = libcamera->camera_id,
-                                               .format = c.format,
-                                               .width = c.width,
-                                               .height = c.height,
-                                               .buffers = libcamera->buffers});
-  const auto &file = std::get<FileCameraConfig>(c.kind);
-  // The board's size is checked against the take's header before anything
-  // of the take's size is made.
-  return hal::camera::open_file_camera({.path = file.path,
-                                        .loop = file.loop,
-                                        .realtime = file.realtime,
-                                        .fps = 0.0,
-                                        .width = c.width,
-                                        .height = c.height});
+  // One opener per kind of camera: a kind without one does not compile.
+  return std::visit(
+      base::Overloaded{[&](const SimCameraConfig &sim) {
+                         base::VideoFormat format;
+                         format.pixel = c.format;
+                         format.width = c.width;
+                         format.height = c.height;
+                         return open_sim_camera(sim, format, scene, pose, lens,
+                                                TraceLens::of_board(board), threads, length);
+                       },
+                       [&](const V4l2CameraConfig &v4l2) {
+                         return hal::camera::open_v4l2_camera({.device = v4l2.device,
+                                                               .format = c.format,
+                                                               .width = c.width,
+                                                               .height = c.height,
+                                                               .fps = v4l2.fps,
+                                                               .buffers = v4l2.buffers,
+                                                               .mjpeg = v4l2.mjpeg});
+                       },
+                       [&](const LibcameraCameraConfig &libcamera) {
+                         return hal::camera::open_libcamera_camera(
+                             {.camera_id = libcamera.camera_id,
+                              .format = c.format,
+                              .width = c.width,
+                              .height = c.height,
+                              .buffers = libcamera.buffers});
+                       },
+                       [&](const FileCameraConfig &file) {
+                         // The board's size is checked against the take's header before
+                         // anything of the take's size is made.
+                         return hal::camera::open_file_camera({.path = file.path,
+                                                               .loop = file.loop,
+                                                               .realtime = file.realtime,
+                                                               .fps = 0.0,
+                                                               .width = c.width,
+                                                               .height = c.height});
+                       }},
+      c.kind);
 }
 
 std::unique_ptr<hal::output::FrameSink> open_output(const OutputSpec &spec, int width, int height,
