@@ -23,11 +23,18 @@ LensHub::LensHub(const Board &board)
 }
 
 void LensHub::start() {
-  if (!thread_.joinable())
-    thread_ = std::thread([this] {
-      base::name_this_thread("camhead-lens");
-      poll_loop();
-    });
+  if (thread_.joinable())
+    return;
+  // The first poll here, on the caller's thread: a trace played from the
+  // rig's start starts its clock at its first poll, and it must not start
+  // after a camera thread has exposed a frame (under load the lens thread's
+  // first poll can come late, and a frame before a trace's first reading
+  // has no lens state that any wait could give it).
+  poll_all(std::chrono::milliseconds(0));
+  thread_ = std::thread([this] {
+    base::name_this_thread("camhead-lens");
+    poll_loop();
+  });
 }
 
 LensHub::~LensHub() {
@@ -38,20 +45,23 @@ LensHub::~LensHub() {
 
 void LensHub::poll_loop() {
   using namespace std::chrono_literals;
-  while (!stop_) {
-    // The waiting happens outside the lock; a frame asking for its lens
-    // state waits only for the readings to be handed to the tracker.
-    for (std::size_t i = 0; i < channels_.size(); ++i) {
-      LensChannel &channel = channels_[i];
-      channel.poll(channels_.size() == 1 ? 5ms : 1ms);
-      // A source's status is read here, on the thread that polls it.
-      const bool connected = channel.encoder().status().connected;
-      std::lock_guard lock(mutex_);
-      channel.feed();
-      connected_[i] = connected;
-    }
-    polled_ = true;
+  while (!stop_)
+    poll_all(channels_.size() == 1 ? 5ms : 1ms);
+}
+
+void LensHub::poll_all(std::chrono::milliseconds timeout) {
+  // The waiting happens outside the lock; a frame asking for its lens
+  // state waits only for the readings to be handed to the tracker.
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    LensChannel &channel = channels_[i];
+    channel.poll(timeout);
+    // A source's status is read here, on the thread that polls it.
+    const bool connected = channel.encoder().status().connected;
+    std::lock_guard lock(mutex_);
+    channel.feed();
+    connected_[i] = connected;
   }
+  polled_ = true;
 }
 
 LensSnapshot LensHub::state_at(std::int64_t t_ns) const {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <mutex>
 #include <optional>
@@ -86,6 +87,8 @@ public:
 
 private:
   void poll_loop();
+  // Polls every source once, waiting up to `timeout` on each.
+  void poll_all(std::chrono::milliseconds timeout);
 
   // Guards the channels' trackers (feed, state_at) and the status reads; the
   // sources themselves are polled by the lens thread alone.
