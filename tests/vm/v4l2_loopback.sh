@@ -7,7 +7,7 @@
 # exclusive_caps=1 as Chrome needs) and unloaded at the end. Where the build
 # machine had no v4l2loopback source the module is not in the lab and the
 # results skip.
-results="v4l2_loopback_open v4l2_loopback_round_trip v4l2_loopback_close v4l2_loopback_nv12 v4l2_loopback_mjpeg v4l2_loopback_v4l2ctl"
+results="v4l2_loopback_open v4l2_loopback_round_trip v4l2_loopback_close v4l2_loopback_nv12 v4l2_loopback_mjpeg v4l2_loopback_reader_100 v4l2_loopback_v4l2ctl"
 say() {
   for name in $results; do
     echo "RESULT $name: $1"

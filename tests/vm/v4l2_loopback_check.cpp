@@ -20,6 +20,12 @@
 //   v4l2_loopback_mjpeg       MJPEG frames (a webcam's, written raw) are read
 //                             with the camera's mjpeg option and come back
 //                             decoded to rgb24 within JPEG's loss
+//   v4l2_loopback_reader_100  a reader (a video-call program) opens the node,
+//                             takes a frame and closes it, 100 times in a row
+//                             (10 under the sanitizers) while the sink writes
+//                             on: every reader gets a whole frame,
+//                             the sink never fails a frame (median and worst
+//                             time from a reader's open to its first frame)
 //
 //   camhead_v4l2_loopback_check DEVICE
 //   camhead_v4l2_loopback_check --write DEVICE SECONDS
@@ -28,6 +34,7 @@
 //       checks frames a client stored raw, one after another: each must be
 //       one of the numbered frames, whole, the numbers increasing; prints
 //       the RESULT line v4l2_loopback_v4l2ctl
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -57,6 +64,9 @@ using namespace std::chrono_literals;
 
 constexpr int kWidth = 320;
 constexpr int kHeight = 180;
+// Readers in a row (v4l2_loopback_reader_100): 100, or 10 in the sanitizer
+// build (tests/vm/CMakeLists.txt).
+constexpr int kReaders = CAMHEAD_LAB_FAULT_CYCLES;
 
 // Frame k: its number in the first four bytes, then bytes that differ from
 // every neighbour and from frame k - 1.
@@ -292,6 +302,72 @@ int verify(const char *path) {
   return problem.empty() ? 0 : 1;
 }
 
+// Readers come and go while the sink writes on, as video-call programs do
+// with a webcam; "" and the open-to-frame times when every one got a whole
+// frame and the sink failed none.
+std::string readers_come_and_go(const std::string &device, int readers, std::string &figures) {
+  const VideoFormat format{PixelFormat::yuyv, kWidth, kHeight};
+  std::unique_ptr<output::FrameSink> sink;
+  try {
+    sink = output::open_v4l2_loopback_sink(device, format, 25);
+  } catch (const output::V4l2SinkError &e) {
+    return e.what();
+  }
+  std::uint32_t k = 0;
+  if (!write_frame(*sink, k))
+    return "first frame: " + sink->status().detail;
+  std::vector<double> first_ms;
+  for (int reader = 0; reader < readers; ++reader) {
+    std::unique_ptr<camera::CameraSource> camera;
+    const std::int64_t opened = camhead::base::monotonic_ns();
+    try {
+      camera = camera::open_v4l2_camera(
+          camera::V4l2CameraOptions{device, PixelFormat::yuyv, kWidth, kHeight, 0, 4});
+    } catch (const std::exception &e) {
+      return "reader " + std::to_string(reader + 1) + " not let in: " + e.what();
+    }
+    // A frame, then up to 40 ms for the reader, until it has one.
+    camera::CapturedFrame frame;
+    camera::CaptureResult got = camera::CaptureResult::timeout;
+    while (got != camera::CaptureResult::frame &&
+           camhead::base::monotonic_ns() - opened < 2'000'000'000) {
+      if (!write_frame(*sink, ++k))
+        return "frame " + std::to_string(k) + " not written with reader " +
+               std::to_string(reader + 1) + " there: " + sink->status().detail;
+      got = camera->wait_frame(40ms, frame);
+    }
+    if (got != camera::CaptureResult::frame)
+      return "reader " + std::to_string(reader + 1) +
+             " got no frame in 2 s: " + camera->status().detail;
+    first_ms.push_back(double(camhead::base::monotonic_ns() - opened) * 1e-6);
+    const std::uint32_t number = number_of(frame.bytes);
+    std::string problem =
+        number > k ? "a frame numbered " + std::to_string(number) + " before it was written"
+                   : first_difference(frame.bytes, number);
+    camera->release(frame);
+    camera.reset(); // the reader goes away
+    if (!problem.empty())
+      return "reader " + std::to_string(reader + 1) + ": " + problem;
+    // The writer does not notice.
+    if (!write_frame(*sink, ++k))
+      return "frame " + std::to_string(k) + " not written after reader " +
+             std::to_string(reader + 1) + " left: " + sink->status().detail;
+  }
+  const output::SinkStatus status = sink->status();
+  if (status.errors != 0)
+    return std::to_string(status.errors) + " frames failed: " + status.detail;
+  (void)sink->close();
+  std::sort(first_ms.begin(), first_ms.end());
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "%d readers, each a whole frame; open to first frame median %.1f ms, worst "
+                "%.1f ms; the sink wrote %llu frames, none failed",
+                readers, first_ms[first_ms.size() / 2], first_ms.back(),
+                static_cast<unsigned long long>(status.frames));
+  figures = text;
+  return {};
+}
+
 int main(int argc, char **argv) {
   if (argc == 4 && std::string(argv[1]) == "--write")
     return write_for(argv[2], std::atof(argv[3]));
@@ -305,8 +381,9 @@ int main(int argc, char **argv) {
   std::string error;
   Pair pair = open_pair(device, PixelFormat::yuyv, error);
   if (!pair.camera) {
-    for (const char *name : {"v4l2_loopback_open", "v4l2_loopback_round_trip", "v4l2_loopback_nv12",
-                             "v4l2_loopback_close", "v4l2_loopback_mjpeg"})
+    for (const char *name :
+         {"v4l2_loopback_open", "v4l2_loopback_round_trip", "v4l2_loopback_nv12",
+          "v4l2_loopback_close", "v4l2_loopback_mjpeg", "v4l2_loopback_reader_100"})
       print_result(name, false, error);
     return 1;
   }
@@ -365,5 +442,8 @@ int main(int argc, char **argv) {
   nv12 = {};
   const std::string mjpeg = mjpeg_round_trip(device);
   print_result("v4l2_loopback_mjpeg", mjpeg.find("decoded within") != std::string::npos, mjpeg);
+  std::string figures;
+  problem = readers_come_and_go(device, kReaders, figures);
+  print_result("v4l2_loopback_reader_100", problem.empty(), problem.empty() ? figures : problem);
   return 0;
 }
