@@ -33,7 +33,7 @@ export ASAN_OPTIONS=detect_leaks=1
 while read -r check; do
   [ -n "$check" ] || continue
   echo "LAB check $check at $(cut -d' ' -f1 /proc/uptime) s"
-  timeout 120 sh "/checks/$check" </dev/null
+  timeout 240 sh "/checks/$check" </dev/null
   status=$?
   if [ "$status" -ne 0 ]; then
     echo "LAB check $check exited with status $status"

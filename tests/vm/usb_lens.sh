@@ -24,7 +24,7 @@ rate=200
 corrupt=50  # index of the corrupted report in the first connection
 serial=VM0001
 results="usb_absent_at_start usb_enumerates_and_streams usb_counts_match_trajectory
-usb_clock_mapping usb_corrupt_report_malformed usb_unplug_replug"
+usb_clock_mapping usb_corrupt_report_malformed usb_unplug_replug usb_replug_100"
 server=
 checker=
 
@@ -118,5 +118,8 @@ echo "$udc" >"$gadget/UDC" || echo "LAB usb_lens: cannot bind the gadget to $udc
 status=0
 wait "$checker" || status=$?
 checker=
+# Then unplugged and plugged back, again and again, the gadget streaming a
+# burst on each connection.
+camhead_usb_replug_check "$gadget/UDC" "$udc" "$serial" || status=$?
 cleanup
 exit "$status"

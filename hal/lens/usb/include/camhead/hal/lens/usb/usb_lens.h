@@ -49,8 +49,11 @@ struct UsbLensConfig {
   // Readings held between two polls; beyond it the oldest are dropped and
   // counted as lost. 4096 are four seconds at 1 kHz.
   std::size_t queue_capacity = 4096;
-  // How often to enumerate again while no board is connected.
-  std::chrono::milliseconds rescan_interval{1000};
+  // How often to enumerate again while no board is connected: a quarter
+  // second, as the V4L2 camera and output reopen, so that a board plugged
+  // back streams within half a second where no hotplug event comes (no
+  // udevd); a fresh libusb context costs about a millisecond.
+  std::chrono::milliseconds rescan_interval{250};
 };
 
 // "usb 1209:0001", or "usb 1209:0001 serial LE000042": the source's name()
