@@ -29,6 +29,7 @@
 #include "lens_camera.h"
 #include "lens_hub.h"
 #include "output_uri.h"
+#include "pipeline.h"
 #include "placeholder.h"
 #include "rig_setup.h"
 #include "run_paths.h"
@@ -44,260 +45,15 @@ namespace camhead::pipeline {
 namespace {
 
 using namespace std::chrono_literals;
-using hal::camera::CameraSource;
 using hal::camera::CapturedFrame;
 using hal::camera::CaptureResult;
 using hal::output::FrameSink;
 
-// One composite on its way to the outputs: a buffer per sink.
-struct Slot {
-  std::vector<std::vector<std::uint8_t>> images;
-  FrameRecord record;
-  // The pixels traced, for the operator page's region view (room for the
-  // most a region holds, reserved once; kept only with a page).
-  std::vector<renderer::PixelRect> region;
-};
-
-// A camera frame and when the camera handed it over. Dropped on any path,
-// it gives the camera its buffer back (frame_lease.h).
-struct Delivered {
-  hal::camera::FrameLease frame;
-  std::int64_t at_ns = 0;
-};
-
 // A camera without a frame for this long (or four frame intervals, if
 // longer) counts as lost, whatever it says.
 constexpr std::int64_t kCameraSilentNs = 1'000'000'000;
-constexpr int kSlots = 3; // frames between render and output
-// How long a frame waits for the lens state of its mid-exposure while the
-// source's readings are still coming: a live frame at most half its
-// interval (the latency it adds), a take composited offline (nothing live
-// waits on it) at most this long.
-constexpr std::int64_t kOfflineLensWaitNs = 1'000'000'000;
-std::int64_t lens_wait_ns(bool lossless, double fps) {
-  return lossless ? kOfflineLensWaitNs : std::llround(0.5e9 / fps);
-}
 
-class Pipeline {
-public:
-  explicit Pipeline(const RunOptions &options);
-  ~Pipeline();
-  Pipeline(const Pipeline &) = delete;
-  Pipeline &operator=(const Pipeline &) = delete;
-  RunSummary run();
-
-private:
-  [[nodiscard]] bool should_stop() const;
-  void capture_loop();
-  void render_loop();
-  void output_loop();
-  // A reload's setup of `board`, its renderer made and prepared.
-  std::unique_ptr<FrameSetup> build_setup(const Board &board) const;
-  // Every pipeline and buffer `setup`'s renderer uses, made for the camera's
-  // and the outputs' formats; the lens as it is now decides the kernels
-  // (its model).
-  void prepare(FrameSetup &setup) const;
-  // The lens at the frame's mid-exposure; waits (bounded) for readings that
-  // are on their way, and says how long in the record.
-  LensSnapshot lens_at(std::int64_t mid_exposure_ns, FrameRecord &record);
-  // The camera's pose at the frame's mid-exposure: a marker pose found in
-  // the frame (waiting for the tracker as long as for the lens, at most),
-  // a tracker's, or the static one.
-  PoseSnapshot pose_at(std::uint64_t sequence, FrameRecord &record);
-  // "static", "freed:NAME", "marker:NAME", "trace:FILE" for the record and
-  // the status line.
-  [[nodiscard]] std::string pose_source_name() const;
-  RunSummary finish();
-  // Sends one frame to every sink: `frame(i)` is sink i's, sent from where
-  // it is (frame_sink.h).
-  template <typename Frame> void send(Frame frame, std::int64_t capture_ns);
-
-  const RunOptions &options_;
-  // The board as the run started: what only a restart changes (the camera,
-  // the outputs, the lens sources, the pose's kind, the executor).
-  const Board &board_;
-  // What frames are rendered with (the scene, the static pose, the render
-  // settings, the renderer): the render thread's, replaced by reloads.
-  std::unique_ptr<FrameSetup> setup_;
-  // The outputs asked for, their paths checked beside the inputs' before
-  // anything slow is opened (a simulated camera's warm-up takes seconds).
-  std::vector<OutputSpec> output_specs_;
-  SetupHandover handover_;
-  LensHub lens_;
-  std::unique_ptr<CameraSource> camera_;
-  // A marker pose's tracker (null for any other pose): fed by the capture
-  // thread, asked by the render thread.
-  std::unique_ptr<MarkerPoseSource> markers_;
-  // A trace pose's camera path.
-  std::optional<PoseTrace> pose_trace_;
-  double fps_ = 25.0;
-  std::vector<std::unique_ptr<FrameSink>> sinks_;
-  std::vector<bool> file_sinks_;           // which sinks are files (their errors: exit 4)
-  std::vector<std::uint64_t> sink_failed_; // output thread: frames each sink did not take
-  std::FILE *stats_ = nullptr;
-  std::string executor_name_;
-  RunRecordFields record_fields_; // the record's fields that every frame shares
-
-  std::vector<Slot> slots_{kSlots};
-  std::vector<std::vector<std::uint8_t>> last_frames_;  // what each sink showed last
-  std::vector<std::vector<std::uint8_t>> placeholders_; // each sink's, made once
-  // Render thread: where a frame's composite goes, its slot's buffers
-  // (named anew each frame: the output thread swaps them).
-  std::vector<renderer::VideoBuffer> targets_;
-  std::string camera_failure_; // capture thread; read after it is joined
-  std::string render_failure_; // render thread: the first; after the join
-  base::BoundedQueue<int> free_slots_{kSlots}, ready_slots_{kSlots};
-  base::BoundedQueue<Delivered> captured_{1};
-  RunCounters counters_;
-  // The reload thread's (RunOptions::reload); none without reloads.
-  std::optional<SetupReloader> reloader_;
-  std::optional<RunStatus> status_; // the status line, unless options_.status is null
-  std::atomic<bool> stopping_{false};
-  // A camera that waits for its consumer (a file not played in real time):
-  // the capture thread waits for the renderer instead of replacing frames.
-  bool lossless_ = false;
-  std::int64_t start_ns_ = 0;
-  std::int64_t last_output_ns_ = 0;           // output thread only
-  std::optional<std::size_t> recording_sink_; // the output whose frames the page records
-  // The operator page, if asked for; last, so that its server (which reads
-  // the members above) stops first.
-  std::unique_ptr<web::OperatorPage> page_;
-};
-
-// The run's outputs, and every path it reads or writes checked.
-std::vector<OutputSpec> checked_outputs(const RunOptions &options, const renderer::Scene &scene) {
-  std::vector<OutputSpec> specs =
-      parse_output_uris(options.outputs.empty() ? options.board.outputs : options.outputs);
-  if (specs.empty())
-    throw OutputError(options.board.file.string(),
-                      "no output: give --output URI, or \"outputs\" in the board");
-  std::vector<RunPath> paths = run_inputs(options.board, scene);
-  for (RunPath &output : run_outputs(specs))
-    paths.push_back(std::move(output));
-  if (options.stats_file)
-    paths.push_back({"--record-stats", *options.stats_file, true, false});
-  check_run_paths(paths);
-  return specs;
-}
-
-// A take played as fast as it is composited (a file, or the simulated
-// world, not in real time): every frame is rendered.
-bool offline_take(const Board &board) {
-  if (const auto *file = std::get_if<FileCameraConfig>(&board.camera->kind))
-    return !file->realtime;
-  if (const auto *sim = std::get_if<SimCameraConfig>(&board.camera->kind))
-    return !sim->realtime;
-  return false;
-}
-
-const Board &checked_board(const RunOptions &options) {
-  if (!options.board.camera)
-    throw std::runtime_error(options.board.file.string() +
-                             ": camera: missing: this board has no camera for `camhead run`");
-  return options.board;
-}
-
-// Everything that can fail is opened here, before the first frame: the
-// outputs' names and every path checked first (before a simulated camera's
-// warm-up), the outputs opened last (a file output is only created once the
-// rest stands). The
-// camera comes before the renderer: a take's size is checked against the
-// board before anything of that size is allocated.
-Pipeline::Pipeline(const RunOptions &options)
-    : options_(options), board_(checked_board(options)), setup_(load_frame_setup(board_)),
-      output_specs_(checked_outputs(options, setup_->scene)), lens_(board_),
-      camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_, options.threads,
-                          {options.frames, options.duration_s})),
-      markers_(open_marker_source(board_, camera_->format(), setup_->base_camera, lens_,
-                                  offline_take(board_),
-                                  lens_wait_ns(offline_take(board_), camera_fps(*camera_)))),
-      pose_trace_(board_.pose && board_.pose->type == PoseType::trace
-                      ? std::optional<PoseTrace>(load_pose_trace(board_.pose->file))
-                      : std::nullopt),
-      fps_(camera_fps(*camera_)) {
-  setup_->renderer = make_renderer(board_, options.executor.value_or(board_.render.executor),
-                                   setup_->scene, options.threads);
-  executor_name_ = setup_->renderer->executor();
-  record_fields_ = {json_string(executor_name_), json_string(pose_source_name())};
-  for (const OutputSpec &spec : output_specs_) {
-    sinks_.push_back(open_output(spec, board_.camera->width, board_.camera->height, fps_));
-    file_sinks_.push_back(spec.kind == OutputKind::y4m || spec.kind == OutputKind::png);
-  }
-  if (options.stats_file) {
-    // A stream of records, written as the run goes (for `tail -f`, or into
-    // a FIFO or /dev/stdout on purpose), not a partial file renamed at the
-    // end as camhead's other files are.
-    stats_ = std::fopen(options.stats_file->c_str(), "w");
-    if (stats_ == nullptr)
-      throw StatsFileError(options.stats_file->string() +
-                           ": cannot be written: " + std::strerror(errno));
-  }
-  // Every pipeline and buffer the loop uses, made now.
-  prepare(*setup_);
-  for (Slot &slot : slots_) {
-    for (const auto &sink : sinks_)
-      slot.images.emplace_back(base::frame_bytes(sink->format()));
-    if (options.web)
-      slot.region.reserve(renderer::max_region_rects(std::uint32_t(board_.camera->width),
-                                                     std::uint32_t(board_.camera->height)));
-  }
-  for (const auto &sink : sinks_) {
-    last_frames_.emplace_back(base::frame_bytes(sink->format()));
-    fill_placeholder(sink->format(), placeholders_.emplace_back(last_frames_.back().size()));
-  }
-  targets_.resize(sinks_.size());
-  sink_failed_.assign(sinks_.size(), 0);
-  for (int i = 0; i < kSlots; ++i)
-    (void)free_slots_.push(i);
-  lossless_ = offline_take(board_);
-  if (options.status != nullptr)
-    status_.emplace(options.status, *camera_, lens_, sinks_, counters_, executor_name_,
-                    pose_source_name());
-  if (options.reload != nullptr)
-    reloader_.emplace(
-        *options.reload, options.service, handover_, lens_,
-        [this](const Board &board) { return build_setup(board); },
-        [this] { return should_stop(); });
-  if (options.web) {
-    // The page's takes are Y4M, of the first output in a format it takes.
-    for (std::size_t i = 0; i < sinks_.size() && !recording_sink_; ++i)
-      if (const base::PixelFormat f = sinks_[i]->format().pixel;
-          f == base::PixelFormat::yuyv || f == base::PixelFormat::nv12)
-        recording_sink_ = i;
-    const bool marker_pose = board_.pose && board_.pose->type == PoseType::marker;
-    page_ = std::make_unique<web::OperatorPage>(
-        *options.web,
-        web::RunView{.board_name = board_.name,
-                     .board_file = board_.file.string(),
-                     .board_description = board_.description,
-                     .camera = *camera_,
-                     .lens = lens_,
-                     .sinks = sinks_,
-                     .counters = counters_,
-                     .executor = executor_name_,
-                     .pose_source = pose_source_name(),
-                     .fps = fps_,
-                     .reloader = reloader_ ? &*reloader_ : nullptr,
-                     .record_format = recording_sink_
-                                          ? std::optional(sinks_[*recording_sink_]->format())
-                                          : std::nullopt,
-                     .marker_board = marker_pose ? board_.pose->file : std::filesystem::path(),
-                     .lens_profile = board_.lens.profile.value_or(std::filesystem::path())},
-        sinks_.front()->format(), camera_->format());
-    if (options.status != nullptr)
-      std::fprintf(options.status, "camhead run: operator page at %s\n", page_->url().c_str());
-  }
-  if (markers_)
-    markers_->start();
-  // Last: a trace played from the rig's start starts with the run, not a
-  // set-up's time (a renderer's kernel compiles) before its first frame.
-  lens_.start();
-}
-
-Pipeline::~Pipeline() {
-  if (stats_ != nullptr)
-    std::fclose(stats_); // a run that failed: what was recorded stays
-}
+} // namespace
 
 bool Pipeline::should_stop() const {
   if (stopping_ || (options_.stop != nullptr && *options_.stop))
@@ -560,23 +316,6 @@ void Pipeline::output_loop() {
   }
 }
 
-std::unique_ptr<FrameSetup> Pipeline::build_setup(const Board &board) const {
-  std::unique_ptr<FrameSetup> setup = load_frame_setup(board);
-  setup->renderer = make_renderer(setup->board, options_.executor.value_or(board_.render.executor),
-                                  setup->scene, options_.threads);
-  prepare(*setup);
-  return setup;
-}
-
-void Pipeline::prepare(FrameSetup &setup) const {
-  std::vector<base::VideoFormat> formats;
-  for (const auto &sink : sinks_)
-    formats.push_back(sink->format());
-  renderer::FrameRequest first = setup_request(setup, options_.influence_region);
-  first.camera = lens_camera(setup.base_camera, lens_.state_at(base::monotonic_ns()).state);
-  setup.renderer->prepare(first, camera_->format(), formats);
-}
-
 RunSummary Pipeline::run() {
   start_ns_ = base::monotonic_ns();
   std::vector<std::thread> threads;
@@ -662,8 +401,6 @@ RunSummary Pipeline::finish() {
   summary.executor = executor_name_;
   return summary;
 }
-
-} // namespace
 
 RunSummary run_pipeline(const RunOptions &options) {
   Pipeline pipeline(options);

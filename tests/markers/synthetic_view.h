@@ -112,30 +112,6 @@ inline cv::Mat expose(const cv::Mat &canvas, const CameraModel &camera, cv::Size
         from_y.at<float>(v, u) = float(s * p.y + o);
       }
   }
-  // Canvas sample `i` between picture pixels `i0` and `i0 + 1`, at `f`:
-  // cv::resize's INTER_LINEAR in its float arithmetic, clamped at the edges.
-  const auto between = [](int i, int n, int &i0, float &f) {
-    f = float((i + 0.5) / kSupersample - 0.5);
-    i0 = int(std::floor(f));
-    f -= float(i0);
-    if (i0 < 0) {
-      i0 = 0;
-      f = 0.0f;
-    } else if (i0 >= n - 1) {
-      i0 = n - 1;
-      f = 0.0f;
-    }
-  };
-  struct Column {
-    int c0, c1;
-    float f;
-  };
-  std::vector<Column> columns(std::size_t(canvas.cols));
-  for (int x = 0; x < canvas.cols; ++x) {
-    Column &c = columns[std::size_t(x)];
-    between(x, size.width, c.c0, c.f);
-    c.c1 = std::min(c.c0 + 1, size.width - 1);
-  }
   constexpr int kBandRows = 16; // picture rows per band
   cv::Mat light(size, CV_32F);
   cv::Mat map_x, map_y, seen, wide, small;
@@ -145,26 +121,17 @@ inline cv::Mat expose(const cv::Mat &canvas, const CameraModel &camera, cv::Size
     if (ideal) {
       seen = canvas.rowRange(canvas_rows);
     } else {
-      map_x.create(canvas_rows.size(), canvas.cols, CV_32F);
-      map_y.create(canvas_rows.size(), canvas.cols, CV_32F);
-      for (int y = canvas_rows.start; y < canvas_rows.end; ++y) {
-        int r0;
-        float fy;
-        between(y, size.height, r0, fy);
-        const int r1 = std::min(r0 + 1, size.height - 1);
-        const auto mix = [&](const cv::Mat &m, float *out) {
-          const float *top = m.ptr<float>(r0), *bottom = m.ptr<float>(r1);
-          for (int x = 0; x < canvas.cols; ++x) {
-            const Column &c = columns[std::size_t(x)];
-            const float upper = top[c.c0] * (1.0f - c.f) + top[c.c1] * c.f;
-            const float lower = bottom[c.c0] * (1.0f - c.f) + bottom[c.c1] * c.f;
-            out[x] = upper * (1.0f - fy) + lower * fy;
-          }
-        };
-        mix(from_x, map_x.ptr<float>(y - canvas_rows.start));
-        mix(from_y, map_y.ptr<float>(y - canvas_rows.start));
-      }
-      cv::remap(canvas, seen, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(128));
+      // The maps spread over the band's canvas rows by cv::resize (OpenCV's,
+      // fast in any build) of the picture rows around the band: the band's
+      // rows are exactly those of the whole map spread at once, since each
+      // takes the same two picture rows at the same weights.
+      const int lo = std::max(v0 - 1, 0), hi = std::min(v0 + rows + 1, size.height);
+      const cv::Size spread(canvas.cols, (hi - lo) * kSupersample);
+      const cv::Range band((v0 - lo) * kSupersample, (v0 - lo + rows) * kSupersample);
+      cv::resize(from_x.rowRange(lo, hi), map_x, spread, 0.0, 0.0, cv::INTER_LINEAR);
+      cv::resize(from_y.rowRange(lo, hi), map_y, spread, 0.0, 0.0, cv::INTER_LINEAR);
+      cv::remap(canvas, seen, map_x.rowRange(band), map_y.rowRange(band), cv::INTER_LINEAR,
+                cv::BORDER_CONSTANT, cv::Scalar(128));
     }
     seen.convertTo(wide, CV_32F, 190.0 / 255.0, 30.0);
     cv::resize(wide, small, cv::Size(size.width, rows), 0.0, 0.0, cv::INTER_AREA);
