@@ -1,19 +1,12 @@
 #include "run_loop.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <memory>
-#include <stdexcept>
-#include <system_error>
 #include <thread>
 #include <utility>
-#include <variant>
 
-#include <glm/geometric.hpp>
 
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"
@@ -23,20 +16,14 @@
 #include "camhead/hal/output/frame_sink.h"
 #include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/frame_renderer.h"
-#include "camhead/renderer/influence_region.h"
 #include "frame_record.h"
 #include "frame_setup.h"
 #include "lens_camera.h"
 #include "lens_hub.h"
-#include "output_uri.h"
 #include "pipeline.h"
-#include "placeholder.h"
-#include "rig_setup.h"
-#include "run_paths.h"
 #include "run_status.h"
 #include "setup_reloader.h"
 #include "status_thread.h"
-#include "tracking/camera_pose.h"
 #include "tracking/marker_source.h"
 #include "tracking/pose_trace.h"
 #include "web/operator_page.h"
