@@ -7,6 +7,7 @@
 #include <thread>
 #include <utility>
 
+#include <glm/geometric.hpp>
 
 #include "camhead/base/bounded_queue.h"
 #include "camhead/base/monotonic_clock.h"

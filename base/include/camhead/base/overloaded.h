@@ -6,8 +6,6 @@
 
 namespace camhead::base {
 
-template <typename... Handlers> struct Overloaded : Handlers... {
-  using Handlers::operator()...;
-};
+template <typename... Handlers> struct Overloaded : Handlers... { using Handlers::operator()...; };
 
 } // namespace camhead::base
