@@ -81,6 +81,7 @@ TEST(Board, SimulatedRigLoadsWithATraceAndAProfileThatExist) {
   ASSERT_EQ(board.lens.sources.size(), 1u);
   const auto *trace = std::get_if<TraceSourceConfig>(&board.lens.sources[0].kind);
   ASSERT_NE(trace, nullptr);
+  EXPECT_EQ(source_type(board.lens.sources[0]), "trace");
   EXPECT_TRUE(trace->loop);
   EXPECT_TRUE(std::filesystem::exists(trace->file)) << trace->file;
   ASSERT_TRUE(board.lens.profile.has_value());
