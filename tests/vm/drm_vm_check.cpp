@@ -350,13 +350,9 @@ void card_unplugged(int cycles) {
   }
   std::string detail = problem;
   if (!back_ms.empty()) {
-    std::vector<double> sorted = back_ms;
-    std::sort(sorted.begin(), sorted.end());
-    detail +=
-        (detail.empty() ? "" : "; ") + std::to_string(back_ms.size()) + " of " +
-        std::to_string(cycles) + " back, median " + std::to_string(int(sorted[sorted.size() / 2])) +
-        " ms, worst " + std::to_string(int(sorted.back())) +
-        " ms after the rescan; while away: " + gone_detail + "; back: " + sink->status().detail;
+    detail += (detail.empty() ? "" : "; ") + std::to_string(back_ms.size()) + " of " +
+              std::to_string(cycles) + " back, " + camhead::vm::median_and_worst_ms(back_ms) +
+              " after the rescan; while away: " + gone_detail + "; back: " + sink->status().detail;
   }
   print_result("drm_card_back", problem.empty() && int(back_ms.size()) == cycles, detail);
 }

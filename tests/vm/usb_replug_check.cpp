@@ -15,7 +15,6 @@
 //
 // Run by usb_lens.sh with the gadget bound and its program (usb_lens_gadget)
 // streaming a burst of reports on every connection.
-#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -128,21 +127,15 @@ int main(int argc, char **argv) {
   }
   std::string detail = problem;
   if (!back.empty()) {
-    const auto median_worst = [&](double Back::*of) {
+    const auto all = [&](double Back::*of) {
       std::vector<double> v;
       for (const Back &b : back)
         v.push_back(b.*of);
-      std::sort(v.begin(), v.end());
-      return std::make_pair(v[v.size() / 2], v.back());
+      return camhead::vm::median_and_worst_ms(std::move(v));
     };
-    const auto [enumerated_median, enumerated_worst] = median_worst(&Back::enumerated_ms);
-    const auto [plug_median, plug_worst] = median_worst(&Back::plug_ms);
-    char text[240];
-    std::snprintf(text, sizeof text,
-                  "%zu of %d back; enumerated to first reading: median %.0f ms, worst %.0f ms; "
-                  "plug to first reading: median %.0f ms, worst %.0f ms",
-                  back.size(), kReplugs, enumerated_median, enumerated_worst, plug_median,
-                  plug_worst);
+    const std::string text = std::to_string(back.size()) + " of " + std::to_string(kReplugs) +
+                             " back; enumerated to first reading: " + all(&Back::enumerated_ms) +
+                             "; plug to first reading: " + all(&Back::plug_ms);
     detail = problem.empty() ? text : problem + "; " + text;
   }
   camhead::vm::print_result("usb_replug_100", problem.empty(), detail);

@@ -34,7 +34,6 @@
 //       checks frames a client stored raw, one after another: each must be
 //       one of the numbered frames, whole, the numbers increasing; prints
 //       the RESULT line v4l2_loopback_v4l2ctl
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -357,14 +356,9 @@ std::string readers_come_and_go(const std::string &device, int readers, std::str
   if (status.errors != 0)
     return std::to_string(status.errors) + " frames failed: " + status.detail;
   (void)sink->close();
-  std::sort(first_ms.begin(), first_ms.end());
-  char text[200];
-  std::snprintf(text, sizeof text,
-                "%d readers, each a whole frame; open to first frame median %.1f ms, worst "
-                "%.1f ms; the sink wrote %llu frames, none failed",
-                readers, first_ms[first_ms.size() / 2], first_ms.back(),
-                static_cast<unsigned long long>(status.frames));
-  figures = text;
+  figures = std::to_string(readers) + " readers, each a whole frame; open to first frame " +
+            camhead::vm::median_and_worst_ms(first_ms, 1) + "; the sink wrote " +
+            std::to_string(status.frames) + " frames, none failed";
   return {};
 }
 

@@ -202,11 +202,10 @@ void unplugged_again_and_again(CameraSource &camera, const std::string &device, 
               std::to_string(count) + " unplugs";
   std::string detail = problem;
   if (!back_ms.empty()) {
-    std::sort(back_ms.begin(), back_ms.end());
     detail += (detail.empty() ? "" : "; ") + std::to_string(back_ms.size()) + " of " +
-              std::to_string(count) + " back, first frame after the loss: median " +
-              std::to_string(int(back_ms[back_ms.size() / 2])) + " ms, worst " +
-              std::to_string(int(back_ms.back())) + " ms; " + status.detail;
+              std::to_string(count) +
+              " back, first frame after the loss: " + camhead::vm::median_and_worst_ms(back_ms) +
+              "; " + status.detail;
   }
   print_result("v4l2_vivid_reconnect_100", problem.empty() && int(back_ms.size()) == count, detail);
 }
