@@ -369,6 +369,11 @@ void LibusbTransport::on_transfer(libusb_transfer *transfer) {
 }
 
 void LibusbTransport::close_device(const std::string &reason) {
+  // No completion resubmits from here on. A transfer that completed just
+  // before its cancellation would otherwise go out again, uncancelled, be
+  // waited for in vain and abandoned below: a stop while the board streamed
+  // took 2 s and leaked it (LeakSanitizer, the hardware lab's replug loop).
+  gone_ = true;
   for (Slot &slot : slots_) {
     if (slot.in_flight) {
       libusb().cancel_transfer(slot.transfer.get());
