@@ -15,7 +15,7 @@
 //                                under emulation the gadget falls behind its
 //                                schedule and catches up (hardware-lab.md:
 //                                no rate checks in the VM), and the mapper's
-//                                precision is tested in tests/hal_usb/
+//                                precision is tested in tests/hal/lens/usb/
 //   usb_corrupt_report_malformed malformed == the corrupted reports, lost == 0
 //   usb_unplug_replug            one reconnect, connected again, the second
 //                                connection complete

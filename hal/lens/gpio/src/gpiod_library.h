@@ -6,7 +6,7 @@
 //
 // gpiod_library.cpp fills the table by dlopen; the backend's tests link
 // libgpiod and a fake kernel instead and fill it from the link
-// (tests/hal_gpio/fake_gpiod.cpp), so define both functions below or
+// (tests/hal/lens/gpio/fake_gpiod.cpp), so define both functions below or
 // neither.
 //
 // Thread safety: the first call of either function loads the library

@@ -1,7 +1,7 @@
 // x4 quadrature decoding. See quadrature_decoder.h for the convention and for
 // what is counted as a missed edge. on_edge() is the hot path: a few branches
 // and no allocation, so a recorded 1 MHz burst decodes far faster than real
-// time (tests/hal_gpio/recording_test.cpp prints the rate).
+// time (tests/hal/lens/gpio/recording_test.cpp prints the rate).
 #include "camhead/hal/lens/gpio/quadrature_decoder.h"
 
 namespace camhead::hal::lens::gpio {

@@ -11,7 +11,7 @@ constexpr std::uint8_t kDescriptorInterface = 0x04;
 constexpr std::uint8_t kDescriptorEndpoint = 0x05;
 
 // <linux/usb/functionfs.h>, spelled out so that this file compiles without it;
-// tests/hal_usb checks them against the kernel header.
+// tests/hal/lens/usb checks them against the kernel header.
 constexpr std::uint32_t kFfsDescriptorsMagicV2 = 3;
 constexpr std::uint32_t kFfsStringsMagic = 2;
 constexpr std::uint32_t kFfsHasFsDesc = 1;

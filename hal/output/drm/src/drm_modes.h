@@ -1,5 +1,5 @@
 // The decisions the DRM sink makes from what the card reports, as pure
-// functions (tests/hal_drm): which card a name means, what a connector is
+// functions (tests/hal/output/drm): which card a name means, what a connector is
 // called, which mode a "WxH[@Hz]" string picks, where the frame sits in the
 // mode, which CRTC drives the connector.
 #pragma once

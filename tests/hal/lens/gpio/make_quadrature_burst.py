@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""Writes the recorded quadrature burst that tests/hal_gpio/recording_test.cpp
+"""Writes the recorded quadrature burst that tests/hal/lens/gpio/recording_test.cpp
 replays: a 1 MHz-equivalent edge stream (focus edges 1 us apart) of 3.7 ms.
 
-    python3 tests/hal_gpio/make_quadrature_burst.py > tests/assets/quadrature_burst_1mhz.csv
+    python3 tests/hal/lens/gpio/make_quadrature_burst.py > tests/assets/quadrature_burst_1mhz.csv
 
 It is written step by step, independently of camhead's C++ twin (which makes
 the same stream from a trajectory; the test checks the two agree), and its
@@ -78,8 +78,8 @@ def main():
 
     w = sys.stdout.write
     w("# camhead quadrature edge recording, format 1\n")
-    w("# made by tests/hal_gpio/make_quadrature_burst.py (the plan is in its docstring);\n")
-    w("# regenerate: python3 tests/hal_gpio/make_quadrature_burst.py "
+    w("# made by tests/hal/lens/gpio/make_quadrature_burst.py (the plan is in its docstring);\n")
+    w("# regenerate: python3 tests/hal/lens/gpio/make_quadrature_burst.py "
       "> tests/assets/quadrature_burst_1mhz.csv\n")
     w(f"# expect focus_count={focus_expect} focus_missed={len(FOCUS_MERGED)} "
       f"focus_duplicates={len(FOCUS_DUPLICATED)} zoom_count={zoom_true} zoom_missed=0 "
