@@ -143,7 +143,10 @@ TEST_F(RunLoop, LostLensSourceHoldsTheLastStateFlaggedStale) {
                         real_scene(32, 16), R"(, "loop": false, "speed": 100)");
   options.outputs = {"null"};
   options.stats_file = dir_ / "stats.jsonl";
-  options.duration_s = 1.5;
+  // On frames, not the clock: under the sanitizers and a loaded machine,
+  // 1.5 s once gave fewer than the 10 frames this test reads.
+  options.frames = 12;
+  options.duration_s = 60.0;
   options.status = nullptr;
   (void)run_pipeline(options);
   const hal::lens::LensTrace trace = hal::lens::read_lens_trace(kLenses / "sim_focus_pull.csv");
