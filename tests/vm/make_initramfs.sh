@@ -119,7 +119,11 @@ for check in "${checks[@]}"; do
 done
 printf '%s\n' "${checks[@]##*/}" >"$root/etc/lab-checks"
 for program in "${programs[@]}"; do
+  # Without its debug information (camhead's is most of its 80 MB): the
+  # guest has no debugger, and a sanitizer's report there names functions
+  # by their symbols, which stay.
   install -m 755 "$program" "$root/usr/bin/"
+  objcopy --strip-debug "$root/usr/bin/$(basename "$program")"
   copy_libraries "$program"
 done
 for soname in "${libraries[@]}"; do

@@ -3,6 +3,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -34,6 +35,17 @@ std::string read_attribute(const std::string &path) {
     fail("cannot read", path);
   }
   return line;
+}
+
+bool usb_device_enumerated(const std::string &serial) {
+  std::error_code ec;
+  for (const auto &entry : std::filesystem::directory_iterator("/sys/bus/usb/devices", ec)) {
+    std::ifstream in(entry.path() / "serial");
+    std::string line;
+    if (std::getline(in, line) && line == serial)
+      return true;
+  }
+  return false;
 }
 
 } // namespace camhead::vm

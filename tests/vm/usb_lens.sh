@@ -10,7 +10,11 @@
 #   3. once the gadget has sent them (its done file says "done 1"), unplug:
 #      unbind the UDC with the checker's transfers still queued;
 #   4. a second later replug: bind again; the board starts over and sends
-#      COUNT more; the checker exits when it has them.
+#      COUNT more; the checker exits when it has them;
+#   5. unplug and plug again and again: 10 times read by the backend alone
+#      (camhead_usb_replug_check), then, the gadget started again streaming
+#      without end, 100 times (10 under the sanitizers) while `camhead run`
+#      composites frames with the board's lens (camhead_usb_run_check).
 #
 # busybox sh; no bash. Needs configfs mounted at /sys/kernel/config and the
 # modules dummy_hcd, libcomposite and usb_f_fs (guest_init.sh loads them; the
@@ -24,7 +28,7 @@ rate=200
 corrupt=50  # index of the corrupted report in the first connection
 serial=VM0001
 results="usb_absent_at_start usb_enumerates_and_streams usb_counts_match_trajectory
-usb_clock_mapping usb_corrupt_report_malformed usb_unplug_replug usb_replug_100"
+usb_clock_mapping usb_corrupt_report_malformed usb_unplug_replug usb_replug_backend usb_replug_100"
 server=
 checker=
 
@@ -119,7 +123,21 @@ status=0
 wait "$checker" || status=$?
 checker=
 # Then unplugged and plugged back, again and again, the gadget streaming a
-# burst on each connection.
+# burst on each connection: read by the backend alone.
 camhead_usb_replug_check "$gadget/UDC" "$udc" "$serial" || status=$?
+# And by `camhead run`, the board streaming for as long as it is plugged in,
+# so that only the unplug can make the lens stale. The gadget program starts
+# again unplugged (FunctionFS takes new descriptors once ep0 is closed).
+echo "" >"$gadget/UDC"
+kill "$server" 2>/dev/null
+wait "$server" 2>/dev/null
+camhead_usb_lens_gadget --ffs "$ffs" --rate "$rate" --count 0 &
+server=$!
+if wait_for 5 test -e "$ffs/ep1" && echo "$udc" >"$gadget/UDC"; then
+  camhead_usb_run_check "$gadget/UDC" "$udc" "$serial" || status=$?
+else
+  echo "RESULT usb_replug_100: FAIL the streaming gadget did not start or bind"
+  status=1
+fi
 cleanup
 exit "$status"
