@@ -44,8 +44,23 @@ constexpr double kFollowReach = 0.3, kFollowContrast = 12.0;
 // At least this many followed corners, fitting one pose this well.
 constexpr std::size_t kMinFollowed = 10;
 constexpr double kMaxFollowedReprojectionPx = 1.0;
+// A chessboard corner is looked for where the pose of all the markers read
+// puts it, and kept with one of its (up to two) neighbouring markers read,
+// not OpenCV's default two: on a defocused or distant board, where only
+// some codes are readable, the default keeps a few corners of many (2-7 of
+// 17-21 on the moving rig's board with 8-9 of 17 markers read, too few to
+// solve from), and every one of them is refined on the image all the same.
+constexpr int kMinAdjacentMarkers = 1;
 // Half the side of the window a chessboard corner is refined in, pixels.
 constexpr int kMinRefineHalfWindow = 2, kMaxRefineHalfWindow = 8;
+// A followed corner's window: a fifth of the square on each side (at most
+// 24 px). A third reached into the markers' blurred edges, whose pull left
+// the moving rig's followed corners 2.2-3.5 px RMS off one board (all
+// refused); a fifth fits them within 1 px and halves the synthetic board's
+// error at 4-6 px of blur; at an eighth the blurred X fills the window and
+// noise wins (bench/RESULTS.md, "Registration by blur").
+constexpr float kFollowWindow = 1.0f / 5.0f;
+constexpr int kMaxFollowHalfWindow = 24;
 
 cv::Matx33d camera_matrix(const CameraModel &c) {
   return {c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0};
@@ -150,7 +165,7 @@ private:
       charuco_ids_.clear();
       if (!ids_.empty()) {
         cv::aruco::interpolateCornersCharuco(corners_, ids_, image, charuco_, charuco_corners_,
-                                             charuco_ids_, k, distortion);
+                                             charuco_ids_, k, distortion, kMinAdjacentMarkers);
         refine_chessboard_corners(image);
       }
       // Few corners read from the markers: follow the board from the
@@ -257,8 +272,8 @@ private:
   // stays an X, centred where it was) long after its markers' codes are
   // unreadable (bench/RESULTS.md: from about 3 px of blur on a 5x5 marker
   // of 26 px). With too few corners found from the markers, each corner is
-  // looked for where the previous pose puts it, refined in a window of a
-  // third of a square, and kept only if it stayed within kFollowReach of a
+  // looked for where the previous pose puts it, refined in a window of
+  // kFollowWindow of a square, and kept only if it stayed within kFollowReach of a
   // square of there (so that it cannot jump to its neighbour) in a window
   // with contrast; the corners kept must make one board (the reprojection
   // check in track_or_throw). The camera must move less than that between
@@ -288,7 +303,9 @@ private:
       // that overflowed) is not looked for; nor one too near the edge.
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(square))
         continue;
-      const int half = std::clamp(int(std::min(square / 3.0f, 24.0f)), kMinRefineHalfWindow, 24);
+      const int half =
+          std::clamp(int(std::min(square * kFollowWindow, float(kMaxFollowHalfWindow))),
+                     kMinRefineHalfWindow, kMaxFollowHalfWindow);
       if (!(p.x >= half + 2 && p.y >= half + 2 && p.x <= image.cols - half - 3 &&
             p.y <= image.rows - half - 3))
         continue;

@@ -1,0 +1,225 @@
+// Registration of a moving simulated rig against the truth, by the blur of
+// its marker board (issue 25, "What must be shown" 2 and 3, on the rig that
+// README's moving example runs): reads the record of a `camhead run` of a
+// board whose simulated camera follows a camera path and whose pose comes
+// from a marker board, and for each composite whose pose was found in its
+// own frame, how far the recorded pose puts the points that register the
+// virtual world to the real one (the board's outer corners, the scene's
+// virtual objects' centres) from where the path's true pose at that frame's
+// mid-exposure puts them, in pixels, against the blur circle of the board's
+// centre in that frame (thin lens, the frame's recorded focus, f-number and
+// focal length).
+//
+//   build/camhead run --board sim-moving --duration 60 --output null --record-stats m.jsonl
+//   build/bench/registration_by_blur board/sim-moving.json m.jsonl [OUT]
+//
+// Prints a table by blur (frames, median and worst registration, median
+// reprojection error); OUT.csv gets a row per frame and OUT.png the scatter.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#include "camhead/renderer/image.h"
+#include "camhead/renderer/image_io.h"
+#include "camhead/renderer/scene_loader.h"
+#include "chart/chart_plot.h"
+#include "config/board.h"
+#include "tracking/marker_board.h"
+#include "tracking/pose_trace.h"
+
+namespace {
+
+using namespace camhead::pipeline;
+namespace chart = camhead::cli::chart;
+
+struct Frame {
+  bool found = false;      // the pose was found in this frame (else held or predicted)
+  double t_s = 0;          // mid-exposure, on the path's clock
+  double blur_px = 0;      // the board's centre
+  double registration = 0; // px, the largest over the points
+  double reprojection = 0; // px, the tracker's own residual
+  int markers = 0;
+};
+
+CameraPose recorded_pose(const nlohmann::json &pose) {
+  const auto vec = [&](const char *key) {
+    const auto &a = pose.at(key);
+    return glm::dvec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>());
+  };
+  const glm::dvec3 forward = glm::normalize(vec("forward"));
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, vec("up")));
+  const glm::dmat3 axes(right, glm::cross(right, forward), -forward); // right, up, back
+  return {vec("position"), glm::normalize(glm::quat_cast(axes))};
+}
+
+// A centred pinhole: the recorded and the true pose are compared through
+// the same camera, so the lens's distortion cancels to first order.
+glm::dvec2 pixel(const CameraPose &pose, const glm::dvec3 &point, int width, int height,
+                 double focal_px) {
+  const glm::dvec3 p = glm::inverse(pose.orientation) * (point - pose.position);
+  return {width / 2.0 + focal_px * p.x / -p.z, height / 2.0 - focal_px * p.y / -p.z};
+}
+
+// The thin lens's blur circle, on the sensor, of a point `depth_m` in front
+// of a lens of focal length f focused at s (infinity allowed), in pixels.
+double blur_px(double depth_m, double focus_m, double f_number, double focal_mm,
+               double sensor_width_mm, int width) {
+  const double f = focal_mm * 1e-3;
+  const double c = std::isinf(focus_m)
+                       ? f * f / (f_number * depth_m)
+                       : f * f / (f_number * (focus_m - f)) * std::abs(depth_m - focus_m) / depth_m;
+  return c * 1e3 / sensor_width_mm * width;
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty())
+    return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  return v[std::size_t(std::lround(q * double(v.size() - 1)))];
+}
+
+int run(int argc, char **argv) {
+  if (argc < 3 || argc > 4) {
+    std::fprintf(stderr, "usage: registration_by_blur BOARD.json RECORD.jsonl [OUT]\n");
+    return 2;
+  }
+  const Board board = load_board(argv[1]);
+  const auto *sim = board.camera ? std::get_if<SimCameraConfig>(&board.camera->kind) : nullptr;
+  if (sim == nullptr || !sim->path || !board.pose || board.pose->type != PoseType::marker ||
+      !board.scene)
+    throw std::runtime_error(std::string(argv[1]) +
+                             ": wants a simulated camera with a path, a scene and a marker pose");
+  const PoseTrace truth = load_pose_trace(*sim->path);
+  const MarkerBoard markers = load_marker_board(board.pose->file);
+  const camhead::renderer::Scene scene = camhead::renderer::load_scene(*board.scene);
+  const int width = board.camera->width, height = board.camera->height;
+  const double sx = markers.squares_x * markers.square_m, sz = markers.squares_y * markers.square_m;
+  const glm::dvec3 centre(sx / 2, 0, sz / 2);
+  std::vector<glm::dvec3> points = {{0, 0, 0}, {sx, 0, 0}, {0, 0, sz}, {sx, 0, sz}};
+  for (const auto &object : scene.objects)
+    if (!object.real)
+      points.emplace_back(object.center);
+
+  std::ifstream in(argv[2]);
+  if (!in)
+    throw std::runtime_error(std::string("cannot read ") + argv[2]);
+  std::vector<Frame> frames;
+  int composites = 0;
+  for (std::string line; std::getline(in, line);) {
+    const nlohmann::json r = nlohmann::json::parse(line);
+    if (r.value("kind", "") != "composite")
+      continue;
+    ++composites;
+    const std::int64_t mid = r.at("exposure_mid_ns").get<std::int64_t>();
+    const CameraPose real = truth.at(mid), seen = recorded_pose(r.at("pose"));
+    const double focal_mm = r.at("focal_length_mm").get<double>();
+    const double focal_px = focal_mm / board.camera->sensor_width_mm * width;
+    Frame f;
+    f.found = r.value("pose_fresh", false);
+    f.t_s = double(mid) * 1e-9;
+    const double depth = glm::dot(centre - real.position, real.forward());
+    const double focus_m = r.at("focus_m").is_null() ? std::numeric_limits<double>::infinity()
+                                                     : r.at("focus_m").get<double>();
+    f.blur_px = blur_px(depth, focus_m, r.at("f_number").get<double>(), focal_mm,
+                        board.camera->sensor_width_mm, width);
+    for (const glm::dvec3 &p : points)
+      f.registration =
+          std::max(f.registration, glm::length(pixel(seen, p, width, height, focal_px) -
+                                               pixel(real, p, width, height, focal_px)));
+    f.reprojection =
+        r.at("reprojection_px").is_null() ? 0.0 : r.at("reprojection_px").get<double>();
+    f.markers = r.value("markers_seen", 0);
+    frames.push_back(f);
+  }
+
+  const auto found =
+      std::count_if(frames.begin(), frames.end(), [](const Frame &f) { return f.found; });
+  std::printf("%d composites, %td with the pose found in the frame\n\n", composites, found);
+  std::printf("| board's blur circle | pose found in the frame: frames | registration median | "
+              "p90 | worst | reprojection median | pose held or predicted: frames | "
+              "registration median | worst |\n|---|---|---|---|---|---|---|---|---|\n");
+  const double edges[] = {0, 1, 2, 3, 4, 6, 10, 1e9};
+  // The chart: per bin of blur, at its middle (the last at 14 px).
+  std::vector<chart::Series> series = {
+      {"median", {31, 119, 180}, chart::Marker::circle, {}, {}, {}},
+      {"worst", {214, 39, 40}, chart::Marker::triangle, {}, {}, {}},
+      {"median", {31, 119, 180}, chart::Marker::circle, {}, {}, {}},
+      {"worst", {214, 39, 40}, chart::Marker::triangle, {}, {}, {}}};
+  const auto add = [&](std::size_t i, double x, double y) {
+    if (std::isfinite(y)) {
+      series[i].x.push_back(x);
+      series[i].y.push_back(std::max(y, 0.01));
+    }
+  };
+  for (std::size_t b = 0; b + 1 < std::size(edges); ++b) {
+    std::vector<double> reg, rep, held;
+    for (const Frame &f : frames)
+      if (f.blur_px >= edges[b] && f.blur_px < edges[b + 1]) {
+        (f.found ? reg : held).push_back(f.registration);
+        if (f.found)
+          rep.push_back(f.reprojection);
+      }
+    if (reg.empty() && held.empty())
+      continue;
+    const std::string bin = edges[b + 1] > 1e8 ? std::to_string(int(edges[b])) + " px and more"
+                                               : std::to_string(int(edges[b])) + "-" +
+                                                     std::to_string(int(edges[b + 1])) + " px";
+    std::printf("| %s | %zu | %.3f px | %.3f px | %.3f px | %.3f px | %zu | %.3f px | %.3f px |\n",
+                bin.c_str(), reg.size(), quantile(reg, 0.5), quantile(reg, 0.9), quantile(reg, 1.0),
+                quantile(rep, 0.5), held.size(), quantile(held, 0.5), quantile(held, 1.0));
+    const double x = edges[b + 1] > 1e8 ? 14.0 : std::max(0.5 * (edges[b] + edges[b + 1]), 0.5);
+    add(0, x, quantile(reg, 0.5));
+    add(1, x, quantile(reg, 1.0));
+    add(2, x, quantile(held, 0.5));
+    add(3, x, quantile(held, 1.0));
+  }
+
+  if (argc == 4) {
+    const std::string out = argv[3];
+    std::ofstream csv(out + ".csv");
+    csv << "t_s,pose_found,blur_px,registration_px,reprojection_px,markers_seen\n";
+    for (const Frame &f : frames) {
+      char row[160];
+      std::snprintf(row, sizeof row, "%.4f,%d,%.4f,%.4f,%.4f,%d\n", f.t_s, int(f.found), f.blur_px,
+                    f.registration, f.reprojection, f.markers);
+      csv << row;
+    }
+    const chart::Panel panels[] = {{"pose found in the frame",
+                                    "board's blur, px (0-1 at 0.5)",
+                                    "registration, px",
+                                    {series[0], series[1]}},
+                                   {"pose held or predicted",
+                                    "board's blur, px (0-1 at 0.5)",
+                                    "registration, px",
+                                    {series[2], series[3]}}};
+    const chart::Canvas canvas =
+        chart::plot_log_log("Moving rig: registration by the board's blur", panels, 480, 400);
+    camhead::renderer::Image image(canvas.width, canvas.height, 3);
+    for (std::size_t i = 0; i < canvas.rgb.size(); ++i)
+      image.data[i] = camhead::renderer::srgb_to_linear(canvas.rgb[i] / 255.0f);
+    camhead::renderer::write_image(out + ".png", image);
+    std::printf("\nwrote %s.csv and %s.png\n", out.c_str(), out.c_str());
+  }
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "registration_by_blur: %s\n", e.what());
+    return 1;
+  }
+}
