@@ -157,8 +157,12 @@ void Pipeline::render_loop() {
     for (std::size_t i = 0; i < sinks_.size(); ++i)
       targets_[i] = {sinks_[i]->format(), slot.images[i]};
     r.render_start_ns = base::monotonic_ns();
-    const renderer::FrameReport report =
+    renderer::FrameReport report =
         setup_->renderer->render(request, {frame.format, frame.bytes}, targets_);
+    if (options_.lose_gpu_after_frames && rendered > *options_.lose_gpu_after_frames) {
+      report.status = renderer::FrameStatus::device_lost;
+      report.detail = "the GPU was lost (a fault for tests)";
+    }
     r.render_end_ns = base::monotonic_ns();
     if (page_)
       page_->feed().camera(frame.sequence, frame.format, frame.bytes);

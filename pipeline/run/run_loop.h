@@ -62,6 +62,10 @@ struct RunOptions {
   // camera frames and hangs until the run is stopped, as one stuck in a
   // driver would (the output repeats the last composite meanwhile).
   std::optional<std::uint64_t> stall_render_after_frames;
+  // A fault for tests: from this many camera frames on, every render says
+  // the GPU was lost (FrameStatus::device_lost), as a device that fell off
+  // its bus or was reset does; the outputs show the placeholder.
+  std::optional<std::uint64_t> lose_gpu_after_frames;
   // Set (by SIGHUP) to reload the board from its file: the scene, the lens
   // profile, the render settings and a static pose are taken between two
   // frames, with no gap in the outputs; a board that does not load, or that

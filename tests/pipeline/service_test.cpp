@@ -215,9 +215,10 @@ TEST(OutputWatchdog, OnlyARealOutputFeedsIt) {
 // The simulated rig under a watchdog of 400 ms (a check every 200 ms):
 // READY=1 once the first frame is out, the status line as STATUS=,
 // STOPPING=1 last, and WATCHDOG=1 only where a composite went out in the
-// check's window. Then the render thread stuck after 2 frames: the output
-// goes on (the last composite again) and so does the status, but the
-// watchdog hears nothing once the last composite is a window old, so
+// check's window. Then the render thread stuck after 2 frames (the output
+// goes on with the last composite again), and the GPU lost after 2 frames
+// (the output goes on with the placeholder): the status goes on too, but
+// the watchdog hears nothing once the last composite is a window old, so
 // systemd would restart the service. Judged against the run's own record
 // of when each composite went out, whatever the machine's rate (a
 // sanitizer build renders far slower).
@@ -235,7 +236,8 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
     std::string text;
     std::int64_t at_ns;
   };
-  const auto run = [&](std::optional<std::uint64_t> stall, double seconds) {
+  enum class Fault { none, render_stuck, gpu_lost };
+  const auto run = [&](Fault fault, double seconds) {
     RunOptions options;
     options.board = load_board(resolve_board("sim"));
     // No cache, so no warm-up before the first frame (rig_setup.h): what
@@ -246,7 +248,10 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
     options.status = status;
     options.service = &notifier;
     options.stats_file = dir_ / "stats.jsonl";
-    options.stall_render_after_frames = stall;
+    if (fault == Fault::render_stuck)
+      options.stall_render_after_frames = 2;
+    if (fault == Fault::gpu_lost)
+      options.lose_gpu_after_frames = 2;
     // Vulkan (lavapipe here): frames at the camera's rate in a sanitizer
     // build too, whose CPU reference renders a frame or two a second.
     options.executor = Executor::gpu;
@@ -263,10 +268,20 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
     (void)run_pipeline(options);
     reader.join();
     std::vector<std::int64_t> composites_out;
+    int placeholders_after = 0; // after the last composite
     std::ifstream stats(dir_ / "stats.jsonl");
-    for (std::string line; std::getline(stats, line);)
-      if (line.find("\"kind\":\"composite\"") != std::string::npos)
+    for (std::string line; std::getline(stats, line);) {
+      if (line.find("\"kind\":\"composite\"") != std::string::npos) {
         composites_out.push_back(std::int64_t(json_number(line, "output_ns")));
+        placeholders_after = 0;
+      }
+      placeholders_after += line.find("\"kind\":\"placeholder\"") != std::string::npos ? 1 : 0;
+    }
+    // The outputs go on with the placeholder (a filler every 0.5 s of
+    // silence, run_loop.h's repeat_after_s).
+    if (fault == Fault::gpu_lost) {
+      EXPECT_GE(placeholders_after, 2) << "placeholders after the last composite";
+    }
     EXPECT_FALSE(composites_out.empty());
     EXPECT_FALSE(messages.empty());
     if (messages.empty() || composites_out.empty())
@@ -291,23 +306,28 @@ TEST_F(Service, TheRunFeedsTheWatchdogOnlyWhileItsOutputAdvances) {
     }
     EXPECT_GE(statuses, 2);
     std::printf("%s: %zu composites, %zu messages, %d statuses, %d WATCHDOG=1\n",
-                stall ? "render stuck after 2 frames" : "running", composites_out.size(),
-                messages.size(), statuses, watchdogs);
+                fault == Fault::render_stuck ? "render stuck after 2 frames"
+                : fault == Fault::gpu_lost   ? "the GPU lost after 2 frames"
+                                             : "running",
+                composites_out.size(), messages.size(), statuses, watchdogs);
     // How long the run went on after its last composite, for the stall.
     return std::pair(watchdogs, last_status_ns - composites_out.back());
   };
-  const auto [running, running_tail] = run(std::nullopt, 3.0);
+  const auto [running, running_tail] = run(Fault::none, 3.0);
   EXPECT_GE(running, 1);
-  // Long enough for the stall to be judged on a loaded machine, where the
+  // Long enough for the fault to be judged on a loaded machine, where the
   // first frames take seconds (a sanitizer suite beside it: 3 composites
   // in the first 3 s).
-  const auto [stuck, stuck_tail] = run(2, 6.0);
-  // The run went on for more than a window after its last composite (the
-  // status kept coming), so a watchdog fed by a live main thread alone
-  // would have been pinged meanwhile: the check above says it was not.
-  EXPECT_GT(stuck_tail, 2 * kWindowNs) << "the stall came too late in the run to be judged";
+  for (const Fault fault : {Fault::render_stuck, Fault::gpu_lost}) {
+    const auto [faulted, faulted_tail] = run(fault, 6.0);
+    // The run went on for more than a window after its last composite (the
+    // status kept coming, and with the GPU lost the placeholder too), so a
+    // watchdog fed by a live main thread or a moving output alone would
+    // have been pinged meanwhile: the check in run() says it was not.
+    EXPECT_GT(faulted_tail, 2 * kWindowNs) << "the fault came too late in the run to be judged";
+    (void)faulted;
+  }
   (void)running_tail;
-  (void)stuck;
   std::fclose(status);
 }
 
