@@ -41,9 +41,10 @@ set(CPACK_DEBIAN_PACKAGE_SECTION video)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-# Not linked, but needed: a Vulkan driver (lavapipe where there is no GPU)
-# and systemd-sysusers for the service's user.
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "mesa-vulkan-drivers | vulkan-icd, systemd")
+# Not linked, but needed: a Vulkan driver (lavapipe where there is no GPU),
+# systemd-sysusers for the service's user, and libjpeg-turbo, which the V4L2
+# camera opens at run time to decode a webcam's MJPEG (hal/jpeg).
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "mesa-vulkan-drivers | vulkan-icd, systemd, libturbojpeg0")
 # The boards in /etc/camhead/board are conffiles (pipeline/CMakeLists.txt):
 # dpkg keeps an administrator's edits through upgrades and asks before
 # replacing one.

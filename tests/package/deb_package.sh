@@ -39,6 +39,7 @@ control=$(dpkg-deb -f "$deb")
 echo "$control" | grep '^Depends:'
 echo "$control" | grep -q '^Depends:.*libvulkan1' || fail "Depends lacks libvulkan1 (dpkg-shlibdeps)"
 echo "$control" | grep -q '^Depends:.*mesa-vulkan-drivers | vulkan-icd' || fail "Depends lacks a Vulkan driver"
+echo "$control" | grep -q '^Depends:.*libturbojpeg0' || fail "Depends lacks libturbojpeg0 (MJPEG, opened at run time)"
 dpkg-deb -e "$deb" "$scratch/control"
 grep -q 'systemd-sysusers camhead.conf' "$scratch/control/postinst" || fail "postinst makes no user"
 grep -q 'install -m 0600 /dev/null /etc/camhead/web-password' "$scratch/control/postinst" ||

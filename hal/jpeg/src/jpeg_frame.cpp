@@ -1,10 +1,13 @@
-// JPEG through stb, compiled into this file only (static symbols, so the
-// PNG copies in hal/video_file and the renderer do not clash).
+// JPEG frames decoded by libjpeg-turbo's TurboJPEG, opened at run time;
+// encoded (for tests and simulated devices) by stb_image_write, compiled into
+// this file only (static symbols, so the PNG writers elsewhere do not clash).
 #include "camhead/hal/jpeg/jpeg_frame.h"
 
 #include <climits>
-#include <cstring>
 #include <memory>
+
+#include <dlfcn.h>
+#include <turbojpeg.h> // the API's types only: the library is opened, not linked
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
@@ -13,18 +16,6 @@
 #pragma GCC diagnostic ignored "-Wsign-compare"
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 #pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
-#pragma GCC diagnostic ignored "-Wtype-limits"
-#pragma GCC diagnostic ignored "-Wunused-but-set-variable"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-// Only JPEG: a camera is a device anyone may plug in, and every other
-// decoder would be attack surface for nothing.
-#define STBI_ONLY_JPEG
-#define STBI_NO_STDIO
-#define STB_IMAGE_STATIC
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb/stb_image.h>
 #define STBI_WRITE_NO_STDIO
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -32,11 +23,33 @@
 #pragma GCC diagnostic pop
 
 namespace camhead::hal::jpeg {
+
+// The TurboJPEG functions the decoder calls, from libturbojpeg.so.0 (the
+// soname of Debian 12's libturbojpeg0, libjpeg-turbo 2.1), and one
+// decompressor kept for the stream's life.
+struct JpegDecoder::Turbo {
+  void *library = nullptr;
+  decltype(&tjInitDecompress) init = nullptr;
+  decltype(&tjDecompressHeader3) header = nullptr;
+  decltype(&tjDecompress2) decompress = nullptr;
+  decltype(&tjGetErrorStr2) error_text = nullptr;
+  decltype(&tjDestroy) destroy = nullptr;
+  tjhandle handle = nullptr;
+
+  ~Turbo() {
+    if (handle != nullptr)
+      destroy(handle);
+    if (library != nullptr)
+      dlclose(library);
+  }
+  [[nodiscard]] std::string reason() const { return error_text(handle); }
+};
+
 namespace {
 
-std::string stb_reason() {
-  const char *reason = stbi_failure_reason();
-  return reason != nullptr ? reason : "unknown";
+template <typename F> bool resolve(void *library, const char *symbol, F &f) {
+  f = reinterpret_cast<F>(dlsym(library, symbol));
+  return f != nullptr;
 }
 
 void append(void *context, void *data, int size) {
@@ -47,37 +60,69 @@ void append(void *context, void *data, int size) {
 
 } // namespace
 
-bool decode_jpeg_rgb(std::span<const std::uint8_t> jpeg, int width, int height,
-                     std::span<std::uint8_t> rgb, std::string &error) {
+JpegDecoder::JpegDecoder() : turbo_(std::make_unique<Turbo>()) {
+  turbo_->library = dlopen(CAMHEAD_TURBOJPEG_SONAME, RTLD_NOW | RTLD_LOCAL);
+  if (turbo_->library == nullptr)
+    throw JpegError("MJPEG needs libjpeg-turbo: " + std::string(dlerror()) +
+                    " (apt-get install libturbojpeg0)");
+  if (!resolve(turbo_->library, "tjInitDecompress", turbo_->init) ||
+      !resolve(turbo_->library, "tjDecompressHeader3", turbo_->header) ||
+      !resolve(turbo_->library, "tjDecompress2", turbo_->decompress) ||
+      !resolve(turbo_->library, "tjGetErrorStr2", turbo_->error_text) ||
+      !resolve(turbo_->library, "tjDestroy", turbo_->destroy))
+    throw JpegError("MJPEG: " CAMHEAD_TURBOJPEG_SONAME " lacks the TurboJPEG 2 functions");
+  turbo_->handle = turbo_->init();
+  if (turbo_->handle == nullptr)
+    throw JpegError("MJPEG: libjpeg-turbo cannot make a decompressor");
+}
+
+JpegDecoder::~JpegDecoder() = default;
+
+bool JpegDecoder::refuse(std::string &error, std::string reason) {
+  error = std::move(reason);
+  // libjpeg-turbo 2.1 can leave a decompressor mid-header after a frame cut
+  // short in its tables (the header then "reads" as 0x0), and the next
+  // frame's tables are misread ("Bogus Huffman table definition"): after a
+  // frame it refused, the next one gets a fresh decompressor. Without
+  // memory for one, every later frame is refused.
+  turbo_->destroy(turbo_->handle);
+  turbo_->handle = turbo_->init();
+  return false;
+}
+
+bool JpegDecoder::decode_rgb(std::span<const std::uint8_t> jpeg, int width, int height,
+                             std::span<std::uint8_t> rgb, std::string &error) {
   if (jpeg.empty() || jpeg.size() > std::size_t(INT_MAX)) {
     error = "JPEG: empty frame";
     return false;
   }
-  const int length = static_cast<int>(jpeg.size());
-  int w = 0, h = 0, channels = 0;
-  // The header first: a frame of another size is refused before stb
-  // allocates for it.
-  if (!stbi_info_from_memory(jpeg.data(), length, &w, &h, &channels)) {
-    error = "JPEG: not a JPEG frame (" + stb_reason() + ")";
+  if (turbo_->handle == nullptr) {
+    error = "JPEG: no decompressor (out of memory)";
+    turbo_->handle = turbo_->init();
     return false;
   }
-  if (w != width || h != height) {
-    error = "JPEG: the frame is " + std::to_string(w) + "x" + std::to_string(h) + ", not " +
-            std::to_string(width) + "x" + std::to_string(height);
-    return false;
-  }
+  const auto length = static_cast<unsigned long>(jpeg.size());
+  // The header first: a frame of another size is refused before the
+  // decoder allocates for it.
+  int w = 0, h = 0, subsampling = 0, colorspace = 0;
+  if (turbo_->header(turbo_->handle, jpeg.data(), length, &w, &h, &subsampling, &colorspace) != 0)
+    return refuse(error, "JPEG: not a JPEG frame (" + turbo_->reason() + ")");
+  if (w <= 0 || h <= 0)
+    return refuse(error, "JPEG: not a JPEG frame (no frame header)");
+  if (w != width || h != height)
+    return refuse(error, "JPEG: the frame is " + std::to_string(w) + "x" + std::to_string(h) +
+                             ", not " + std::to_string(width) + "x" + std::to_string(height));
   if (rgb.size() < std::size_t(width) * std::size_t(height) * 3) {
     error = "JPEG: the buffer holds " + std::to_string(rgb.size()) + " bytes, not a " +
             std::to_string(width) + "x" + std::to_string(height) + " RGB frame";
     return false;
   }
-  const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> pixels(
-      stbi_load_from_memory(jpeg.data(), length, &w, &h, &channels, 3), &stbi_image_free);
-  if (!pixels) {
-    error = "JPEG: cannot decode (" + stb_reason() + ")";
-    return false;
-  }
-  std::memcpy(rgb.data(), pixels.get(), std::size_t(width) * std::size_t(height) * 3);
+  // Into the caller's buffer directly. A warning (data cut short or
+  // corrupt, the rest painted grey) fails the frame as an error does: a
+  // camera's broken frame is not shown.
+  if (turbo_->decompress(turbo_->handle, jpeg.data(), length, rgb.data(), width, 0, height,
+                         TJPF_RGB, 0) != 0)
+    return refuse(error, "JPEG: cannot decode (" + turbo_->reason() + ")");
   return true;
 }
 

@@ -97,6 +97,14 @@ std::unique_ptr<CaptureStream> CaptureStream::open(const StreamRequest &request,
 
 bool CaptureStream::negotiate(const StreamRequest &request, std::string &error) {
   mjpeg_ = request.mjpeg;
+  if (mjpeg_ && !jpeg_) {
+    try {
+      jpeg_ = std::make_unique<jpeg::JpegDecoder>();
+    } catch (const jpeg::JpegError &e) {
+      error = e.what();
+      return false;
+    }
+  }
   const auto fourcc =
       mjpeg_ ? std::optional<std::uint32_t>(V4L2_PIX_FMT_MJPEG) : v4l2::fourcc_of(request.format);
   if (!fourcc) {
@@ -271,8 +279,8 @@ bool CaptureStream::decode(int index, std::uint32_t bytesused, std::string &erro
   const Buffer &buffer = buffers_[static_cast<std::size_t>(index)];
   const std::span<const std::uint8_t> jpeg(static_cast<const std::uint8_t *>(buffer.address),
                                            std::min<std::size_t>(bytesused, buffer.length));
-  return jpeg::decode_jpeg_rgb(jpeg, format_.width, format_.height,
-                               decoded_[static_cast<std::size_t>(index)], error);
+  return jpeg_->decode_rgb(jpeg, format_.width, format_.height,
+                           decoded_[static_cast<std::size_t>(index)], error);
 }
 
 CaptureStream::Dequeued CaptureStream::dequeue(v4l2_buffer &buffer) {

@@ -16,6 +16,7 @@
 #include <linux/videodev2.h>
 
 #include "camhead/base/video_format.h"
+#include "camhead/hal/jpeg/jpeg_frame.h"
 #include "camhead/hal/v4l2/device_file.h"
 
 namespace camhead::hal::camera {
@@ -99,6 +100,7 @@ private:
   bool streaming_ = false;
   bool mjpeg_ = false;
   std::vector<std::vector<std::uint8_t>> decoded_; // one rgb24 frame per buffer (MJPEG)
+  std::unique_ptr<jpeg::JpegDecoder> jpeg_;        // MJPEG: made at the negotiation
 };
 
 } // namespace camhead::hal::camera
