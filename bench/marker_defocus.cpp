@@ -22,9 +22,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "camhead/renderer/image.h"
-#include "camhead/renderer/image_io.h"
 #include "chart/chart_plot.h"
+#include "chart/chart_png.h"
 #include "synthetic_view.h"
 #include "tracking/marker_board.h"
 #include "tracking/marker_tracker.h"
@@ -155,10 +154,7 @@ int main(int argc, char **argv) {
                                   "blur diameter px (sharp at 0.25)", "mm", steps}};
   const chart::Canvas canvas = chart::plot_log_log(
       "ChArUco 9x6 of 10 cm at 2 m, 720x576, 35 mm, 1 DN noise: pose against defocus", panels);
-  camhead::renderer::Image image(canvas.width, canvas.height, 3);
-  for (std::size_t i = 0; i < canvas.rgb.size(); ++i)
-    image.data[i] = camhead::renderer::srgb_to_linear(canvas.rgb[i] / 255.0f);
-  camhead::renderer::write_image(out + ".png", image);
+  chart::write_png(out + ".png", canvas);
   std::printf("wrote %s.csv and %s.png\n", out.c_str(), out.c_str());
   return 0;
 }

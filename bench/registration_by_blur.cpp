@@ -29,10 +29,9 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
-#include "camhead/renderer/image.h"
-#include "camhead/renderer/image_io.h"
 #include "camhead/renderer/scene_loader.h"
 #include "chart/chart_plot.h"
+#include "chart/chart_png.h"
 #include "config/board.h"
 #include "tracking/marker_board.h"
 #include "tracking/pose_trace.h"
@@ -204,10 +203,7 @@ int run(int argc, char **argv) {
                                     {series[2], series[3]}}};
     const chart::Canvas canvas =
         chart::plot_log_log("Moving rig: registration by the board's blur", panels, 480, 400);
-    camhead::renderer::Image image(canvas.width, canvas.height, 3);
-    for (std::size_t i = 0; i < canvas.rgb.size(); ++i)
-      image.data[i] = camhead::renderer::srgb_to_linear(canvas.rgb[i] / 255.0f);
-    camhead::renderer::write_image(out + ".png", image);
+    chart::write_png(out + ".png", canvas);
     std::printf("\nwrote %s.csv and %s.png\n", out.c_str(), out.c_str());
   }
   return 0;

@@ -37,6 +37,7 @@
 #include "chart/chart_errors.h"
 #include "chart/chart_methods.h"
 #include "chart/chart_plot.h"
+#include "chart/chart_png.h"
 #include "cli/commands.h"
 
 namespace camhead::cli {
@@ -226,10 +227,7 @@ void write_chart(const SceneRun &run, const std::vector<const chart::Method *> &
                             std::to_string(run.height) + ", " + device + ", reference " +
                             std::to_string(run.reference.rpp) + " rpp, points labelled with rpp";
   const chart::Canvas canvas = chart::plot_log_log(title, panels, 640, 480);
-  Image image(canvas.width, canvas.height, 3);
-  for (std::size_t i = 0; i < canvas.rgb.size(); ++i)
-    image.data[i] = srgb_to_linear(canvas.rgb[i] / 255.0f);
-  write_image(png, image);
+  chart::write_png(png, canvas);
 }
 
 int run_chart(const ChartArgs &args) {

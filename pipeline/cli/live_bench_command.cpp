@@ -32,11 +32,10 @@
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/frame_settings.h"
-#include "camhead/renderer/image.h"
-#include "camhead/renderer/image_io.h"
 #include "camhead/renderer/influence_region.h"
 #include "camhead/renderer/scene_loader.h"
 #include "chart/chart_plot.h"
+#include "chart/chart_png.h"
 #include "cli/commands.h"
 #include "config/data_dir.h"
 
@@ -232,12 +231,8 @@ std::string fmt(double v, const char *f = "%.4f") {
   return buf;
 }
 
-// Writes an 8-bit sRGB canvas as a PNG (image_io takes linear light).
 void write_canvas(const fs::path &png, const chart::Canvas &canvas) {
-  Image image(canvas.width, canvas.height, 3);
-  for (std::size_t i = 0; i < canvas.rgb.size(); ++i)
-    image.data[i] = srgb_to_linear(canvas.rgb[i] / 255.0f);
-  write_image(png, image);
+  chart::write_png(png, canvas);
   std::printf("wrote %s\n", png.string().c_str());
 }
 

@@ -62,9 +62,12 @@ void append(void *context, void *data, int size) {
 
 JpegDecoder::JpegDecoder() : turbo_(std::make_unique<Turbo>()) {
   turbo_->library = dlopen(CAMHEAD_TURBOJPEG_SONAME, RTLD_NOW | RTLD_LOCAL);
-  if (turbo_->library == nullptr)
-    throw JpegError("MJPEG needs libjpeg-turbo: " + std::string(dlerror()) +
+  if (turbo_->library == nullptr) {
+    const char *why = dlerror();
+    throw JpegError("MJPEG needs libjpeg-turbo: " +
+                    std::string(why != nullptr ? why : CAMHEAD_TURBOJPEG_SONAME " does not open") +
                     " (apt-get install libturbojpeg0)");
+  }
   if (!resolve(turbo_->library, "tjInitDecompress", turbo_->init) ||
       !resolve(turbo_->library, "tjDecompressHeader3", turbo_->header) ||
       !resolve(turbo_->library, "tjDecompress2", turbo_->decompress) ||
