@@ -86,7 +86,7 @@ bool JpegDecoder::refuse(std::string &error, std::string reason) {
   // libjpeg-turbo 2.1 can leave a decompressor mid-header after a frame cut
   // short in its tables (the header then "reads" as 0x0), and the next
   // frame's tables are misread ("Bogus Huffman table definition"): after a
-  // frame it refused, the next one gets a fresh decompressor. Without
+  // frame it could not read, the next one gets a fresh decompressor. Without
   // memory for one, every later frame is refused.
   turbo_->destroy(turbo_->handle);
   turbo_->handle = turbo_->init();
@@ -112,15 +112,17 @@ bool JpegDecoder::decode_rgb(std::span<const std::uint8_t> jpeg, int width, int 
     return refuse(error, "JPEG: not a JPEG frame (" + turbo_->reason() + ")");
   if (w <= 0 || h <= 0)
     return refuse(error, "JPEG: not a JPEG frame (no frame header)");
-  if (w != width || h != height)
-    return refuse(error, "JPEG: the frame is " + std::to_string(w) + "x" + std::to_string(h) +
-                             ", not " + std::to_string(width) + "x" + std::to_string(height));
+  if (w != width || h != height) { // a header read whole: the decompressor is sound
+    error = "JPEG: the frame is " + std::to_string(w) + "x" + std::to_string(h) + ", not " +
+            std::to_string(width) + "x" + std::to_string(height);
+    return false;
+  }
   if (rgb.size() < std::size_t(width) * std::size_t(height) * 3) {
     error = "JPEG: the buffer holds " + std::to_string(rgb.size()) + " bytes, not a " +
             std::to_string(width) + "x" + std::to_string(height) + " RGB frame";
     return false;
   }
-  // Into the caller's buffer directly. A warning (data cut short or
+  // A warning (data cut short or
   // corrupt, the rest painted grey) fails the frame as an error does: a
   // camera's broken frame is not shown.
   if (turbo_->decompress(turbo_->handle, jpeg.data(), length, rgb.data(), width, 0, height,
