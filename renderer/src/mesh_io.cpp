@@ -16,16 +16,8 @@
 #include <system_error>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#if !defined(__clang__) // GCC only; clang rejects the unknown group
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
 #define TINYOBJLOADER_IMPLEMENTATION
 #include <tiny_obj_loader.h>
-#pragma GCC diagnostic pop
 
 #include "camhead/base/input_file.h"
 #include "mesh_common.h"
