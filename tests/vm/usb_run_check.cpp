@@ -295,10 +295,19 @@ int main(int argc, char **argv) {
   }
   camhead::vm::print_result("usb_replug_100", problem.empty(), detail);
   if (!problem.empty()) {
+    // Its first lines (what it opened) and its last (the status lines
+    // before the end and the summary, whose drops name their cause).
     std::ifstream log(kDir / "run.log");
-    std::string line;
-    for (int n = 0; n < 40 && std::getline(log, line); ++n)
-      std::printf("LAB usb_run: camhead: %s\n", line.c_str());
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(log, line);)
+      lines.push_back(std::move(line));
+    constexpr std::size_t kHead = 3, kTail = 12;
+    for (std::size_t n = 0; n < lines.size(); ++n) {
+      if (n == kHead && lines.size() > kHead + kTail)
+        std::printf("LAB usb_run: camhead: (%zu lines left out)\n", lines.size() - kHead - kTail);
+      if (n < kHead || n + kTail >= lines.size())
+        std::printf("LAB usb_run: camhead: %s\n", lines[n].c_str());
+    }
   }
   return problem.empty() ? 0 : 1;
 }
