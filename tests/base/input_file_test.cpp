@@ -24,7 +24,8 @@ protected:
 
 TEST_F(InputFile, ReadsTheWholeFileUpToItsBound) {
   const std::filesystem::path file = dir_ / "a.bin";
-  const std::string bytes = std::string("\0\r\n\xff", 4) + std::string(200000, 'x');
+  std::string bytes("\0\r\n\xff", 4);
+  bytes.append(200000, 'x');
   std::ofstream(file, std::ios::binary) << bytes;
   std::string error;
   EXPECT_EQ(read_input_file(file, bytes.size(), error), bytes);

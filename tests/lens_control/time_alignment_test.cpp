@@ -3,6 +3,7 @@
 // then the whole chain from raw samples to a LensState for a frame.
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -16,6 +17,11 @@ namespace camhead::lens_control {
 namespace {
 
 constexpr std::int64_t kMs = 1'000'000;
+
+// One of the example lens profiles in the source tree.
+std::filesystem::path example_lens(const char *file) {
+  return std::filesystem::path(CAMHEAD_SOURCE_DIR) / "scenes/lenses" / file;
+}
 
 TEST(TimeAlignment, MidExposure) {
   EXPECT_EQ(mid_exposure_ns(1000 * kMs, 20 * kMs), 1010 * kMs);
@@ -116,8 +122,7 @@ TEST(LensTracker, FrameStateFromRawSamples) {
   LensTrackerConfig cfg;
   cfg.focus.timeline.delay_ns = 5 * kMs;
   cfg.iris.timeline.delay_ns = 0;
-  LensTracker tracker(
-      LensProfile::load(std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/example_35mm.json"), cfg);
+  LensTracker tracker(LensProfile::load(example_lens("example_35mm.json")), cfg);
   // No samples yet: rest values, nothing fresh.
   const LensState rest = tracker.state_at(0);
   EXPECT_EQ(rest.focus_distance_m.value, std::numeric_limits<double>::infinity());
@@ -183,8 +188,7 @@ TEST(LensTracker, CountsWinWithAProfileValuesWithout) {
   EncoderSample both = counts_at(0, 9400, 1900);
   both.focus_distance_m = 5.0;
   both.f_number = 8.0;
-  LensTracker profiled(
-      LensProfile::load(std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/example_35mm.json"));
+  LensTracker profiled(LensProfile::load(example_lens("example_35mm.json")));
   profiled.push(both);
   EXPECT_NEAR(profiled.state_at(0).focus_distance_m.value, 2.0, 1e-9); // the 2 m mark
   EXPECT_NEAR(profiled.state_at(0).f_number.value, 4.0, 1e-9);
@@ -199,9 +203,8 @@ TEST(LensTracker, CountsWinWithAProfileValuesWithout) {
 // the state is the one a tracker fed the same samples under the new profile
 // gives, at once and without a sample lost.
 TEST(LensTracker, ASwappedProfileMapsTheSameHistory) {
-  const std::string lenses = std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/";
-  const LensProfile prime = LensProfile::load(lenses + "example_35mm.json");
-  const LensProfile zoom = LensProfile::load(lenses + "example_zoom_24_70.json");
+  const LensProfile prime = LensProfile::load(example_lens("example_35mm.json"));
+  const LensProfile zoom = LensProfile::load(example_lens("example_zoom_24_70.json"));
   LensTracker swapped(prime), fresh(zoom);
   for (std::int64_t t = 0; t <= 200 * kMs; t += 10 * kMs) {
     const EncoderSample s = counts_at(t, std::int32_t(6000 + t / kMs * 10), 1900, 3000);
@@ -223,8 +226,7 @@ TEST(LensTracker, ASwappedProfileMapsTheSameHistory) {
 // A focus sent as a distance still breathes as the profile says: the
 // projection focal length at 2 m is the one the counts at the 2 m mark give.
 TEST(LensTracker, AFocusValueBreathesAsTheProfileSays) {
-  const LensProfile profile =
-      LensProfile::load(std::string(CAMHEAD_SOURCE_DIR) + "/scenes/lenses/example_35mm.json");
+  const LensProfile profile = LensProfile::load(example_lens("example_35mm.json"));
   LensTracker by_value(profile);
   EncoderSample value = counts_at(0, std::nullopt, 1900);
   value.focus_distance_m = 2.0;

@@ -128,7 +128,7 @@ TEST(CalibrateCamera, TheCommandWritesTheCameraIntoTheProfile) {
   const fs::path profile = dir / "lens.json";
   fs::copy_file(fs::path(CAMHEAD_SOURCE_DIR) / "scenes/lenses/example_35mm.json", profile);
   const auto run = [&](const std::vector<std::string> &files) {
-    std::string command = std::string(CAMHEAD_BINARY) + " calibrate camera";
+    std::string command = CAMHEAD_BINARY " calibrate camera";
     for (const std::string &f : files)
       command += " '" + f + "'";
     command += " --board '" + (dir / "floor.json").string() + "' --profile '" + profile.string() +

@@ -66,11 +66,11 @@ TEST(Y4mRoundTrip, Nv12OddSizedChromaRows) {
 TEST(Y4mRoundTrip, Planar420IsInterleavedAsNv12) {
   const test::ScratchDir dir;
   // No XCOLORRANGE (limited); FRAME parameters are allowed and ignored.
-  test::write_text(dir / "jpeg.y4m", std::string("YUV4MPEG2 W4 H2 F25:1 Ip C420jpeg\n"
-                                                 "FRAME Ixyz\n") +
-                                         "\x01\x02\x03\x04\x05\x06\x07\x08"
-                                         "\x64\x65"
-                                         "\xc8\xc9");
+  test::write_text(dir / "jpeg.y4m", "YUV4MPEG2 W4 H2 F25:1 Ip C420jpeg\n"
+                                     "FRAME Ixyz\n"
+                                     "\x01\x02\x03\x04\x05\x06\x07\x08"
+                                     "\x64\x65"
+                                     "\xc8\xc9");
   auto camera = play_once(dir / "jpeg.y4m");
   EXPECT_EQ(camera->format(), test::make_format(PixelFormat::nv12, 4, 2, ColorRange::limited));
   const auto read = test::read_all(*camera);
@@ -80,11 +80,11 @@ TEST(Y4mRoundTrip, Planar420IsInterleavedAsNv12) {
 
 TEST(Y4mRoundTrip, Planar422IsPackedAsYuyv) {
   const test::ScratchDir dir;
-  test::write_text(dir / "422.y4m", std::string("YUV4MPEG2 W4 H1 F50:1 Ip A1:1 C422 "
-                                                "XCOLORRANGE=FULL\nFRAME\n") +
-                                        "\x01\x02\x03\x04"
-                                        "\x64\x65"
-                                        "\xc8\xc9");
+  test::write_text(dir / "422.y4m", "YUV4MPEG2 W4 H1 F50:1 Ip A1:1 C422 "
+                                    "XCOLORRANGE=FULL\nFRAME\n"
+                                    "\x01\x02\x03\x04"
+                                    "\x64\x65"
+                                    "\xc8\xc9");
   auto camera = play_once(dir / "422.y4m");
   EXPECT_EQ(camera->format(), test::make_format(PixelFormat::yuyv, 4, 1, ColorRange::full));
   EXPECT_EQ(camera->frame_interval_ns(), 20'000'000);
