@@ -114,9 +114,8 @@ bool JpegDecoder::decode_rgb(std::span<const std::uint8_t> jpeg, int width, int 
             std::to_string(width) + "x" + std::to_string(height) + " RGB frame";
     return false;
   }
-  // A warning (data cut short or
-  // corrupt, the rest painted grey) fails the frame as an error does: a
-  // camera's broken frame is not shown.
+  // A warning (data cut short or corrupt, the rest painted grey) fails the
+  // frame as an error does: a camera's broken frame is not shown.
   if (turbo_->decompress(turbo_->handle, jpeg.data(), length, rgb.data(), width, 0, height,
                          TJPF_RGB, 0) != 0)
     return refuse(error, "JPEG: cannot decode (" + turbo_->reason() + ")");
