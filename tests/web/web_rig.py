@@ -79,13 +79,15 @@ class Run:
         return json.loads(body)
 
     def wait_frames(self, count, headers=None, timeout=60):
+        """Until the newest composite went out as output frame `count` or later
+        (repeats and placeholders take indices too)."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             frame = self.state(headers).get("frame")
             if frame and frame["frame"] >= count:
                 return
             time.sleep(0.2)
-        raise RuntimeError("the run sent fewer than %d composites in %d s" % (count, timeout))
+        raise RuntimeError("the outputs got fewer than %d frames in %d s" % (count, timeout))
 
     def stop(self):
         if self.process.poll() is None:
