@@ -108,6 +108,15 @@ CameraModel MarkerPoseSource::camera_of(const lens_control::LensState &lens) con
   camera.cx = double(model.principal_point.x) * format_.width - 0.5;
   camera.cy = double(model.principal_point.y) * format_.height - 0.5;
   camera.distortion = {model.k1, model.k2, model.p1, model.p2, model.k3};
+  // The renderer's thin lens (renderer/src/compiled_scene.cpp): an aperture
+  // f / N across, focused at S, spreads a point at depth z over
+  // f / N * fx * |1/S - 1/z| pixels. The tracker draws the board so blurred
+  // where it cannot read it.
+  const double f_m = lens.focal_length_mm.value * 1e-3, n = lens.f_number.value;
+  if (f_m > 0.0 && n > 0.0 && lens.focus_distance_m.value > 0.0) {
+    camera.focus_m = lens.focus_distance_m.value;
+    camera.defocus_px = f_m / n * camera.fx;
+  }
   return camera;
 }
 

@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -42,13 +43,18 @@ struct LumaImage {
 struct CameraModel {
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
   std::array<double, 5> distortion{};
+  // Its defocus (thin lens): a point z metres ahead of the lens, along its
+  // axis, is a disc of defocus_px * |1 / focus_m - 1 / z| pixels across.
+  // 0: not known, taken as sharp.
+  double focus_m = std::numeric_limits<double>::infinity();
+  double defocus_px = 0.0;
 };
 
 struct MarkerPose {
   bool found = false;           // enough of the board seen for a pose
   CameraPose pose;              // the camera in the scene's world, when found
   double reprojection_px = 0.0; // RMS distance of the points used from where the pose puts them
-  int markers_seen = 0;         // the board's markers detected
+  int markers_seen = 0;         // the board's markers detected (0 where aligned first)
   int points_used = 0;          // corners the pose was solved from
   // A planar target seen nearly head on has two poses that fit almost
   // equally well (the mirror flip): the one nearer the previous pose was
@@ -57,6 +63,10 @@ struct MarkerPose {
   // The board's markers were too blurred (defocus, motion) to read, and its
   // chessboard corners were followed from where the previous pose put them.
   bool followed = false;
+  // Neither its markers nor its corners could be read, and the whole board,
+  // drawn as the previous pose and the lens's defocus show it, was aligned
+  // with the picture.
+  bool aligned = false;
 };
 
 class MarkerTracker {
@@ -65,7 +75,9 @@ public:
   // The camera's pose in one picture. `previous`, where there is one (the
   // pose predicted for this picture from the last ones found), picks
   // between the two poses of an ambiguous planar view, and lets a ChArUco
-  // board be followed where its markers cannot be read. Never throws.
+  // board be followed where its markers cannot be read: its corners, or,
+  // blurred by `camera`'s defocus by 4 px or more there, the whole board
+  // aligned. Never throws.
   virtual MarkerPose track(const LumaImage &luma, const CameraModel &camera,
                            const CameraPose *previous) = 0;
 };

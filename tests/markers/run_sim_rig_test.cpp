@@ -2,8 +2,9 @@
 // markers (issue 25, "What must be shown" 2): the simulated camera films a
 // printed ChArUco board lying on a textured floor (the page OpenCV draws,
 // an albedo texture of the scene) while it dollies, pans and tilts along a
-// camera path and the lens pulls focus; `camhead run` finds the camera's
-// pose in each frame. Wherever a frame's pose came from the markers, the
+// camera path and the lens pulls focus, gently or deep into defocus;
+// `camhead run` finds the camera's pose in each frame, from the markers
+// read or from the whole board aligned. Wherever a frame's pose was found, the
 // points that register the virtual world to the real one (the board's
 // corners, a virtual ball standing on the floor behind it) land within
 // 1 px of where the path's true pose at that frame's mid-exposure puts
@@ -38,8 +39,23 @@ const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_TEST_MARKERS_
 constexpr int kWidth = 640, kHeight = 360;
 constexpr double kFocalPx = 35.0 / 36.0 * kWidth;
 
-TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) {
-  ASSERT_TRUE(kModuleFound);
+// What the run's composites say about the pose found in them.
+struct Registration {
+  int found = 0, aligned = 0; // aligned: found with fewer than 4 markers read
+  double worst_px = 0.0;      // over the frames whose pose was found
+  std::string not_found;      // those frames' records
+};
+
+// The rig: a dolly to the right and in, panning left and tilting down, and
+// back, filmed 10 frames a second, not in real time; the lens pulls focus
+// as `lens_trace` says. The board's outer corners and a virtual ball's
+// centre and foot are where registration is measured.
+class MovingRig : public RunLoop {
+protected:
+  Registration run(const std::string &lens_trace) const;
+};
+
+Registration MovingRig::run(const std::string &lens_trace) const {
   const fs::path markers = write("board.json", R"({"format": "camhead-markers", "version": 1,
       "name": "floor board", "type": "charuco", "dictionary": "4X4_50", "squares": [7, 5],
       "square_m": 0.15, "marker_m": 0.11})");
@@ -48,16 +64,12 @@ TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) 
   for (std::size_t i = 0; i < page.grey.size(); ++i)
     image.data[i] = page.grey[i] == 0 ? 0.0f : 1.0f;
   renderer::write_image(dir_ / "page.png", image);
-  // A dolly to the right and in, panning left and tilting down, and back.
   const fs::path path = write("dolly.csv", "# camhead pose trace v1\n"
                                            "t_s,x_m,y_m,z_m,pan_deg,tilt_deg,roll_deg\n"
                                            "0,0.35,1.45,1.75,0,-40,0\n"
                                            "1,0.75,1.4,1.45,-9,-42,1\n"
                                            "2,0.35,1.45,1.75,0,-40,0\n");
-  // Focus pulled from 1.6 to 2.6 m and back at f/8 (the board is 1.9-2.4 m
-  // away): blur circles up to 1.5 px.
-  const fs::path lens = write("lens.csv", "# camhead lens trace v1\nt_s,focus_m,f_stop,focal_mm\n"
-                                          "0,1.6,8,35\n1,2.6,8,35\n2,1.6,8,35\n");
+  const fs::path lens = write("lens.csv", lens_trace);
   const fs::path scene =
       write("scene.json", R"({"render": {"width": 640, "height": 360, "samples": 4},
       "camera": {"position": [0.35, 1.45, 1.75], "look_at": [0.5, 0, 0.3], "up": [0, 1, 0],
@@ -94,38 +106,67 @@ TEST_F(RunLoop, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) 
   options.status = nullptr;
   (void)run_pipeline(options);
 
-  // The board's outer corners and the ball's centre and foot.
   const std::vector<glm::dvec3> points = {{0, 0, 0},       {1.05, 0, 0},     {0, 0, 0.75},
                                           {1.05, 0, 0.75}, {0.3, 0.2, -0.3}, {0.3, 0, -0.3}};
   const PoseTrace truth = load_pose_trace(path);
   std::ifstream stats(dir_ / "stats.jsonl");
-  int found = 0;
-  double worst = 0.0;
-  std::string not_found; // the records of frames whose pose was not found
+  Registration out;
   for (std::string line; std::getline(stats, line);) {
     if (line.find("\"kind\":\"composite\"") == std::string::npos)
       continue;
     if (line.find("\"pose_fresh\":true") == std::string::npos) {
-      not_found += line + "\n";
+      out.not_found += line + "\n";
       continue;
     }
-    EXPECT_GE(json_number(line, "markers_seen"), 4.0) << line;
     const CameraPose truth_pose = truth.at(std::int64_t(json_number(line, "exposure_mid_ns")));
     const CameraPose seen = json_pose(line);
     double off = 0.0;
     for (const glm::dvec3 &p : points)
       off = std::max(off, glm::length(pinhole_pixel(seen, p, kWidth, kHeight, kFocalPx) -
                                       pinhole_pixel(truth_pose, p, kWidth, kHeight, kFocalPx)));
-    EXPECT_LT(off, 1.0) << "output frame " << json_number(line, "output_frame") << ": " << line;
-    worst = std::max(worst, off);
-    ++found;
+    out.worst_px = std::max(out.worst_px, off);
+    ++out.found;
+    out.aligned += json_number(line, "markers_seen") < 4.0 ? 1 : 0;
   }
-  std::printf("%d frames with the pose from the markers: registration within %.3f px\n", found,
-              worst);
+  return out;
+}
+
+// Focus pulled from 1.6 to 2.6 m and back at f/8 (the board is 1.9-2.4 m
+// away): blur circles up to 1.5 px, every frame's pose read from the
+// markers, within 1 px.
+TEST_F(MovingRig, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull) {
+  ASSERT_TRUE(kModuleFound);
+  const Registration r = run("# camhead lens trace v1\n"
+                             "t_s,focus_m,f_stop,focal_mm\n"
+                             "0,1.6,8,35\n1,2.6,8,35\n2,1.6,8,35\n");
+  std::printf("%d frames with the pose from the markers: registration within %.3f px\n", r.found,
+              r.worst_px);
   // Filmed not in real time, so every frame waits for its tracker: under
   // load too, each one's pose is the markers' (in real time a late tracker
   // sends the frame out with the predicted pose: run_markers_test's).
-  EXPECT_EQ(found, 10) << "frames whose pose did not come from the markers:\n" << not_found;
+  EXPECT_EQ(r.found, 10) << "frames whose pose did not come from the markers:\n" << r.not_found;
+  EXPECT_EQ(r.aligned, 0) << "read from the markers, not aligned";
+  EXPECT_LT(r.worst_px, 1.0);
+}
+
+// The same move with the focus pulled in to 0.5 m at f/2 from the first
+// frame on (sharp at 2 m only there): the board, 1.9-2.4 m away, is a blur
+// of 12-17 px, far past reading its markers or following its corners. Its
+// pose is found in every later frame by aligning the board drawn with the
+// lens's blur, within the 1 px of a sharp board here (0.74 px; the moving
+// rig, at 720x576 and 10-27 px: 0.7 px median, 2.3 px worst,
+// bench/RESULTS.md, "Registration through defocus").
+TEST_F(MovingRig, TheMarkerPoseFollowsTheBoardThroughADeepDefocus) {
+  ASSERT_TRUE(kModuleFound);
+  const Registration r = run("# camhead lens trace v1\n"
+                             "t_s,focus_m,f_stop,focal_mm\n"
+                             "0,2,8,35\n0.1,0.5,2,35\n2,0.5,2,35\n");
+  std::printf("%d frames with the pose from the markers, %d of them aligned: registration within "
+              "%.3f px\n",
+              r.found, r.aligned, r.worst_px);
+  EXPECT_EQ(r.found, 10) << "frames whose pose was not found:\n" << r.not_found;
+  EXPECT_GE(r.aligned, 8);
+  EXPECT_LT(r.worst_px, 1.0);
 }
 
 // The moving simulated rig (board/sim-moving.json) films the board its
