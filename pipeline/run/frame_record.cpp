@@ -45,7 +45,8 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
       ",\"encode_ms\":%.3f,\"executor\":%s,\"pose_source\":%s,\"pose_fresh\":%s"
       ",\"pose\":{\"position\":[%.7g,%.7g,%.7g],\"forward\":[%.6g,%.6g,%.6g]"
-      ",\"up\":[%.6g,%.6g,%.6g]},\"markers_seen\":%d,\"reprojection_px\":%s"
+      ",\"up\":[%.6g,%.6g,%.6g]},\"markers_seen\":%d,\"pose_found_by\":%s%s%s"
+      ",\"reprojection_px\":%s"
       ",\"track_ms\":%.3f,\"pose_wait_ms\":%.3f}\n",
       output_frame, r.sequence, r.setup, r.capture_ns, r.exposure_mid_ns, r.delivered_ns,
       r.render_start_ns, r.render_end_ns, output_ns,
@@ -54,7 +55,8 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       r.history_samples, r.reprojected_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
       1e3 * r.trace_s, 1e3 * r.encode_s, run.executor.c_str(), run.pose_source.c_str(),
       r.pose_fresh ? "true" : "false", r.position.x, r.position.y, r.position.z, r.forward.x,
-      r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z, r.markers_seen, reprojection,
+      r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z, r.markers_seen, r.pose_found_by ? "\"" : "",
+      r.pose_found_by ? r.pose_found_by : "null", r.pose_found_by ? "\"" : "", reprojection,
       1e3 * r.track_s, 1e3 * r.pose_wait_s);
   std::fflush(out);
 }

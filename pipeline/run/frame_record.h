@@ -32,6 +32,7 @@ struct FrameRecord {
   // distance of the corners used from where the pose puts them (NaN: none).
   int markers_seen = 0;
   double reprojection_px = std::numeric_limits<double>::quiet_NaN();
+  const char *pose_found_by = nullptr; // FramePose::found_by: a literal, or null
   // The tracker's time on the frame, and how long rendering it waited for
   // the tracker (marker poses; 0 otherwise).
   double track_s = 0.0, pose_wait_s = 0.0;

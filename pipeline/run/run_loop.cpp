@@ -230,6 +230,7 @@ PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
       markers_->pose_for(sequence, record.exposure_mid_ns, deadline, setup_->rest_pose);
   record.markers_seen = found.markers_seen;
   record.reprojection_px = found.reprojection_px;
+  record.pose_found_by = found.found_by;
   record.track_s = found.track_s;
   record.pose_wait_s = found.wait_s;
   return {found.pose, found.fresh};

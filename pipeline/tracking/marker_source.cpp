@@ -205,6 +205,9 @@ FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_ex
       out.pose = result->pose.pose;
       out.fresh = true;
       out.reprojection_px = result->pose.reprojection_px;
+      out.found_by = result->pose.aligned    ? "alignment"
+                     : result->pose.followed ? "corners"
+                                             : "markers";
       return out;
     }
   }

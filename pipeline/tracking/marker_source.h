@@ -57,6 +57,10 @@ struct FramePose {
   bool fresh = false; // found in this very frame
   int markers_seen = 0;
   double reprojection_px = std::numeric_limits<double>::quiet_NaN(); // NaN: not found
+  // How the tracker found it: "markers" (read), "corners" (followed from
+  // the pose before), "alignment" (the whole board drawn blurred and
+  // aligned: marker_tracker.h); null when not found in the frame.
+  const char *found_by = nullptr;
   // The tracker's time on this frame (0: not tracked), and how long the
   // render thread waited for it in pose_for(): the latency tracking adds.
   double track_s = 0.0, wait_s = 0.0;

@@ -255,6 +255,7 @@ std::string OperatorPage::state_json(const web_module::HttpStats &http) {
                      {"forward", vec(r.forward)},
                      {"up", vec(r.up)},
                      {"markers_seen", r.markers_seen},
+                     {"found_by", r.pose_found_by ? json(r.pose_found_by) : json(nullptr)},
                      {"reprojection_px", number(r.reprojection_px)}};
   } else {
     state["frame"] = nullptr;

@@ -195,6 +195,7 @@ TEST_P(RunMarkersLens, EachFramesPoseIsFoundInThatFrame) {
       worst_deg = std::max(worst_deg, deg);
       EXPECT_NE(line.find("\"pose_fresh\":true"), std::string::npos) << "frame " << k;
       EXPECT_GT(json_number(line, "markers_seen"), 15.0) << "frame " << k;
+      EXPECT_NE(line.find("\"pose_found_by\":\"markers\""), std::string::npos) << "frame " << k;
       EXPECT_LT(mm, 2.0) << "frame " << k << ": " << line;
       EXPECT_LT(deg, 0.1) << "frame " << k;
       ++checked;
@@ -204,6 +205,7 @@ TEST_P(RunMarkersLens, EachFramesPoseIsFoundInThatFrame) {
       EXPECT_NE(line.find("\"pose_fresh\":false"), std::string::npos) << "frame " << k;
       EXPECT_NE(line.find("\"markers_seen\":0"), std::string::npos) << "frame " << k;
       EXPECT_NE(line.find("\"reprojection_px\":null"), std::string::npos) << "frame " << k;
+      EXPECT_NE(line.find("\"pose_found_by\":null"), std::string::npos) << "frame " << k;
       const glm::dvec3 last = truth_at(kBoardFrames - 1).position;
       const glm::dvec3 predicted = last + 0.5 * (last - truth_at(kBoardFrames - 2).position);
       // Two measured poses extrapolated by half their step: their errors,

@@ -56,7 +56,10 @@ function show(state) {
     text('traced', (100 * frame.traced).toFixed(0) + ' %');
   }
   const pose = state.pose;
-  health($('pose'), pose.fresh !== false, pose.source + (pose.fresh === false ? ', held' : ''),
+  // A marker pose says how it was found: markers read, corners followed or
+  // the blurred board aligned.
+  health($('pose'), pose.fresh !== false,
+         pose.source + (pose.fresh === false ? ', held' : pose.found_by ? ', by ' + pose.found_by : ''),
          pose.source + ', held (stale)');
   text('in-fps', fixed(state.in_fps, 1));
   text('out-fps', fixed(state.out_fps, 1));
