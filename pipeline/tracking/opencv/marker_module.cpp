@@ -65,13 +65,16 @@ constexpr int kMinRefineHalfWindow = 2, kMaxRefineHalfWindow = 8;
 constexpr float kFollowWindow = 1.0f / 5.0f;
 constexpr int kMaxFollowHalfWindow = 24;
 constexpr double kNoLimit = std::numeric_limits<double>::infinity();
-// A board aligned whole (align_board): on a picture reduced by 2, 4 or 8,
-// whichever leaves the board's blur 2-4 pixels across; kept if its drawing
-// and the picture correlate this well (ECC's coefficient, 1 for a perfect
-// match up to the light's gain and offset), and if no corner moved by more
-// than this fraction of a square from where the previous pose put it (a
-// chessboard looks alike one square over: no slipping into that). Two
-// passes, the second from the first's pose.
+// A board aligned whole (align_board): from this much blur on (below it,
+// reading or following its corners is as near the truth); on a picture
+// reduced by 2 or 4, whichever leaves the board's blur 2-4 pixels across
+// (by 8 the board was 300 pixels and the pose walked: bench/RESULTS.md,
+// "Registration through defocus"); kept if its drawing and the picture
+// correlate this well (ECC's coefficient, 1 for a perfect match up to the
+// light's gain and offset; 0.96-0.99 on the rig and the synthetic board),
+// and if no corner moved by more than this fraction of a square from where
+// the previous pose put it (a chessboard looks alike one square over: no
+// slipping into that). Two passes, the second from the first's pose.
 constexpr double kAlignFromBlurPx = 4.0;
 constexpr int kMaxAlignLevel = 2;
 constexpr double kMinAlignCorrelation = 0.8;
@@ -460,6 +463,8 @@ private:
     return true;
   }
 
+  // One pass: the board drawn from (rvec, tvec) and aligned; the corners
+  // it moves into object_ and image_points_.
   bool align_once(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion,
                   const cv::Vec3d &rvec, const cv::Vec3d &tvec, double blur) {
     const std::vector<cv::Point3f> &corners = charuco_->chessboardCorners;
