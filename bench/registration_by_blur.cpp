@@ -15,14 +15,19 @@
 //   build/bench/registration_by_blur board/sim-moving.json m.jsonl [OUT]
 //
 // Prints a table by blur (frames, median and worst registration, median
-// reprojection error); OUT.csv gets a row per frame and OUT.png the scatter.
+// reprojection error), then one by how each pose was found (on the board
+// and at the virtual objects, and how far the registration jumps from one
+// composite to the next); OUT.csv gets a row per frame and OUT.png the
+// chart.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -49,6 +54,15 @@ struct Frame {
   double registration = 0; // px, the largest over the points
   double reprojection = 0; // px, the tracker's own residual
   int markers = 0;
+  // The largest registration on the board's own outer corners and at the
+  // virtual objects' centres (farther from the board, where an error of
+  // the board's tilt grows).
+  double on_board = 0, at_virtual = 0;
+  // The largest change of a point's registration since the composite
+  // before, px: how far the virtual world jumps against the real one (the
+  // camera's own motion taken out).
+  double jump = 0;
+  const char *found_by = "";
 };
 
 CameraPose recorded_pose(const nlohmann::json &pose) {
@@ -106,9 +120,11 @@ int run(int argc, char **argv) {
   const double sx = markers.squares_x * markers.square_m, sz = markers.squares_y * markers.square_m;
   const glm::dvec3 centre(sx / 2, 0, sz / 2);
   std::vector<glm::dvec3> points = {{0, 0, 0}, {sx, 0, 0}, {0, 0, sz}, {sx, 0, sz}};
+  const std::size_t board_points = points.size();
   for (const auto &object : scene.objects)
     if (!object.real)
       points.emplace_back(object.center);
+  std::vector<glm::dvec2> error_before(points.size());
 
   std::ifstream in(argv[2]);
   if (!in)
@@ -138,10 +154,27 @@ int run(int argc, char **argv) {
                                                      : r.at("focus_m").get<double>();
     f.blur_px = blur_px(depth, focus_m, r.at("f_number").get<double>(), focal_mm,
                         board.camera->sensor_width_mm, width);
-    for (const glm::dvec3 &p : points)
-      f.registration =
-          std::max(f.registration, glm::length(pixel(seen, p, width, height, focal_px) -
-                                               pixel(real, p, width, height, focal_px)));
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const glm::dvec2 error = pixel(seen, points[i], width, height, focal_px) -
+                               pixel(real, points[i], width, height, focal_px);
+      double &part = i < board_points ? f.on_board : f.at_virtual;
+      part = std::max(part, glm::length(error));
+      if (!frames.empty())
+        f.jump = std::max(f.jump, glm::length(error - error_before[i]));
+      error_before[i] = error;
+      if (std::getenv("SIGNED") && i < board_points)
+        std::fprintf(
+            stderr, "%s %.1f corner %zu err %+.2f %+.2f at %.0f %.0f\n",
+            r.at("pose_found_by").is_string() ? r.at("pose_found_by").get<std::string>().c_str()
+                                              : "-",
+            f.blur_px, i, error.x, error.y, pixel(real, points[i], width, height, focal_px).x,
+            pixel(real, points[i], width, height, focal_px).y);
+    }
+    f.registration = std::max(f.on_board, f.at_virtual);
+    if (const auto &by = r.at("pose_found_by"); by.is_string())
+      f.found_by = by.get<std::string>() == "markers"   ? "markers"
+                   : by.get<std::string>() == "corners" ? "corners"
+                                                        : "alignment";
     f.reprojection =
         r.at("reprojection_px").is_null() ? 0.0 : r.at("reprojection_px").get<double>();
     f.markers = r.value("markers_seen", 0);
@@ -192,14 +225,42 @@ int run(int argc, char **argv) {
     add(3, x, quantile(held, 1.0));
   }
 
+  // Where the error is and how it moves, by how the pose was found: a
+  // planar board pins its own corners better than points off it, and a
+  // pose measured afresh each frame jitters (the jump).
+  std::printf("\n| found by | frames | on the board: median, p90, worst | at the virtual objects: "
+              "median, p90, worst | within 1 px | jump since the composite before: median, p99, "
+              "worst |\n|---|---|---|---|---|---|\n");
+  for (const char *by : {"markers", "corners", "alignment"}) {
+    std::vector<double> board_px, virtual_px, jump_px;
+    std::size_t within = 0;
+    for (const Frame &f : frames)
+      if (f.found && std::string_view(f.found_by) == by) {
+        board_px.push_back(f.on_board);
+        virtual_px.push_back(f.at_virtual);
+        jump_px.push_back(f.jump);
+        within += f.registration <= 1.0 ? 1 : 0;
+      }
+    if (board_px.empty())
+      continue;
+    std::printf("| %s | %zu | %.2f, %.2f, %.2f px | %.2f, %.2f, %.2f px | %.1f %% | %.2f, %.2f, "
+                "%.2f px |\n",
+                by, board_px.size(), quantile(board_px, 0.5), quantile(board_px, 0.9),
+                quantile(board_px, 1.0), quantile(virtual_px, 0.5), quantile(virtual_px, 0.9),
+                quantile(virtual_px, 1.0), 100.0 * double(within) / double(board_px.size()),
+                quantile(jump_px, 0.5), quantile(jump_px, 0.99), quantile(jump_px, 1.0));
+  }
+
   if (argc == 4) {
     const std::string out = argv[3];
     std::ofstream csv(out + ".csv");
-    csv << "t_s,pose_found,blur_px,registration_px,reprojection_px,markers_seen\n";
+    csv << "t_s,pose_found,found_by,blur_px,registration_px,on_board_px,at_virtual_px,jump_px,"
+           "reprojection_px,markers_seen\n";
     for (const Frame &f : frames) {
-      char row[160];
-      std::snprintf(row, sizeof row, "%.4f,%d,%.4f,%.4f,%.4f,%d\n", f.t_s, int(f.found), f.blur_px,
-                    f.registration, f.reprojection, f.markers);
+      char row[200];
+      std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", f.t_s,
+                    int(f.found), f.found_by, f.blur_px, f.registration, f.on_board, f.at_virtual,
+                    f.jump, f.reprojection, f.markers);
       csv << row;
     }
     const chart::Panel panels[] = {{"pose found in the frame",
