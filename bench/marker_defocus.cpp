@@ -7,7 +7,8 @@
 // board's 2 m). For each D: how often a pose is found (and how often by
 // following the board's corners from the pose before, or by aligning the
 // whole board drawn blurred, its markers unreadable), its median and worst
-// position and orientation error, and the largest step between the poses of
+// position and orientation error, how far it puts the board's outer corners
+// in the picture (median and worst), and the largest step between the poses of
 // consecutive frames of the still camera (what a viewer sees as a jump).
 //
 //   build/bench/marker_defocus bench/marker_defocus   (writes .csv and .png)
@@ -77,13 +78,26 @@ int main(int argc, char **argv) {
   const glm::dvec3 directions[] = {{0.0, 1.2, 1.6}, {0.6, 1.3, 1.4}, {0.1, 0.75, 1.8}};
   const double diameters[] = {0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0};
   const auto tracker = open_marker_tracker(board);
+  // How far a pose puts the board's outer corners from where the truth
+  // does, pixels, the worst of them: what a viewer sees (a camera position
+  // off along a planar board's weak direction moves them little).
+  const auto corners_px = [&](const CameraPose &pose, const CameraPose &truth) {
+    const double w = board.squares_x * board.square_m, h = board.squares_y * board.square_m;
+    const auto pixel = [&](const CameraPose &at, const glm::dvec3 &p) {
+      const glm::dvec3 v = glm::inverse(at.orientation) * (p - at.position);
+      return glm::dvec2(camera.cx + camera.fx * v.x / -v.z, camera.cy - camera.fy * v.y / -v.z);
+    };
+    double worst = 0.0;
+    for (const glm::dvec3 &corner :
+         {glm::dvec3(0.0), glm::dvec3(w, 0.0, 0.0), glm::dvec3(0.0, 0.0, h), glm::dvec3(w, 0.0, h)})
+      worst = std::max(worst, glm::length(pixel(pose, corner) - pixel(truth, corner)));
+    return worst;
+  };
   std::mt19937 random(7);
 
   std::ofstream csv(out + ".csv");
   csv << "blur_px,view,found,followed,aligned,frames,median_mm,worst_mm,median_deg,worst_deg,"
-         "largest_step_"
-         "mm,"
-         "markers_median\n";
+         "largest_step_mm,markers_median,median_px,worst_px\n";
   std::vector<chart::Series> position(3), steps(3);
   const chart::Rgb colors[] = {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}};
   const char *names[] = {"from the bottom edge", "from the right", "shallow"};
@@ -111,7 +125,7 @@ int main(int argc, char **argv) {
       // which the tracker draws the board with where it cannot read it.
       CameraModel lens = camera;
       lens.defocus_px = 2.0 * d;
-      std::vector<double> mm, deg, step, markers;
+      std::vector<double> mm, deg, px, step, markers;
       std::optional<CameraPose> previous;
       if (start.found)
         previous = start.pose;
@@ -130,6 +144,7 @@ int main(int argc, char **argv) {
         aligned += got.aligned ? 1 : 0;
         mm.push_back(1000.0 * glm::length(got.pose.position - truth.position));
         deg.push_back(degrees_between(got.pose.orientation, truth.orientation));
+        px.push_back(corners_px(got.pose, truth));
         if (!first_step) // the first step is from the sharp frame's pose
           step.push_back(1000.0 * glm::length(got.pose.position - previous->position));
         first_step = false;
@@ -139,13 +154,13 @@ int main(int argc, char **argv) {
       csv << d << "," << v << "," << found << "," << followed << "," << aligned << "," << kFrames
           << "," << percentile(mm, 0.5) << "," << percentile(mm, 1.0) << "," << percentile(deg, 0.5)
           << "," << percentile(deg, 1.0) << "," << worst_step << "," << percentile(markers, 0.5)
-          << "\n";
+          << "," << percentile(px, 0.5) << "," << percentile(px, 1.0) << "\n";
       std::printf("blur %4.1f px, %-20s found %2d/%d (followed %2d, aligned %2d)  median %.3f mm  "
-                  "worst %.3f mm "
-                  " %.4f deg  "
-                  "largest step %.3f mm  markers %.0f\n",
+                  "worst %.3f mm  %.4f deg  corners %.2f / %.2f px  largest step %.3f mm  "
+                  "markers %.0f\n",
                   d, names[v], found, kFrames, followed, aligned, percentile(mm, 0.5),
-                  percentile(mm, 1.0), percentile(deg, 1.0), worst_step, percentile(markers, 0.5));
+                  percentile(mm, 1.0), percentile(deg, 1.0), percentile(px, 0.5),
+                  percentile(px, 1.0), worst_step, percentile(markers, 0.5));
       // Log axes: a sharp board at a quarter of a pixel.
       const double x = d > 0.0 ? d : 0.25;
       if (found > 0) {

@@ -36,8 +36,11 @@ constexpr std::size_t kMinCorners = 10;
 constexpr int kOutlineSteps = 8;
 constexpr int kMinAlignPixels = 200, kMaxAlignPixels = 8000;
 constexpr int kRayStep = 8;
+// At most this many samples a grid pixel along one axis: for a board
+// foreshortened 4 times or more (seen from 15 degrees above its plane).
+constexpr int kMaxSamples = 4;
 // The board's page, drawn once, halved down to 4 pixels a square: the
-// drawing samples the level with a square's size in the reduced picture.
+// drawing reads the level that its samples do not alias.
 constexpr int kPagePixelsPerSquare = 128, kSmallestPagePixelsPerSquare = 4;
 
 // A defocused lens's blur, a uniform disc `diameter` pixels across with its
@@ -56,6 +59,20 @@ cv::Mat disc(double diameter) {
       k.at<float>(y + r, x + r) = float(inside);
     }
   return k / cv::sum(k)[0];
+}
+
+// Where pixel (x, y) of a picture reduced by `scale`, cut to `roi`, is in the
+// whole picture of `size`: -0.5 to 0.5 from its centre, in picture widths
+// (so a gain's slope does not depend on the reduction).
+cv::Point2d across(const cv::Rect &roi, double scale, int x, int y, cv::Size size) {
+  return {((roi.x + x + 0.5) / scale - 0.5 * size.width) / size.width,
+          ((roi.y + y + 0.5) / scale - 0.5 * size.height) / size.width};
+}
+
+double shading_at(const cv::Vec2d &slope, const cv::Rect &roi, double scale, int x, int y,
+                  cv::Size size) {
+  const cv::Point2d u = across(roi, scale, x, y, size);
+  return std::max(0.05, 1.0 + slope[0] * u.x + slope[1] * u.y);
 }
 
 } // namespace
@@ -124,6 +141,7 @@ bool BoardAligner::align(const cv::Mat &image, const cv::Matx33d &k, const cv::M
   if (!std::isfinite(blur))
     return false; // too little of the board in the picture
   picture_size_ = image.size();
+  shading_ = {0.0, 0.0};
   for (int pass = 0; pass < kAlignPasses; ++pass) {
     if (!align_once(image, k, distortion, rvec, tvec, blur, object, image_points))
       return false;
@@ -179,28 +197,45 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
   reduced_(roi).convertTo(picture_, CV_32F);
 
   // The board drawn as the camera saw it: each pixel of a grid twice as
-  // fine as the reduced picture's sees the board's plane through the
-  // lens (and reads the page level whose squares are no larger than
-  // they are here), blurred as the lens blurs it, then reduced as the
-  // picture was. The pixels the floor around the board blurs into are
-  // left out of the comparison.
+  // fine as the reduced picture's sees the board's plane through the lens,
+  // blurred as the lens blurs it, then reduced as the picture was. The
+  // pixels the floor around the board blurs into are left out of the
+  // comparison.
+  //
+  // A board seen at a slant has its squares foreshortened one way: n times
+  // shorter than the other. The grid is sampled n times a pixel along the
+  // picture's axis nearer that way, and the samples averaged, and the page
+  // is read at the level whose squares have no more pixels than the
+  // samples have across a square that way. A page read more coarsely than
+  // its pixels aliases: its moire pulled the board's corners 0.35-0.96 px
+  // off at a 37-degree view through 6-16 px of blur (bench/RESULTS.md,
+  // "Registration through defocus: the page aliased, a lamp").
   const std::size_t middle = predicted_.size() / 2;
   const cv::Point2f m = predicted_[middle];
-  const double square_fine = 2.0 * scale *
-                             std::min(cv::norm(predicted_[neighbour(middle)] - m),
-                                      cv::norm(predicted_[column_neighbour(middle)] - m));
-  if (!(square_fine > 0.0 && std::isfinite(square_fine)))
+  const cv::Point2f along_row = predicted_[neighbour(middle)] - m,
+                    along_column = predicted_[column_neighbour(middle)] - m;
+  const cv::Point2f shorter =
+      cv::norm(along_row) < cv::norm(along_column) ? along_row : along_column;
+  const double square_fine = 2.0 * scale * cv::norm(shorter),
+               square_fine_long =
+                   2.0 * scale * std::max(cv::norm(along_row), cv::norm(along_column));
+  if (!(square_fine > 0.0 && std::isfinite(square_fine_long)))
     return false; // a pose that puts the board nowhere
+  const int n = std::clamp(int(std::ceil(square_fine_long / square_fine - 1e-3)), 1, kMaxSamples);
+  const bool upright = std::abs(shorter.y) >= std::abs(shorter.x);
+  const int nx = upright ? 1 : n, ny = upright ? n : 1;
   std::size_t page = 0;
   double pps = kPagePixelsPerSquare;
-  while (page + 1 < pages_.size() && pps / 2.0 >= square_fine) {
+  while (page + 1 < pages_.size() && pps > n * square_fine) {
     ++page;
     pps /= 2.0;
   }
-  const cv::Size fine(2 * roi.width, 2 * roi.height);
+  const cv::Size fine(2 * roi.width, 2 * roi.height), sampled(nx * fine.width, ny * fine.height);
   // The rays through the lens at every kRayStep-th pixel of the grid
-  // (undistorting is iterative), bilinear between: the lens bends them
-  // far too gently for that to show.
+  // (undistorting is iterative), bilinear between (the lens bends them far
+  // too gently for that to show), each followed to the board's plane.
+  // Interpolating where they meet the plane instead moved the drawing 0.1 px
+  // at a 21-degree view: the perspective bends that.
   const int columns = (fine.width - 1 + kRayStep - 1) / kRayStep + 1,
             rows = (fine.height - 1 + kRayStep - 1) / kRayStep + 1;
   grid_.resize(std::size_t(columns * rows));
@@ -210,37 +245,71 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
           cv::Point2f(float((roi.x + (x * kRayStep + 0.5) / 2.0) / scale - 0.5),
                       float((roi.y + (y * kRayStep + 0.5) / 2.0) / scale - 0.5));
   cv::undistortPoints(grid_, rays_, k, distortion);
-  map_x_.create(fine, CV_32F);
-  map_y_.create(fine, CV_32F);
-  mask_fine_.create(fine, CV_8U);
-  const cv::Vec3d normal(r(0, 2), r(1, 2), r(2, 2)); // the board's z in the camera
-  const double plane = normal.dot(tvec);
-  const cv::Matx33d rt = r.t();
-  for (int y = 0; y < fine.height; ++y) {
-    const int y0 = std::min(y / kRayStep, rows - 2);
-    const float fy = float(y - y0 * kRayStep) / kRayStep;
-    for (int x = 0; x < fine.width; ++x) {
-      const int x0 = std::min(x / kRayStep, columns - 2);
-      const float fx = float(x - x0 * kRayStep) / kRayStep;
-      const cv::Point2f *at = &rays_[std::size_t(y0 * columns + x0)];
-      const cv::Point2f ray = (1.0f - fy) * ((1.0f - fx) * at[0] + fx * at[1]) +
-                              fy * ((1.0f - fx) * at[columns] + fx * at[columns + 1]);
-      const cv::Vec3d d(ray.x, ray.y, 1.0);
-      const double along = plane / normal.dot(d);
-      const cv::Vec3d on = rt * (along * d - tvec); // on the board, metres
-      const bool board =
-          along > 0.0 && on[0] >= 0.0 && on[1] >= 0.0 && on[0] <= width_m && on[1] <= height_m;
-      map_x_.at<float>(y, x) = board ? float(on[0] / board_.square_m * pps - 0.5) : -1.0f;
-      map_y_.at<float>(y, x) = board ? float(on[1] / board_.square_m * pps - 0.5) : -1.0f;
-      mask_fine_.at<std::uint8_t>(y, x) = board ? 255 : 0;
+  // The board's plane in the camera: its normal (the board's z) and its
+  // distance; a point of the plane back to the board's axes by r^T.
+  const float n0 = float(r(0, 2)), n1 = float(r(1, 2)), n2 = float(r(2, 2));
+  const float plane = float(cv::Vec3d(r(0, 2), r(1, 2), r(2, 2)).dot(tvec));
+  const cv::Matx33f rt = cv::Matx33f(r.t());
+  const float t0 = float(tvec[0]), t1 = float(tvec[1]), t2 = float(tvec[2]);
+  map_x_.create(sampled, CV_32F);
+  map_y_.create(sampled, CV_32F);
+  mask_sampled_.create(sampled, CV_8U);
+  // Where sample i, `per` to a grid pixel, lies between the rays: the ray
+  // before it and how far on to the next.
+  const auto between = [](int i, int per, int nodes, int &before, float &on) {
+    const float g = (float(i) + 0.5f) / float(per) - 0.5f; // in grid pixels
+    before = std::clamp(int(std::floor(g / kRayStep)), 0, nodes - 2);
+    on = (g - float(before * kRayStep)) / kRayStep;
+  };
+  column_ray_.resize(std::size_t(sampled.width));
+  column_on_.resize(std::size_t(sampled.width));
+  for (int x = 0; x < sampled.width; ++x)
+    between(x, nx, columns, column_ray_[std::size_t(x)], column_on_[std::size_t(x)]);
+  row_rays_.resize(std::size_t(columns));
+  const float to_page = float(pps / board_.square_m);
+  for (int y = 0; y < sampled.height; ++y) {
+    int y0 = 0;
+    float fy = 0.0f;
+    between(y, ny, rows, y0, fy);
+    for (int c = 0; c < columns; ++c)
+      row_rays_[std::size_t(c)] = (1.0f - fy) * rays_[std::size_t(y0 * columns + c)] +
+                                  fy * rays_[std::size_t((y0 + 1) * columns + c)];
+    float *map_x = map_x_.ptr<float>(y), *map_y = map_y_.ptr<float>(y);
+    std::uint8_t *inside = mask_sampled_.ptr<std::uint8_t>(y);
+    for (int x = 0; x < sampled.width; ++x) {
+      const std::size_t x0 = std::size_t(column_ray_[std::size_t(x)]);
+      const float fx = column_on_[std::size_t(x)];
+      const cv::Point2f ray = (1.0f - fx) * row_rays_[x0] + fx * row_rays_[x0 + 1];
+      // Along the ray (ray.x, ray.y, 1) to the plane, then into the board's
+      // axes: metres on the board.
+      const float along = plane / (n0 * ray.x + n1 * ray.y + n2);
+      const float p0 = along * ray.x - t0, p1 = along * ray.y - t1, p2 = along - t2;
+      const float u = rt(0, 0) * p0 + rt(0, 1) * p1 + rt(0, 2) * p2,
+                  v = rt(1, 0) * p0 + rt(1, 1) * p1 + rt(1, 2) * p2;
+      const bool board = along > 0.0f && u >= 0.0f && v >= 0.0f && u <= width_m && v <= height_m;
+      map_x[x] = board ? u * to_page - 0.5f : -1.0f;
+      map_y[x] = board ? v * to_page - 0.5f : -1.0f;
+      inside[x] = board ? 255 : 0;
     }
   }
-  cv::remap(pages_[page], drawn_fine_, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  if (n == 1) {
+    cv::remap(pages_[page], drawn_fine_, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    mask_sampled_.copyTo(mask_fine_);
+  } else {
+    cv::remap(pages_[page], drawn_sampled_, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    cv::resize(drawn_sampled_, drawn_fine_, fine, 0, 0, cv::INTER_AREA);
+    cv::resize(mask_sampled_, mask_fine_, fine, 0, 0, cv::INTER_AREA);
+    cv::threshold(mask_fine_, mask_fine_, 254, 255, cv::THRESH_BINARY);
+  }
   const double blur_fine = 2.0 * blur * scale;
   if (blur_fine > 0.5)
     cv::filter2D(drawn_fine_, drawn_fine_, -1, disc(blur_fine), cv::Point(-1, -1), 0.0,
                  cv::BORDER_REPLICATE);
   cv::resize(drawn_fine_, drawn_, roi.size(), 0, 0, cv::INTER_AREA);
+  if (shading_ != cv::Vec2d(0.0, 0.0))
+    for (int y = 0; y < drawn_.rows; ++y)
+      for (int x = 0; x < drawn_.cols; ++x)
+        drawn_.at<float>(y, x) *= float(shading_at(shading_, roi, scale, x, y, image.size()));
   cv::resize(mask_fine_, mask_, roi.size(), 0, 0, cv::INTER_AREA);
   cv::threshold(mask_, mask_, 254, 255, cv::THRESH_BINARY);
   const int margin = int(std::ceil(blur * scale / 2.0)) + 1;
@@ -266,6 +335,7 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
   cv::Matx33d w;
   warp.convertTo(cv::Mat(w, false), CV_64F);
   const cv::Matx33d back = w.inv();
+  fit_shading(w, roi, scale);
 
   // Each corner in the picture, moved as the alignment moves the drawing.
   const double square = square_fine / (2.0 * scale);
@@ -285,6 +355,42 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
     image_points.push_back(moved);
   }
   return object.size() >= kMinCorners;
+}
+
+void BoardAligner::fit_shading(const cv::Matx33d &warp, const cv::Rect &roi, double scale) {
+  // The drawing as aligned, where the picture is: picture ~ gain * drawn +
+  // offset, the gain linear across the picture. Least squares over the
+  // board's pixels; the slopes relative to the gain's mean.
+  cv::warpPerspective(drawn_, warped_, cv::Mat(warp), picture_.size(),
+                      cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  cv::Matx44d normal = cv::Matx44d::zeros();
+  cv::Vec4d right(0.0, 0.0, 0.0, 0.0);
+  for (int y = 0; y < picture_.rows; ++y)
+    for (int x = 0; x < picture_.cols; ++x) {
+      if (mask_.at<std::uint8_t>(y, x) == 0)
+        continue;
+      const double d = warped_.at<float>(y, x);
+      const cv::Point2d u = across(roi, scale, x, y, picture_size_);
+      const cv::Vec4d row(d, d * u.x, d * u.y, 1.0);
+      normal += row * row.t();
+      right += double(picture_.at<float>(y, x)) * row;
+    }
+  cv::Vec4d g;
+  if (!cv::solve(normal, right, g, cv::DECOMP_CHOLESKY) || !(g[0] > 0.0)) {
+    shading_ = {0.0, 0.0};
+    return;
+  }
+  // The drawing already carries the gain fitted before: what is left adds
+  // to it (to first order). A gain that stays within 1/5 and 9/5 of its
+  // mean over the board is light; anything steeper is not a lamp (the board
+  // half hidden, say), and the board is drawn evenly lit.
+  shading_ += cv::Vec2d(g[1] / g[0], g[2] / g[0]);
+  for (const cv::Point corner : {cv::Point(0, 0), cv::Point(roi.width, 0), cv::Point(0, roi.height),
+                                 cv::Point(roi.width, roi.height)}) {
+    const cv::Point2d u = across(roi, scale, corner.x, corner.y, picture_size_);
+    if (std::abs(shading_[0] * u.x + shading_[1] * u.y) > 0.8)
+      shading_ = {0.0, 0.0};
+  }
 }
 
 bool BoardAligner::in_picture(cv::Point2f p) const {

@@ -48,6 +48,9 @@ private:
   bool align_once(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion,
                   const cv::Vec3d &rvec, const cv::Vec3d &tvec, double blur,
                   std::vector<cv::Point3f> &object, std::vector<cv::Point2f> &image_points);
+  // The light across the board, fitted to the picture once aligned: a gain
+  // that changes linearly over the picture (a lamp nearer one side).
+  void fit_shading(const cv::Matx33d &warp, const cv::Rect &roi, double scale);
   [[nodiscard]] bool in_picture(cv::Point2f p) const;
   [[nodiscard]] std::size_t neighbour(std::size_t i) const;
   [[nodiscard]] std::size_t column_neighbour(std::size_t i) const;
@@ -60,8 +63,14 @@ private:
   std::vector<double> blurs_;
   cv::Size picture_size_;
   std::vector<cv::Point3f> outline_;
-  std::vector<cv::Point2f> predicted_, outline_image_, grid_, rays_;
-  cv::Mat reduced_, picture_, drawn_fine_, drawn_, map_x_, map_y_, mask_fine_, mask_;
+  std::vector<cv::Point2f> predicted_, outline_image_, grid_, rays_, row_rays_;
+  std::vector<int> column_ray_;
+  std::vector<float> column_on_;
+  cv::Mat reduced_, picture_, drawn_sampled_, drawn_fine_, drawn_, map_x_, map_y_, mask_sampled_,
+      mask_fine_, mask_, warped_;
+  // The gain's slope across the picture, per picture width, in x and in y
+  // (relative to its mean): fitted by one pass, drawn in by the next.
+  cv::Vec2d shading_{0.0, 0.0};
 };
 
 } // namespace camhead::pipeline
