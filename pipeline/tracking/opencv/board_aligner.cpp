@@ -358,16 +358,19 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
 }
 
 void BoardAligner::fit_shading(const cv::Matx33d &warp, const cv::Rect &roi, double scale) {
-  // The drawing as aligned, where the picture is: picture ~ gain * drawn +
-  // offset, the gain linear across the picture. Least squares over the
-  // board's pixels; the slopes relative to the gain's mean.
+  // The drawing (and which of its pixels are the board's) as aligned, where
+  // the picture is: picture ~ gain * drawn + offset, the gain linear across
+  // the picture. Least squares over the board's pixels; the slopes relative
+  // to the gain at the picture's centre.
   cv::warpPerspective(drawn_, warped_, cv::Mat(warp), picture_.size(),
                       cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  cv::warpPerspective(mask_, warped_mask_, cv::Mat(warp), picture_.size(),
+                      cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT);
   cv::Matx44d normal = cv::Matx44d::zeros();
   cv::Vec4d right(0.0, 0.0, 0.0, 0.0);
   for (int y = 0; y < picture_.rows; ++y)
     for (int x = 0; x < picture_.cols; ++x) {
-      if (mask_.at<std::uint8_t>(y, x) == 0)
+      if (warped_mask_.at<std::uint8_t>(y, x) == 0)
         continue;
       const double d = warped_.at<float>(y, x);
       const cv::Point2d u = across(roi, scale, x, y, picture_size_);
@@ -382,8 +385,9 @@ void BoardAligner::fit_shading(const cv::Matx33d &warp, const cv::Rect &roi, dou
   }
   // The drawing already carries the gain fitted before: what is left adds
   // to it (to first order). A gain that stays within 1/5 and 9/5 of its
-  // mean over the board is light; anything steeper is not a lamp (the board
-  // half hidden, say), and the board is drawn evenly lit.
+  // value at the picture's centre over the board is light; anything steeper
+  // is not a lamp (the board half hidden, say), and the board is drawn
+  // evenly lit.
   shading_ += cv::Vec2d(g[1] / g[0], g[2] / g[0]);
   for (const cv::Point corner : {cv::Point(0, 0), cv::Point(roi.width, 0), cv::Point(0, roi.height),
                                  cv::Point(roi.width, roi.height)}) {

@@ -67,9 +67,10 @@ private:
   std::vector<int> column_ray_;
   std::vector<float> column_on_;
   cv::Mat reduced_, picture_, drawn_sampled_, drawn_fine_, drawn_, map_x_, map_y_, mask_sampled_,
-      mask_fine_, mask_, warped_;
+      mask_fine_, mask_, warped_, warped_mask_;
   // The gain's slope across the picture, per picture width, in x and in y
-  // (relative to its mean): fitted by one pass, drawn in by the next.
+  // (relative to the gain at the picture's centre): fitted by one pass,
+  // drawn in by the next.
   cv::Vec2d shading_{0.0, 0.0};
 };
 
