@@ -22,7 +22,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <limits>
@@ -162,13 +161,6 @@ int run(int argc, char **argv) {
       if (!frames.empty())
         f.jump = std::max(f.jump, glm::length(error - error_before[i]));
       error_before[i] = error;
-      if (std::getenv("SIGNED") && i < board_points)
-        std::fprintf(
-            stderr, "%s %.1f corner %zu err %+.2f %+.2f at %.0f %.0f\n",
-            r.at("pose_found_by").is_string() ? r.at("pose_found_by").get<std::string>().c_str()
-                                              : "-",
-            f.blur_px, i, error.x, error.y, pixel(real, points[i], width, height, focal_px).x,
-            pixel(real, points[i], width, height, focal_px).y);
     }
     f.registration = std::max(f.on_board, f.at_virtual);
     if (const auto &by = r.at("pose_found_by"); by.is_string())
