@@ -26,7 +26,6 @@
 #include <fstream>
 #include <limits>
 #include <string>
-#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -61,7 +60,7 @@ struct Frame {
   // before, px: how far the virtual world jumps against the real one (the
   // camera's own motion taken out).
   double jump = 0;
-  const char *found_by = "";
+  std::string found_by; // the record's pose_found_by; empty: null
 };
 
 CameraPose recorded_pose(const nlohmann::json &pose) {
@@ -164,9 +163,7 @@ int run(int argc, char **argv) {
     }
     f.registration = std::max(f.on_board, f.at_virtual);
     if (const auto &by = r.at("pose_found_by"); by.is_string())
-      f.found_by = by.get<std::string>() == "markers"   ? "markers"
-                   : by.get<std::string>() == "corners" ? "corners"
-                                                        : "alignment";
+      f.found_by = by.get<std::string>();
     f.reprojection =
         r.at("reprojection_px").is_null() ? 0.0 : r.at("reprojection_px").get<double>();
     f.markers = r.value("markers_seen", 0);
@@ -227,7 +224,7 @@ int run(int argc, char **argv) {
     std::vector<double> board_px, virtual_px, jump_px;
     std::size_t within = 0;
     for (const Frame &f : frames)
-      if (f.found && std::string_view(f.found_by) == by) {
+      if (f.found && f.found_by == by) {
         board_px.push_back(f.on_board);
         virtual_px.push_back(f.at_virtual);
         jump_px.push_back(f.jump);
@@ -251,8 +248,8 @@ int run(int argc, char **argv) {
     for (const Frame &f : frames) {
       char row[200];
       std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", f.t_s,
-                    int(f.found), f.found_by, f.blur_px, f.registration, f.on_board, f.at_virtual,
-                    f.jump, f.reprojection, f.markers);
+                    int(f.found), f.found_by.c_str(), f.blur_px, f.registration, f.on_board,
+                    f.at_virtual, f.jump, f.reprojection, f.markers);
       csv << row;
     }
     const chart::Panel panels[] = {{"pose found in the frame",

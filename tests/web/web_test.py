@@ -432,6 +432,12 @@ if markers:
             views.append(json.loads(body) if status == 200 else {"status": status,
                                                                  "reply": body.decode()})
             time.sleep(0.6)
+        # The state says how the newest composite's pose was found: the
+        # board, sharp at this lens, by its markers (or null, held).
+        pose = run.state()["pose"]
+        check(pose.get("found_by") == ("markers" if pose.get("fresh") else None),
+              "state: the marker pose says how it was found: %s"
+              % {k: pose.get(k) for k in ("source", "fresh", "found_by", "markers_seen")})
     folder = os.path.join(scratch, "recordings", "camera-views", "focus-8000-zoom-0")
     seen = [v.get("markers_seen") for v in views]
     check([os.path.basename(v.get("file", "")) for v in views] ==

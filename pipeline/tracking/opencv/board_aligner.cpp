@@ -69,12 +69,6 @@ cv::Point2d across(const cv::Rect &roi, double scale, int x, int y, cv::Size siz
           ((roi.y + y + 0.5) / scale - 0.5 * size.height) / size.width};
 }
 
-double shading_at(const cv::Vec2d &slope, const cv::Rect &roi, double scale, int x, int y,
-                  cv::Size size) {
-  const cv::Point2d u = across(roi, scale, x, y, size);
-  return std::max(0.05, 1.0 + slope[0] * u.x + slope[1] * u.y);
-}
-
 } // namespace
 
 std::size_t corner_neighbour(std::size_t i, std::size_t cols, std::size_t n) {
@@ -126,15 +120,15 @@ double BoardAligner::board_blur(const CameraModel &camera, const cv::Matx33d &k,
 // Where the board can be neither read nor followed (its markers and its
 // corners lost in defocus: bench/RESULTS.md, "Registration through
 // defocus"), it is drawn as the previous pose and the lens's defocus show
-// it, and the
-// drawing is aligned with the picture by a homography: OpenCV's ECC,
-// which is blind to the light's gain and offset, on the picture reduced
-// so far that the blur leaves nothing finer. A planar board is one
-// homography away from any other view of it through a pinhole; the
-// lens's distortion bends that a little, which the second pass, drawn
-// from the first pass's pose, takes out. The chessboard corners moved as
-// the alignment moves the drawn ones are the points the pose is solved
-// from (object, image_points).
+// it, and the drawing is aligned with the picture by a homography: OpenCV's
+// ECC, which is blind to the light's gain and offset, on the picture
+// reduced so far that the blur leaves nothing finer. A planar board is one
+// homography away from any other view of it through a pinhole; the lens's
+// distortion bends that a little, and a lamp lights one side brighter,
+// which the second pass, drawn from the first pass's pose with the gain
+// the first pass fitted, takes out. The chessboard corners moved as the
+// alignment moves the drawn ones are the points the pose is solved from
+// (object, image_points).
 bool BoardAligner::align(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion,
                          cv::Vec3d rvec, cv::Vec3d tvec, double blur,
                          std::vector<cv::Point3f> &object, std::vector<cv::Point2f> &image_points) {
@@ -143,20 +137,22 @@ bool BoardAligner::align(const cv::Mat &image, const cv::Matx33d &k, const cv::M
   picture_size_ = image.size();
   shading_ = {0.0, 0.0};
   for (int pass = 0; pass < kAlignPasses; ++pass) {
-    if (!align_once(image, k, distortion, rvec, tvec, blur, object, image_points))
+    const bool last = pass + 1 == kAlignPasses;
+    if (!align_once(image, k, distortion, rvec, tvec, blur, !last, object, image_points))
       return false;
-    if (pass + 1 < kAlignPasses && !cv::solvePnP(object, image_points, k, distortion, rvec, tvec,
-                                                 true, cv::SOLVEPNP_ITERATIVE))
+    if (!last && !cv::solvePnP(object, image_points, k, distortion, rvec, tvec, true,
+                               cv::SOLVEPNP_ITERATIVE))
       return false;
   }
   return true;
 }
 
 // One pass: the board drawn from (rvec, tvec) and aligned; the corners
-// it moves into object and image_points.
+// it moves into object and image_points; with `fit_light`, the light's gain
+// across the picture fitted for the next pass to draw.
 bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion,
                               const cv::Vec3d &rvec, const cv::Vec3d &tvec, double blur,
-                              std::vector<cv::Point3f> &object,
+                              bool fit_light, std::vector<cv::Point3f> &object,
                               std::vector<cv::Point2f> &image_points) {
   const std::vector<cv::Point3f> &corners = charuco_->chessboardCorners;
   cv::projectPoints(corners, rvec, tvec, k, distortion, predicted_);
@@ -306,10 +302,14 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
     cv::filter2D(drawn_fine_, drawn_fine_, -1, disc(blur_fine), cv::Point(-1, -1), 0.0,
                  cv::BORDER_REPLICATE);
   cv::resize(drawn_fine_, drawn_, roi.size(), 0, 0, cv::INTER_AREA);
+  // The lamp's gain the pass before fitted (fit_shading keeps it between
+  // 1/5 and 9/5 over the board).
   if (shading_ != cv::Vec2d(0.0, 0.0))
     for (int y = 0; y < drawn_.rows; ++y)
-      for (int x = 0; x < drawn_.cols; ++x)
-        drawn_.at<float>(y, x) *= float(shading_at(shading_, roi, scale, x, y, image.size()));
+      for (int x = 0; x < drawn_.cols; ++x) {
+        const cv::Point2d u = across(roi, scale, x, y, image.size());
+        drawn_.at<float>(y, x) *= float(1.0 + shading_[0] * u.x + shading_[1] * u.y);
+      }
   cv::resize(mask_fine_, mask_, roi.size(), 0, 0, cv::INTER_AREA);
   cv::threshold(mask_, mask_, 254, 255, cv::THRESH_BINARY);
   const int margin = int(std::ceil(blur * scale / 2.0)) + 1;
@@ -335,7 +335,8 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Matx33d &k, const 
   cv::Matx33d w;
   warp.convertTo(cv::Mat(w, false), CV_64F);
   const cv::Matx33d back = w.inv();
-  fit_shading(w, roi, scale);
+  if (fit_light)
+    fit_shading(w, roi, scale);
 
   // Each corner in the picture, moved as the alignment moves the drawing.
   const double square = square_fine / (2.0 * scale);
