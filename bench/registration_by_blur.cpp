@@ -7,17 +7,20 @@
 // virtual world to the real one (the board's outer corners, the scene's
 // virtual objects' centres) from where the path's true pose at that frame's
 // mid-exposure puts them, in pixels, against the blur circle of the board's
-// centre in that frame (thin lens, the frame's recorded focus, f-number and
-// focal length). The composites before the board was first found (the
-// board file's rest pose) are left out.
+// centre in that frame. Both poses are seen through the lens the simulated
+// camera filmed with at that instant (the board's trace as the glass moved,
+// run/trace_lens.h): from its entrance pupil, at its projection focal
+// length, and its thin-lens blur. The composites before the board was first
+// found (the board file's rest pose) are left out.
 //
 //   build/camhead run --board sim-moving --duration 60 --output null --record-stats m.jsonl
 //   build/bench/registration_by_blur board/sim-moving.json m.jsonl [OUT]
 //
 // Prints a table by blur (frames, median and worst registration, median
 // reprojection error), then one by how each pose was found (on the board
-// and at the virtual objects, and how far the registration jumps from one
-// composite to the next); OUT.csv gets a row per frame and OUT.png the
+// and at the virtual objects, how far the registration jumps from one
+// composite to the next, and how far out it puts the board's corners: a
+// scale error); OUT.csv gets a row per frame and OUT.png the
 // chart.
 #include <algorithm>
 #include <cmath>
@@ -37,6 +40,7 @@
 #include "chart/chart_plot.h"
 #include "chart/chart_png.h"
 #include "config/board.h"
+#include "run/trace_lens.h"
 #include "tracking/marker_board.h"
 #include "tracking/pose_trace.h"
 
@@ -56,6 +60,10 @@ struct Frame {
   // virtual objects' centres (farther from the board, where an error of
   // the board's tilt grows).
   double on_board = 0, at_virtual = 0;
+  // The mean of the board's outer corners' errors along the way out from
+  // the board's centre in the picture: positive, the board registered too
+  // large (a scale error that a median of distances hides).
+  double outward = 0;
   // The largest change of a point's registration since the composite
   // before, px: how far the virtual world jumps against the real one (the
   // camera's own motion taken out).
@@ -74,23 +82,22 @@ CameraPose recorded_pose(const nlohmann::json &pose) {
   return {vec("position"), glm::normalize(glm::quat_cast(axes))};
 }
 
-// A centred pinhole: the recorded and the true pose are compared through
-// the same camera, so the lens's distortion cancels to first order.
+// A centred pinhole at the entrance pupil, `pupil_m` ahead of the pose's
+// reference plane: the recorded and the true pose are compared through the
+// same camera, so the lens's distortion cancels to first order.
 glm::dvec2 pixel(const CameraPose &pose, const glm::dvec3 &point, int width, int height,
-                 double focal_px) {
-  const glm::dvec3 p = glm::inverse(pose.orientation) * (point - pose.position);
+                 double focal_px, double pupil_m) {
+  const glm::dvec3 p =
+      glm::inverse(pose.orientation) * (point - pose.position - pose.forward() * pupil_m);
   return {width / 2.0 + focal_px * p.x / -p.z, height / 2.0 - focal_px * p.y / -p.z};
 }
 
-// The thin lens's blur circle, on the sensor, of a point `depth_m` in front
-// of a lens of focal length f focused at s (infinity allowed), in pixels.
-double blur_px(double depth_m, double focus_m, double f_number, double focal_mm,
-               double sensor_width_mm, int width) {
-  const double f = focal_mm * 1e-3;
-  const double c = std::isinf(focus_m)
-                       ? f * f / (f_number * depth_m)
-                       : f * f / (f_number * (focus_m - f)) * std::abs(depth_m - focus_m) / depth_m;
-  return c * 1e3 / sensor_width_mm * width;
+// The thin lens's blur circle of a point `depth_m` in front of the entrance
+// pupil, in pixels of a projection focal length of `focal_px`:
+// f_px (f / N) |1/s - 1/d|, focus s from the pupil too (infinity allowed).
+double blur_px(double depth_m, const camhead::lens_control::LensState &lens, double focal_px) {
+  const double aperture_m = lens.focal_length_mm.value * 1e-3 / lens.f_number.value;
+  return focal_px * aperture_m * std::abs(1.0 / lens.focus_distance_m.value - 1.0 / depth_m);
 }
 
 double quantile(std::vector<double> v, double q) {
@@ -112,6 +119,10 @@ int run(int argc, char **argv) {
     throw std::runtime_error(std::string(argv[1]) +
                              ": wants a simulated camera with a path, a scene and a marker pose");
   const PoseTrace truth = load_pose_trace(*sim->path);
+  const std::optional<TraceLens> lens = TraceLens::of_board(board);
+  if (!lens)
+    throw std::runtime_error(std::string(argv[1]) +
+                             ": wants a lens trace replayed on the monotonic clock (the truth)");
   const MarkerBoard markers = load_marker_board(board.pose->file);
   const camhead::renderer::Scene scene = camhead::renderer::load_scene(*board.scene);
   const int width = board.camera->width, height = board.camera->height;
@@ -142,21 +153,29 @@ int run(int argc, char **argv) {
     }
     const std::int64_t mid = r.at("exposure_mid_ns").get<std::int64_t>();
     const CameraPose real = truth.at(mid), seen = recorded_pose(r.at("pose"));
-    const double focal_mm = r.at("focal_length_mm").get<double>();
-    const double focal_px = focal_mm / board.camera->sensor_width_mm * width;
+    const camhead::lens_control::LensState filmed = lens->state_at(mid);
+    const double focal_px =
+        filmed.projection_focal_length_mm.value / board.camera->sensor_width_mm * width;
+    const double pupil_m = filmed.entrance_pupil_offset_mm.value * 1e-3;
     Frame f;
     f.found = r.value("pose_fresh", false);
     f.t_s = double(mid) * 1e-9;
-    const double depth = glm::dot(centre - real.position, real.forward());
-    const double focus_m = r.at("focus_m").is_null() ? std::numeric_limits<double>::infinity()
-                                                     : r.at("focus_m").get<double>();
-    f.blur_px = blur_px(depth, focus_m, r.at("f_number").get<double>(), focal_mm,
-                        board.camera->sensor_width_mm, width);
+    f.blur_px =
+        blur_px(glm::dot(centre - real.position, real.forward()) - pupil_m, filmed, focal_px);
+    glm::dvec2 board_centre(0.0);
+    for (std::size_t i = 0; i < board_points; ++i)
+      board_centre += pixel(real, points[i], width, height, focal_px, pupil_m);
+    board_centre /= double(board_points);
     for (std::size_t i = 0; i < points.size(); ++i) {
-      const glm::dvec2 error = pixel(seen, points[i], width, height, focal_px) -
-                               pixel(real, points[i], width, height, focal_px);
+      const glm::dvec2 error = pixel(seen, points[i], width, height, focal_px, pupil_m) -
+                               pixel(real, points[i], width, height, focal_px, pupil_m);
       double &part = i < board_points ? f.on_board : f.at_virtual;
       part = std::max(part, glm::length(error));
+      if (i < board_points) {
+        const glm::dvec2 out =
+            glm::normalize(pixel(real, points[i], width, height, focal_px, pupil_m) - board_centre);
+        f.outward += glm::dot(error, out) / double(board_points);
+      }
       if (!frames.empty())
         f.jump = std::max(f.jump, glm::length(error - error_before[i]));
       error_before[i] = error;
@@ -219,37 +238,39 @@ int run(int argc, char **argv) {
   // pose measured afresh each frame jitters (the jump).
   std::printf("\n| found by | frames | on the board: median, p90, worst | at the virtual objects: "
               "median, p90, worst | within 1 px | jump since the composite before: median, p99, "
-              "worst |\n|---|---|---|---|---|---|\n");
+              "worst | outward: median |\n|---|---|---|---|---|---|---|\n");
   for (const char *by : {"markers", "corners", "alignment"}) {
-    std::vector<double> board_px, virtual_px, jump_px;
+    std::vector<double> board_px, virtual_px, jump_px, outward_px;
     std::size_t within = 0;
     for (const Frame &f : frames)
       if (f.found && f.found_by == by) {
         board_px.push_back(f.on_board);
         virtual_px.push_back(f.at_virtual);
         jump_px.push_back(f.jump);
+        outward_px.push_back(f.outward);
         within += f.registration <= 1.0 ? 1 : 0;
       }
     if (board_px.empty())
       continue;
     std::printf("| %s | %zu | %.2f, %.2f, %.2f px | %.2f, %.2f, %.2f px | %.1f %% | %.2f, %.2f, "
-                "%.2f px |\n",
+                "%.2f px | %+.2f px |\n",
                 by, board_px.size(), quantile(board_px, 0.5), quantile(board_px, 0.9),
                 quantile(board_px, 1.0), quantile(virtual_px, 0.5), quantile(virtual_px, 0.9),
                 quantile(virtual_px, 1.0), 100.0 * double(within) / double(board_px.size()),
-                quantile(jump_px, 0.5), quantile(jump_px, 0.99), quantile(jump_px, 1.0));
+                quantile(jump_px, 0.5), quantile(jump_px, 0.99), quantile(jump_px, 1.0),
+                quantile(outward_px, 0.5));
   }
 
   if (argc == 4) {
     const std::string out = argv[3];
     std::ofstream csv(out + ".csv");
     csv << "t_s,pose_found,found_by,blur_px,registration_px,on_board_px,at_virtual_px,jump_px,"
-           "reprojection_px,markers_seen\n";
+           "reprojection_px,markers_seen,outward_px\n";
     for (const Frame &f : frames) {
       char row[200];
-      std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", f.t_s,
+      std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%.4f\n", f.t_s,
                     int(f.found), f.found_by.c_str(), f.blur_px, f.registration, f.on_board,
-                    f.at_virtual, f.jump, f.reprojection, f.markers);
+                    f.at_virtual, f.jump, f.reprojection, f.markers, f.outward);
       csv << row;
     }
     const chart::Panel panels[] = {{"pose found in the frame",

@@ -1,8 +1,11 @@
 #include "trace_lens.h"
 
+#include <cmath>
 #include <variant>
+#include <vector>
 
 #include "camhead/hal/lens/trace/trace_replay.h"
+#include "camhead/lens_control/encoder_filter.h"
 #include "config/lens_sources.h"
 
 namespace camhead::pipeline {
@@ -16,6 +19,34 @@ std::optional<double> period_of(const hl::LensTrace &trace, bool loop) {
   return loop ? std::optional<double>(double(hl::loop_period_ns(trace)) * 1e-9) : std::nullopt;
 }
 
+// The trace as the lens moved: each axis's lone glitches (a reading that
+// leaves both of its neighbours, to the same side, by more than the lens
+// chain's spike threshold: further than a ring travels between two readings
+// and back) replaced by the mean of those neighbours. The encoder latched
+// the glitch, and the simulated boards replay it as latched; the glass did
+// not move, so the simulated camera must not film it.
+hl::LensTrace as_the_lens_moved(hl::LensTrace trace) {
+  const double travel = lens_control::EncoderFilterParams{}.spike_threshold_counts;
+  for (auto axis :
+       {&hl::EncoderReading::focus, &hl::EncoderReading::iris, &hl::EncoderReading::zoom}) {
+    std::vector<hl::EncoderReading *> rows;
+    for (hl::EncoderReading &r : trace.readings)
+      if (r.*axis)
+        rows.push_back(&r);
+    // Judged on the readings as latched, not as already mended. The first
+    // and last readings are kept as they are.
+    std::vector<std::int32_t> latched;
+    for (const hl::EncoderReading *r : rows)
+      latched.push_back(*(r->*axis));
+    for (std::size_t i = 1; i + 1 < rows.size(); ++i) {
+      const double before = latched[i] - latched[i - 1], after = latched[i] - latched[i + 1];
+      if (before * after > 0.0 && std::abs(before) > travel && std::abs(after) > travel)
+        rows[i]->*axis = std::int32_t(std::lround(0.5 * (latched[i - 1] + latched[i + 1])));
+    }
+  }
+  return trace;
+}
+
 } // namespace
 
 std::optional<TraceLens> TraceLens::of_board(const Board &board) {
@@ -24,7 +55,8 @@ std::optional<TraceLens> TraceLens::of_board(const Board &board) {
   const auto *trace = std::get_if<TraceSourceConfig>(&board.lens.sources.front().kind);
   if (trace == nullptr || !trace->monotonic_origin)
     return std::nullopt;
-  return TraceLens(hl::read_lens_trace(trace->file), load_board_profile(board), *trace);
+  return TraceLens(as_the_lens_moved(hl::read_lens_trace(trace->file)), load_board_profile(board),
+                   *trace);
 }
 
 TraceLens::TraceLens(const hl::LensTrace &trace, lens_control::LensProfile profile,

@@ -2,7 +2,10 @@
 // simulated rig. The simulated camera films the real world through this
 // lens, while the virtual objects get what the lens chain (encoder, filter,
 // time alignment) makes of the same trace, as on a real rig; a chain that
-// lags shows as a mismatch between real and virtual blur.
+// lags shows as a mismatch between real and virtual blur. An encoder's lone
+// glitch in the trace (its bundled focus pull has one, at 3.0 s) is latched
+// by the simulated boards but not followed by this lens: glass does not jump
+// and come back within one reading.
 //
 // Only for a trace replayed with its time 0 at CLOCK_MONOTONIC 0 (board
 // "clock_origin": "monotonic"): then the replay's reading i of loop k is due
@@ -28,8 +31,8 @@ public:
   [[nodiscard]] static std::optional<TraceLens> of_board(const Board &board);
 
   // The lens at CLOCK_MONOTONIC instant t_ns: each axis's counts linear
-  // between the readings around it (across a loop's wrap too), through the
-  // profile.
+  // between the readings around it (across a loop's wrap too; a lone glitch
+  // replaced by the mean of its neighbours), through the profile.
   [[nodiscard]] lens_control::LensState state_at(std::int64_t t_ns) const;
 
   // How often the lens repeats, in seconds of real time, when the trace
