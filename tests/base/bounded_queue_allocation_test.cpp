@@ -1,36 +1,14 @@
 // The frame loop allocates nothing (architecture.md): the queues between its
 // threads take, drop and hand back items in slots made with the queue. The
-// global operator new of this test binary counts the allocations of the
-// thread that asks, while it asks; every other test is unaffected.
+// allocations of the thread that asks are counted while it asks
+// (support/counting_new.h).
 #include <chrono>
 #include <cstddef>
-#include <cstdlib>
-#include <new>
 
 #include "camhead/base/bounded_queue.h"
+#include "counting_new.h"
 
 #include <gtest/gtest.h>
-
-namespace {
-
-thread_local bool counting = false;
-thread_local std::size_t allocations = 0;
-
-} // namespace
-
-void *operator new(std::size_t bytes) {
-  if (counting)
-    ++allocations;
-  if (void *p = std::malloc(bytes > 0 ? bytes : 1))
-    return p;
-  throw std::bad_alloc();
-}
-void operator delete(void *p) noexcept {
-  std::free(p);
-}
-void operator delete(void *p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace camhead::base {
 namespace {
@@ -47,8 +25,9 @@ struct Item {
 
 TEST(BoundedQueueAllocations, PushingDroppingAndPoppingAllocateNothing) {
   BoundedQueue<Item> queue(3);
-  counting = true;
-  allocations = 0;
+  static thread_local bool asking = false;
+  asking = true;
+  test::counting_new::start([] { return asking ? 0 : -1; });
   int dropped = 0, popped = 0;
   for (int i = 0; i < 1000; ++i) {
     dropped += queue.push(Item(i)) ? 1 : 0; // full from the fourth on: the oldest out
@@ -60,9 +39,9 @@ TEST(BoundedQueueAllocations, PushingDroppingAndPoppingAllocateNothing) {
       popped += queue.pop(0ns) ? 1 : 0;
     }
   }
-  const std::size_t counted = allocations;
-  counting = false;
-  EXPECT_EQ(counted, 0u);
+  test::counting_new::stop();
+  asking = false;
+  EXPECT_EQ(test::counting_new::count(0), 0u);
   EXPECT_GT(dropped, 0) << "the full queue dropped its oldest";
   EXPECT_GT(popped, 0);
 }
