@@ -76,7 +76,7 @@ public:
   // pose predicted for this picture from the last ones found), picks
   // between the two poses of an ambiguous planar view, and lets a ChArUco
   // board be followed where its markers cannot be read: its corners, or,
-  // blurred by `camera`'s defocus by 4 px or more there, the whole board
+  // blurred by `camera`'s defocus by 2 px or more there, the whole board
   // aligned. Never throws.
   virtual MarkerPose track(const LumaImage &luma, const CameraModel &camera,
                            const CameraPose *previous) = 0;

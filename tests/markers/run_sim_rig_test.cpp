@@ -59,7 +59,7 @@ Registration MovingRig::run(const std::string &lens_trace) const {
   const fs::path markers = write("board.json", R"({"format": "camhead-markers", "version": 1,
       "name": "floor board", "type": "charuco", "dictionary": "4X4_50", "squares": [7, 5],
       "square_m": 0.15, "marker_m": 0.11})");
-  const BoardPage page = draw_board_page(load_marker_board(markers), 64);
+  const BoardPage page = draw_board_page(load_marker_board(markers), 256);
   renderer::Image image(page.width, page.height, 1);
   for (std::size_t i = 0; i < page.grey.size(); ++i)
     image.data[i] = page.grey[i] == 0 ? 0.0f : 1.0f;
@@ -173,14 +173,17 @@ TEST_F(MovingRig, TheMarkerPoseFollowsTheBoardThroughADeepDefocus) {
 // pose is found from: the page on its floor is the one OpenCV draws for
 // that board file (regenerate it with `camhead markers draw
 // scenes/markers/floor_board.json -o scenes/markers/floor_board.png
-// --pixels-per-square 64` after changing the board), and the scene lays it
-// where marker_board.h puts the board, its origin at the world's.
+// --pixels-per-square 256` after changing the board), and the scene lays it
+// where marker_board.h puts the board, its origin at the world's. At 64
+// pixels a square the rendered page put the board's corners 0.5 px out from
+// where the whole-board alignment puts them, sharp or blurred
+// (bench/RESULTS.md, "the page's resolution").
 TEST(SimRig, ThePageOnItsFloorIsTheBoardItTracks) {
   const fs::path source(CAMHEAD_SOURCE_DIR);
   const Board rig = load_board(source / "board" / "sim-moving.json");
   ASSERT_EQ(rig.pose->type, PoseType::marker);
   const MarkerBoard markers = load_marker_board(rig.pose->file);
-  const BoardPage page = draw_board_page(markers, 64);
+  const BoardPage page = draw_board_page(markers, 256);
   const renderer::Image printed = renderer::read_image(source / "scenes/markers/floor_board.png");
   ASSERT_EQ(printed.width, page.width);
   ASSERT_EQ(printed.height, page.height);
