@@ -3,7 +3,6 @@
 // allocations of the thread that asks are counted while it asks
 // (support/counting_new.h).
 #include <chrono>
-#include <cstddef>
 
 #include "camhead/base/bounded_queue.h"
 #include "counting_new.h"

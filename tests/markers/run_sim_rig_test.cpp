@@ -175,9 +175,9 @@ TEST_F(MovingRig, TheMarkerPoseFollowsTheBoardThroughADeepDefocus) {
 // scenes/markers/floor_board.json -o scenes/markers/floor_board.png
 // --pixels-per-square 256` after changing the board), and the scene lays it
 // where marker_board.h puts the board, its origin at the world's. At 64
-// pixels a square the rendered page put the board's corners 0.5 px out from
-// where the whole-board alignment puts them, sharp or blurred
-// (bench/RESULTS.md, "the page's resolution").
+// pixels a square, the whole-board alignment of the rendered page put the
+// board's corners about 0.5 px too far out, sharp or blurred, where its
+// markers read put them right (bench/RESULTS.md, "the page's resolution").
 TEST(SimRig, ThePageOnItsFloorIsTheBoardItTracks) {
   const fs::path source(CAMHEAD_SOURCE_DIR);
   const Board rig = load_board(source / "board" / "sim-moving.json");
