@@ -20,15 +20,18 @@
 // reprojection error), then one by how each pose was found (on the board
 // and at the virtual objects, how far the registration jumps from one
 // composite to the next, and how far out it puts the board's corners: a
-// scale error); OUT.csv gets a row per frame and OUT.png the
-// chart.
+// scale error), then one of every found frame predicted as if its tracking
+// had come late (the marker source's rule, marker_source.h, against the
+// 20 ms it had before); OUT.csv gets a row per frame and OUT.png the chart.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <fstream>
 #include <limits>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -42,6 +45,8 @@
 #include "config/board.h"
 #include "run/trace_lens.h"
 #include "tracking/marker_board.h"
+#include "tracking/marker_source.h"
+#include "tracking/pose_timeline.h"
 #include "tracking/pose_trace.h"
 
 namespace {
@@ -51,6 +56,8 @@ namespace chart = camhead::cli::chart;
 
 struct Frame {
   bool found = false;      // the pose was found in this frame (else held or predicted)
+  std::int64_t mid_ns = 0; // mid-exposure, CLOCK_MONOTONIC: the path's clock
+  CameraPose seen;         // the recorded pose
   double t_s = 0;          // mid-exposure, on the path's clock
   double blur_px = 0;      // the board's centre
   double registration = 0; // px, the largest over the points
@@ -134,6 +141,19 @@ int run(int argc, char **argv) {
     if (!object.real)
       points.emplace_back(object.center);
   std::vector<glm::dvec2> error_before(points.size());
+  // Where `seen` puts each point at mid-exposure `mid`, less where the
+  // path's true pose puts it, through the lens filmed with then.
+  std::vector<glm::dvec2> errors(points.size());
+  const auto errors_at = [&](const CameraPose &seen, std::int64_t mid) {
+    const CameraPose real = truth.at(mid);
+    const camhead::lens_control::LensState filmed = lens->state_at(mid);
+    const double focal_px =
+        filmed.projection_focal_length_mm.value / board.camera->sensor_width_mm * width;
+    const double pupil_m = filmed.entrance_pupil_offset_mm.value * 1e-3;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      errors[i] = pixel(seen, points[i], width, height, focal_px, pupil_m) -
+                  pixel(real, points[i], width, height, focal_px, pupil_m);
+  };
 
   std::ifstream in(argv[2]);
   if (!in)
@@ -159,6 +179,8 @@ int run(int argc, char **argv) {
     const double pupil_m = filmed.entrance_pupil_offset_mm.value * 1e-3;
     Frame f;
     f.found = r.value("pose_fresh", false);
+    f.mid_ns = mid;
+    f.seen = seen;
     f.t_s = double(mid) * 1e-9;
     f.blur_px =
         blur_px(glm::dot(centre - real.position, real.forward()) - pupil_m, filmed, focal_px);
@@ -166,9 +188,9 @@ int run(int argc, char **argv) {
     for (std::size_t i = 0; i < board_points; ++i)
       board_centre += pixel(real, points[i], width, height, focal_px, pupil_m);
     board_centre /= double(board_points);
+    errors_at(seen, mid);
     for (std::size_t i = 0; i < points.size(); ++i) {
-      const glm::dvec2 error = pixel(seen, points[i], width, height, focal_px, pupil_m) -
-                               pixel(real, points[i], width, height, focal_px, pupil_m);
+      const glm::dvec2 error = errors[i];
       double &part = i < board_points ? f.on_board : f.at_virtual;
       part = std::max(part, glm::length(error));
       if (i < board_points) {
@@ -259,6 +281,41 @@ int run(int argc, char **argv) {
                 quantile(virtual_px, 1.0), 100.0 * double(within) / double(board_px.size()),
                 quantile(jump_px, 0.5), quantile(jump_px, 0.99), quantile(jump_px, 1.0),
                 quantile(outward_px, 0.5));
+  }
+
+  // Each frame found as if its tracking had come late: predicted from the
+  // frames found before it, by the marker source's rule and by the one it
+  // had before (20 ms of the last two poses' motion, then held). A frame
+  // late in the run itself is rare (under load), this is every frame.
+  const std::int64_t interval_ns = std::llround(1e9 / sim->fps);
+  PoseTimelineParams before_params = predicted_pose_params(interval_ns);
+  before_params.max_extrapolation_ns = 20'000'000;
+  before_params.stale_after_ns = 50'000'000;
+  std::printf("\n| each found frame predicted as if late, by | frames | registration: median, "
+              "p90, p99, worst | within 1 px |\n|---|---|---|---|\n");
+  for (const auto &[rule, params] : {std::pair{"the marker source (a frame interval on, up to two)",
+                                               predicted_pose_params(interval_ns)},
+                                     std::pair{"20 ms on, then held (before)", before_params}}) {
+    PoseTimeline found_before(params);
+    std::vector<double> predicted_px;
+    for (const Frame &f : frames) {
+      if (!f.found)
+        continue;
+      if (found_before.size() >= 2) {
+        errors_at(found_before.at(f.mid_ns)->pose, f.mid_ns);
+        double worst = 0.0;
+        for (const glm::dvec2 &e : errors)
+          worst = std::max(worst, glm::length(e));
+        predicted_px.push_back(worst);
+      }
+      (void)found_before.push(f.mid_ns, f.seen);
+    }
+    const auto within = std::count_if(predicted_px.begin(), predicted_px.end(),
+                                      [](double px) { return px <= 1.0; });
+    std::printf("| %s | %zu | %.2f, %.2f, %.2f, %.2f px | %.1f %% |\n", rule, predicted_px.size(),
+                quantile(predicted_px, 0.5), quantile(predicted_px, 0.9),
+                quantile(predicted_px, 0.99), quantile(predicted_px, 1.0),
+                predicted_px.empty() ? 0.0 : 100.0 * double(within) / double(predicted_px.size()));
   }
 
   if (argc == 4) {

@@ -60,9 +60,9 @@ Pipeline::Pipeline(const RunOptions &options)
       output_specs_(checked_outputs(options, setup_->scene)), lens_(board_),
       camera_(open_camera(board_, setup_->scene, setup_->base_camera, lens_, options.threads,
                           {options.frames, options.duration_s})),
-      markers_(open_marker_source(board_, camera_->format(), setup_->base_camera, lens_,
-                                  offline_take(board_),
-                                  lens_wait_ns(offline_take(board_), camera_fps(*camera_)))),
+      markers_(open_marker_source(
+          board_, camera_->format(), setup_->base_camera, lens_, offline_take(board_),
+          lens_wait_ns(offline_take(board_), camera_fps(*camera_)), camera_fps(*camera_))),
       pose_trace_(board_.pose && board_.pose->type == PoseType::trace
                       ? std::optional<PoseTrace>(load_pose_trace(board_.pose->file))
                       : std::nullopt),
@@ -134,7 +134,8 @@ Pipeline::Pipeline(const RunOptions &options)
                                           ? std::optional(sinks_[*recording_sink_]->format())
                                           : std::nullopt,
                      .marker_board = marker_pose ? board_.pose->file : std::filesystem::path(),
-                     .lens_profile = board_.lens.profile.value_or(std::filesystem::path())},
+                     .lens_profile = board_.lens.profile.value_or(std::filesystem::path()),
+                     .sensor_width_mm = board_.camera->sensor_width_mm},
         sinks_.front()->format(), camera_->format());
     if (options.status != nullptr)
       std::fprintf(options.status, "camhead run: operator page at %s\n", page_->url().c_str());

@@ -416,11 +416,11 @@ std::unique_ptr<MarkerPoseSource> open_marker_source(const Board &board,
                                                      const base::VideoFormat &format,
                                                      const renderer::FrameCamera &base,
                                                      const LensHub &lens, bool every_frame,
-                                                     std::int64_t lens_wait_ns) {
+                                                     std::int64_t lens_wait_ns, double fps) {
   if (!board.pose || board.pose->type != PoseType::marker)
     return nullptr;
   return std::make_unique<MarkerPoseSource>(load_marker_board(board.pose->file), format, base, lens,
-                                            every_frame, lens_wait_ns);
+                                            every_frame, lens_wait_ns, std::llround(1e9 / fps));
 }
 
 double camera_fps(const CameraSource &camera) {

@@ -58,12 +58,12 @@ open_camera(const Board &board, const renderer::Scene &scene, const renderer::Fr
 // A marker pose's tracker for frames of `format` (its board loaded, the
 // OpenCV module opened: throws MarkerBoardError, MarkerModuleError); null
 // for any other pose. `every_frame`: a take composited offline;
-// `lens_wait_ns`: how long a frame's tracking waits for its lens
-// (marker_source.h).
+// `lens_wait_ns`: how long a frame's tracking waits for its lens;
+// `fps`: the camera's rate (marker_source.h).
 [[nodiscard]] std::unique_ptr<MarkerPoseSource>
 open_marker_source(const Board &board, const base::VideoFormat &format,
                    const renderer::FrameCamera &base, const LensHub &lens, bool every_frame,
-                   std::int64_t lens_wait_ns);
+                   std::int64_t lens_wait_ns, double fps);
 
 // Opens the sink at `width` x `height`, `fps` frames a second (for the
 // formats that carry a rate). Throws OutputError (or the backend's error,

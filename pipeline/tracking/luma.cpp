@@ -1,5 +1,7 @@
 #include "luma.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace camhead::pipeline {
@@ -34,6 +36,15 @@ void copy_luma(const base::VideoFormat &format, std::span<const std::uint8_t> fr
     }
     }
   }
+}
+
+bool luma_limited_range(const base::VideoFormat &format) {
+  return base::is_yuv(format.pixel) && format.range == base::ColorRange::limited;
+}
+
+void luma_to_full_range(std::span<std::uint8_t> luma) {
+  for (std::uint8_t &code : luma)
+    code = std::uint8_t(std::clamp(int(std::lround((code - 16) * 255.0 / 219.0)), 0, 255));
 }
 
 } // namespace camhead::pipeline

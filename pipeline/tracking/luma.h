@@ -16,4 +16,12 @@ namespace camhead::pipeline {
 void copy_luma(const base::VideoFormat &format, std::span<const std::uint8_t> frame,
                std::span<std::uint8_t> out);
 
+// Whether copy_luma's codes for `format` span 16-235 (Y'CbCr video in the
+// limited range) rather than 0-255 (full range, and the RGB formats).
+[[nodiscard]] bool luma_limited_range(const base::VideoFormat &format);
+
+// Limited-range codes (16-235) stretched, in place, over the full range
+// (0-255), as an 8-bit grey picture file has them.
+void luma_to_full_range(std::span<std::uint8_t> luma);
+
 } // namespace camhead::pipeline

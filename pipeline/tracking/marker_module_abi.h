@@ -12,7 +12,7 @@
 
 namespace camhead::pipeline::marker_module {
 
-inline constexpr int kAbiVersion = 5;
+inline constexpr int kAbiVersion = 6;
 inline constexpr const char *kFactorySymbol = "camhead_markers_module";
 
 class Module {

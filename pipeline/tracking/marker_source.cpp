@@ -34,13 +34,82 @@ std::vector<glm::dvec3> extent_of(const MarkerBoard &board) {
 
 } // namespace
 
+// The next frame is a whole frame interval past the newest pose found, and
+// extrapolating only part of the way leaves the rest of the camera's motion
+// in the picture (the moving rig's found frames, each predicted as if it
+// were late: median 1.10 px at the virtual objects with 20 ms of a 40-ms
+// interval, 0.39 px with all of it; bench/RESULTS.md, "Late frames and the
+// first"). Two intervals cover a second late frame in a row; found poses
+// with one frame missed between them still give the motion.
+PoseTimelineParams predicted_pose_params(std::int64_t frame_interval_ns) {
+  PoseTimelineParams p;
+  p.max_extrapolation_ns = 2 * frame_interval_ns;
+  p.stale_after_ns = 2 * frame_interval_ns + frame_interval_ns / 2;
+  return p;
+}
+
+CameraModel tracker_camera(const lens_control::LensState &lens, const base::VideoFormat &format,
+                           double sensor_width_mm) {
+  CameraModel camera;
+  camera.fx = camera.fy =
+      lens.projection_focal_length_mm.value * double(format.width) / sensor_width_mm;
+  // The renderer's pixel x spans [x, x + 1); OpenCV's is centred on x.
+  const renderer::LensModel model = lens_model(lens);
+  camera.fy = camera.fx * double(model.fy_over_fx);
+  camera.cx = double(model.principal_point.x) * format.width - 0.5;
+  camera.cy = double(model.principal_point.y) * format.height - 0.5;
+  camera.distortion = {model.k1, model.k2, model.p1, model.p2, model.k3};
+  // The renderer's thin lens (renderer/src/compiled_scene.cpp): an aperture
+  // f / N across, focused at S, spreads a point at depth z over
+  // f / N * fx * |1/S - 1/z| pixels. The tracker draws the board so blurred
+  // where it cannot read it.
+  const double f_m = lens.focal_length_mm.value * 1e-3, n = lens.f_number.value;
+  if (f_m > 0.0 && n > 0.0 && lens.focus_distance_m.value > 0.0) {
+    camera.focus_m = lens.focus_distance_m.value;
+    camera.defocus_px = f_m / n * camera.fx;
+  }
+  return camera;
+}
+
+TrackerGuides tracker_guides(const PoseTimeline &found, std::int64_t mid_ns) {
+  TrackerGuides guides;
+  if (found.size() == 0 || mid_ns - found.newest_ns() > kFollowWithinNs)
+    return guides;
+  guides.predicted = found.at(mid_ns)->pose;
+  if (mid_ns > found.newest_ns())
+    guides.newest = found.at(found.newest_ns())->pose;
+  return guides;
+}
+
+MarkerPose track_guided(MarkerTracker &tracker, const LumaImage &luma, const CameraModel &camera,
+                        const TrackerGuides &guides, double pupil_m) {
+  const auto at_pupil = [pupil_m](CameraPose pose) {
+    pose.position += pose.forward() * pupil_m;
+    return pose;
+  };
+  std::optional<CameraPose> guide;
+  if (guides.predicted)
+    guide = at_pupil(*guides.predicted);
+  MarkerPose found = tracker.track(luma, camera, guide ? &*guide : nullptr);
+  if (!found.found && guides.newest) {
+    guide = at_pupil(*guides.newest);
+    const int markers_seen = found.markers_seen;
+    found = tracker.track(luma, camera, &*guide);
+    found.markers_seen = std::max(found.markers_seen, markers_seen);
+  }
+  if (found.found)
+    found.pose.position -= found.pose.forward() * pupil_m;
+  return found;
+}
+
 MarkerPoseSource::MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
                                    const renderer::FrameCamera &base, const LensHub &lens,
-                                   bool every_frame, std::int64_t lens_wait_ns)
+                                   bool every_frame, std::int64_t lens_wait_ns,
+                                   std::int64_t frame_interval_ns)
     : tracker_(open_marker_tracker(board)), format_(format), sensor_width_mm_(base.sensor_width_mm),
       lens_(lens), every_frame_(every_frame), lens_wait_ns_(lens_wait_ns),
       name_("marker:" + board.name), slots_(kSlots), results_(kResults),
-      board_extent_(extent_of(board)) {
+      found_(predicted_pose_params(frame_interval_ns)), board_extent_(extent_of(board)) {
   for (Slot &slot : slots_)
     slot.luma.resize(std::size_t(format.width) * std::size_t(format.height));
 }
@@ -98,28 +167,6 @@ void MarkerPoseSource::submit(const hal::camera::CapturedFrame &frame) {
   work_.notify_one();
 }
 
-CameraModel MarkerPoseSource::camera_of(const lens_control::LensState &lens) const {
-  CameraModel camera;
-  camera.fx = camera.fy =
-      lens.projection_focal_length_mm.value * double(format_.width) / sensor_width_mm_;
-  // The renderer's pixel x spans [x, x + 1); OpenCV's is centred on x.
-  const renderer::LensModel model = lens_model(lens);
-  camera.fy = camera.fx * double(model.fy_over_fx);
-  camera.cx = double(model.principal_point.x) * format_.width - 0.5;
-  camera.cy = double(model.principal_point.y) * format_.height - 0.5;
-  camera.distortion = {model.k1, model.k2, model.p1, model.p2, model.k3};
-  // The renderer's thin lens (renderer/src/compiled_scene.cpp): an aperture
-  // f / N across, focused at S, spreads a point at depth z over
-  // f / N * fx * |1/S - 1/z| pixels. The tracker draws the board so blurred
-  // where it cannot read it.
-  const double f_m = lens.focal_length_mm.value * 1e-3, n = lens.f_number.value;
-  if (f_m > 0.0 && n > 0.0 && lens.focus_distance_m.value > 0.0) {
-    camera.focus_m = lens.focus_distance_m.value;
-    camera.defocus_px = f_m / n * camera.fx;
-  }
-  return camera;
-}
-
 void MarkerPoseSource::track_loop() {
   std::unique_lock lock(mutex_);
   for (;;) {
@@ -144,11 +191,8 @@ void MarkerPoseSource::track_loop() {
           s.state = SlotState::free;
         }
     slot->state = SlotState::tracking;
-    // The pose predicted for this frame from the last ones found, while
-    // they are recent enough to follow the board from (marker_tracker.h).
-    std::optional<CameraPose> previous;
-    if (found_.size() > 0 && slot->mid_ns - found_.newest_ns() <= kFollowWithinNs)
-      previous = found_.at(slot->mid_ns)->pose;
+    // The poses found recently enough to follow the board from.
+    const TrackerGuides guides = tracker_guides(found_, slot->mid_ns);
     lock.unlock();
 
     // The markers see from the entrance pupil; the renderer's camera, the
@@ -157,19 +201,15 @@ void MarkerPoseSource::track_loop() {
     const lens_control::LensState lens =
         lens_.state_when_covered(slot->mid_ns, slot->submitted_ns + lens_wait_ns_ / 2, &stop_)
             .state;
-    const double pupil_m = lens.entrance_pupil_offset_mm.value / 1000.0;
-    if (previous)
-      previous->position += previous->forward() * pupil_m;
     const LumaImage luma{slot->luma.data(), format_.width, format_.height,
-                         std::ptrdiff_t(format_.width)};
-    const CameraModel camera = camera_of(lens);
+                         std::ptrdiff_t(format_.width), luma_limited_range(format_)};
+    const CameraModel camera = tracker_camera(lens, format_, sensor_width_mm_);
     const std::int64_t track_start_ns = base::monotonic_ns();
-    MarkerPose found = tracker_->track(luma, camera, previous ? &*previous : nullptr);
+    MarkerPose found =
+        track_guided(*tracker_, luma, camera, guides, lens.entrance_pupil_offset_mm.value / 1000.0);
     const double track_s = double(base::monotonic_ns() - track_start_ns) * 1e-9;
-    if (found.found) {
-      found.pose.position -= found.pose.forward() * pupil_m;
+    if (found.found)
       found.pose = still_.filter(found.pose, camera.fx, board_extent_);
-    }
 
     lock.lock();
     results_[next_result_++ % kResults] = {slot->sequence, true, found, track_s};

@@ -13,7 +13,8 @@
 //   render thread    pose_for(frame): that frame's result, waiting for it at
 //                    most until a deadline; when it is late or the board was
 //                    not seen, the pose predicted from the frames before
-//                    (PoseTimeline: 20 ms of extrapolation, then held),
+//                    (predicted_pose_params: the last two found poses'
+//                    motion, for up to two frame intervals, then held),
 //                    flagged not fresh
 //
 // The found pose is the entrance pupil's (the pinhole of the model the
@@ -51,6 +52,38 @@ namespace camhead::pipeline {
 
 class LensHub;
 
+// How a frame whose own pose is late or not found is predicted from the
+// poses found, for a camera of `frame_interval_ns`: along the last two, for
+// up to two frame intervals, then held.
+[[nodiscard]] PoseTimelineParams predicted_pose_params(std::int64_t frame_interval_ns);
+
+// The poses that guide the tracker into a frame (marker_tracker.h), from
+// the poses found before it (reference-plane poses, as found_ keeps them):
+// the pose they predict for the frame's mid-exposure, and the newest found
+// as it was, where the prediction went past it. Neither where the newest
+// is older than 100 ms: no guide to where the board is now.
+struct TrackerGuides {
+  std::optional<CameraPose> predicted, newest;
+};
+[[nodiscard]] TrackerGuides tracker_guides(const PoseTimeline &found, std::int64_t mid_ns);
+
+// The frame's pose: tracked from the predicted guide, and where that finds
+// nothing, from the newest found as it was. A camera that turns back
+// between two frames (a dolly stopped hard, a whip pan's end) is where the
+// prediction overshoots by twice a frame's motion: at 10 fps on the moving
+// rig's test, far enough that the board blurred past reading was not
+// aligned from it, and then never again. Guides and pose are the
+// reference plane's; `pupil_m`: the entrance pupil ahead of it, where the
+// tracker sees from.
+[[nodiscard]] MarkerPose track_guided(MarkerTracker &tracker, const LumaImage &luma,
+                                      const CameraModel &camera, const TrackerGuides &guides,
+                                      double pupil_m);
+
+// The lens as the tracker models it, in pixels of a frame of `format`
+// whose width spans `sensor_width_mm` of the sensor the lens projects onto.
+[[nodiscard]] CameraModel tracker_camera(const lens_control::LensState &lens,
+                                         const base::VideoFormat &format, double sensor_width_mm);
+
 // What a frame's pose was, for the renderer and the record.
 struct FramePose {
   CameraPose pose;
@@ -81,9 +114,11 @@ public:
   // shift. `lens_wait_ns`: how long the render thread waits for the lens
   // and for the pose after a frame is handed over; the tracker waits for
   // the lens half of it at most, leaving the rest for the tracking.
+  // `frame_interval_ns`: the camera's, how far ahead a late frame's pose
+  // is predicted.
   MarkerPoseSource(const MarkerBoard &board, const base::VideoFormat &format,
                    const renderer::FrameCamera &base, const LensHub &lens, bool every_frame,
-                   std::int64_t lens_wait_ns);
+                   std::int64_t lens_wait_ns, std::int64_t frame_interval_ns);
   ~MarkerPoseSource();
   MarkerPoseSource(const MarkerPoseSource &) = delete;
   MarkerPoseSource &operator=(const MarkerPoseSource &) = delete;
@@ -118,8 +153,6 @@ private:
   };
 
   void track_loop();
-  // The lens as the tracker models it, in pixels of the frame.
-  [[nodiscard]] CameraModel camera_of(const lens_control::LensState &lens) const;
   [[nodiscard]] const Result *result_of(std::uint64_t sequence) const;
 
   std::unique_ptr<MarkerTracker> tracker_;

@@ -31,11 +31,16 @@ public:
   using std::runtime_error::runtime_error;
 };
 
-// A frame's luma plane, as captured: 8-bit, rows `stride` bytes apart.
+// A frame's luma plane, as captured: 8-bit, rows `stride` bytes apart; its
+// codes are sRGB's encoding of the light (as the renderer decodes a
+// camera's video), over 16-235 (`limited_range`, as Y'CbCr video most
+// often is) or 0-255. The tracker reads and aligns the board in light,
+// decoded (marker_module.cpp).
 struct LumaImage {
   const std::uint8_t *data = nullptr;
   int width = 0, height = 0;
   std::ptrdiff_t stride = 0;
+  bool limited_range = false;
 };
 
 // The lens at that frame, in pixels of the luma plane: OpenCV's camera

@@ -1,7 +1,8 @@
 // The operator page's camera-calibration helper: the camera frame as it
 // came, its luma plane (tracking/luma.h: what the marker tracker and
-// `camhead calibrate camera` read of a picture) saved as an 8-bit grey PNG
-// in a folder per lens position,
+// `camhead calibrate camera` read of a picture; stretched to the full range
+// by the page where the camera's is limited) saved as an 8-bit grey PNG in
+// a folder per lens position,
 //   RECORDINGS/camera-views/focus-COUNTS[-zoom-COUNTS]/view-NNN.png,
 // so that the views of one calibration (taken at one focus, as the fit
 // needs) are the files of one folder, and the command that fits them can

@@ -12,6 +12,7 @@
 #include "calibration_marks.h"
 #include "camera_views.h"
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/lens_control/lens_profile.h"
 #include "tracking/luma.h"
 #include "tracking/marker_board.h"
 #include "web_server.h"
@@ -477,12 +478,21 @@ web_module::Reply OperatorPage::capture_view() {
   const int w = frame.format.width, h = frame.format.height;
   std::vector<std::uint8_t> luma(std::size_t(w) * std::size_t(h));
   copy_luma(frame.format, frame.bytes, luma);
+  // The PNG, and `calibrate camera` reading it, take the full range.
+  if (luma_limited_range(frame.format))
+    luma_to_full_range(luma);
   const LumaImage image{luma.data(), w, h, w};
 
+  // The zoom counts only for a zoom lens: `calibrate camera --at` refuses
+  // them for a prime, whose source may still send a zoom axis.
+  const ProfileFacts profile = profile_facts();
   LensPlace place;
   if (const auto reading = run_.lens.last_reading();
-      reading && run_.lens.state_at(base::monotonic_ns()).connected)
-    place = {reading->focus, reading->zoom};
+      reading && run_.lens.state_at(base::monotonic_ns()).connected) {
+    place.focus = reading->focus;
+    if (profile.zooms)
+      place.zoom = reading->zoom;
+  }
   SavedView saved;
   if (const std::string error = save_camera_view(recordings_, image, place, saved); !error.empty())
     return {409, json{{"error", "view: " + error}}.dump()};
@@ -519,7 +529,24 @@ web_module::Reply OperatorPage::capture_view() {
       " --profile " +
       (run_.lens_profile.empty() ? std::string("PROFILE.json") : run_.lens_profile.string()) +
       " --at " + saved.at;
+  // A profile's first camera model needs the sensor the pixels span.
+  if (!profile.camera_model && run_.sensor_width_mm > 0.0) {
+    char width[32];
+    std::snprintf(width, sizeof width, "%g", run_.sensor_width_mm);
+    reply["command"] = reply["command"].get<std::string>() + " --sensor-width-mm " + width;
+  }
   return {200, reply.dump()};
+}
+
+OperatorPage::ProfileFacts OperatorPage::profile_facts() const {
+  if (run_.lens_profile.empty())
+    return {};
+  try {
+    const lens_control::LensProfile profile = lens_control::LensProfile::load(run_.lens_profile);
+    return {profile.is_zoom(), profile.has_camera_model()};
+  } catch (const lens_control::ProfileError &) {
+    return {};
+  }
 }
 
 } // namespace camhead::pipeline::web

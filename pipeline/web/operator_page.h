@@ -53,6 +53,8 @@ struct RunView {
   // fit writes into (empty: the board has none).
   std::filesystem::path marker_board;
   std::filesystem::path lens_profile;
+  // The width of the sensor the camera's frames span (the board's camera).
+  double sensor_width_mm = 0.0;
 };
 
 class OperatorPage final : public web_module::Host {
@@ -85,6 +87,14 @@ private:
   // The "view" action: the next camera frame saved for `calibrate camera`
   // (camera_views.h), checked for the marker board's markers.
   web_module::Reply capture_view();
+  // What `calibrate camera` asks of the board's lens profile (read afresh:
+  // a reload may have changed it): whether it is a zoom's (then the views'
+  // zoom counts; assumed without a profile, or one that does not load),
+  // and whether it has a camera model yet (else the sensor's width).
+  struct ProfileFacts {
+    bool zooms = true, camera_model = false;
+  };
+  [[nodiscard]] ProfileFacts profile_facts() const;
 
   RunView run_;
   WebFeed feed_;

@@ -17,6 +17,7 @@
 
 #include "synthetic_view.h"
 #include "tracking/marker_board.h"
+#include "tracking/marker_source.h"
 #include "tracking/marker_tracker.h"
 
 #include <gtest/gtest.h>
@@ -440,6 +441,78 @@ TEST(MarkerTracking, ABoardLitByALampToOneSideIsAlignedAsWellAsOneLitEvenly) {
                 offset.x, offset.y, offset.z, evenly, unevenly);
     EXPECT_LT(unevenly, evenly + 0.15);
   }
+}
+
+// A board first seen already blurred (a run that starts, or a board that
+// comes back, mid focus pull) has no pose before to align from: its markers
+// are read, and from the pose they give, the board is aligned whole, as it
+// would have been with a guide. Through 4 px of blur in a grainy picture (8
+// digital numbers of noise) only 7-8 of the markers can be read, and the
+// pose they give puts the board's corners 0.27-0.52 px off (aligned from it,
+// 0.08-0.09 px); on the moving rig the first frame, read from 4 markers at
+// 6.3 px of blur, was 2.6 px off where the frames aligned after it were 0.2
+// px (bench/RESULTS.md, "Late frames and the first").
+TEST(MarkerTracking, ABoardFirstSeenBlurredIsAlignedFromTheMarkersRead) {
+  const auto tracker = open_marker_tracker(kCharuco);
+  std::mt19937 random(10);
+  constexpr int kBlur = 4;
+  constexpr double kGrain = 8.0;
+  CameraModel lens = camera();
+  lens.defocus_px = 2.0 * kBlur; // focused at infinity: kBlur px at the board's 2 m
+  // (From the third, lowest view no marker is readable through this blur.)
+  for (const glm::dvec3 &offset : {kThreeViews[0], kThreeViews[1]}) {
+    const CameraPose truth = looking_at(kBoardCentre + 2.0 * glm::normalize(offset), kBoardCentre);
+    const cv::Mat picture = test::frame(
+        blurred(test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight}), kBlur), kGrain,
+        random);
+    // The lens's defocus not known: the markers read, and their pose.
+    const MarkerPose read = tracker->track(luma(picture), camera(), nullptr);
+    ASSERT_TRUE(read.found) << "some markers are still readable";
+    EXPECT_FALSE(read.aligned);
+    const MarkerPose got = tracker->track(luma(picture), lens, nullptr);
+    ASSERT_TRUE(got.found);
+    EXPECT_TRUE(got.aligned);
+    EXPECT_EQ(got.markers_seen, read.markers_seen);
+    const double read_px = registration_px(read.pose, truth);
+    const double got_px = registration_px(got.pose, truth);
+    std::printf("first seen through %d px of blur from (%.2f, %.2f, %.2f): %d markers read, the "
+                "board's corners %.2f px off; aligned from that, %.2f px\n",
+                kBlur, offset.x, offset.y, offset.z, read.markers_seen, read_px, got_px);
+    EXPECT_LT(got_px, 0.33);
+    EXPECT_LT(got_px, read_px);
+  }
+}
+
+// A camera that turns back between two frames: the pose predicted from the
+// two before overshoots by twice a frame's motion, 80 mm here, past where
+// a board blurred beyond reading (11 px) can be aligned from. The frame is
+// tracked again from the newest pose found as it was (10 mm off), and the
+// board is not lost; from the prediction alone it was, and a board that
+// cannot be read is not found again (the moving rig's test at 10 fps lost
+// it for the rest of its run whenever its turn fell between two frames).
+TEST(MarkerTracking, APredictionThatOvershootsATurnFallsBackToTheLastPoseFound) {
+  const auto tracker = open_marker_tracker(kCharuco);
+  std::mt19937 random(11);
+  constexpr int kBlur = 11;
+  CameraModel lens = camera();
+  lens.defocus_px = 2.0 * kBlur; // focused at infinity: kBlur px at the board's 2 m
+  const CameraPose truth =
+      looking_at(kBoardCentre + 2.0 * glm::normalize(glm::dvec3(0.0, 1.2, 1.6)), kBoardCentre);
+  const cv::Mat picture =
+      test::frame(blurred(test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight}), kBlur),
+                  1.0, random);
+  TrackerGuides guides;
+  guides.predicted = truth;
+  guides.predicted->position.x += 0.08;
+  const MarkerPose overshot =
+      track_guided(*tracker, luma(picture), lens, {guides.predicted, {}}, 0.0);
+  EXPECT_FALSE(overshot.found) << "aligned from 80 mm off";
+  guides.newest = truth;
+  guides.newest->position.x -= 0.01;
+  const MarkerPose got = track_guided(*tracker, luma(picture), lens, guides, 0.0);
+  ASSERT_TRUE(got.found);
+  EXPECT_TRUE(got.aligned);
+  EXPECT_LT(1000.0 * glm::length(got.pose.position - truth.position), 10.0);
 }
 
 // A ChArUco strip one corner wide (2 squares across): its corners lie on one

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -68,20 +69,39 @@ inline cv::Matx33d supersampled(const CameraModel &camera) {
           0.0,           1.0};
 }
 
-// One frame of that light: Gaussian sensor noise of `noise` digital
-// numbers, quantized to 8 bits. The noise is OpenCV's generator, seeded
-// from `random`: drawn pixel by pixel through <random>, it was half of the
-// marker tests' time in the unoptimised sanitizer build.
+// One frame of that light as a camera codes it: Gaussian noise of `noise`
+// (the sensor's, in the light's 0..255 units), then sRGB's curve (as
+// camhead's renderer takes a camera's video to be coded), quantized to 8
+// bits. The noise is OpenCV's generator, seeded from `random`: drawn pixel
+// by pixel through <random>, it was half of the marker tests' time in the
+// unoptimised sanitizer build.
 inline cv::Mat frame(const cv::Mat &light, double noise, std::mt19937 &random) {
-  cv::Mat out;
+  CV_Assert(light.type() == CV_32F);
+  static const cv::Mat kToCode = [] {
+    // sRGB's encoding (IEC 61966-2-1) of 0..255 light, at a 16th of a level.
+    cv::Mat lut(1, 256 * 16, CV_32F);
+    for (int i = 0; i < lut.cols; ++i) {
+      const double v = i / (255.0 * 16.0);
+      lut.at<float>(i) =
+          float(255.0 * (v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055));
+    }
+    return lut;
+  }();
+  cv::Mat sensed = light.clone(); // `light` is every frame's and stays as it is
   if (noise > 0.0) {
     cv::Mat grain(light.size(), CV_32F);
     cv::RNG(random()).fill(grain, cv::RNG::NORMAL, 0.0, noise);
-    grain += light;              // into the grain: `light` is every frame's and stays as it is
-    grain.convertTo(out, CV_8U); // rounded and saturated, as a sensor's ADC
-  } else {
-    light.convertTo(out, CV_8U);
+    sensed += grain;
   }
+  cv::Mat code(light.size(), CV_32F);
+  for (int y = 0; y < light.rows; ++y) {
+    const float *in = sensed.ptr<float>(y);
+    float *out = code.ptr<float>(y);
+    for (int x = 0; x < light.cols; ++x)
+      out[x] = kToCode.at<float>(std::clamp(int(in[x] * 16.0f + 0.5f), 0, kToCode.cols - 1));
+  }
+  cv::Mat out;
+  code.convertTo(out, CV_8U); // rounded and saturated, as a sensor's ADC
   return out;
 }
 

@@ -1,6 +1,7 @@
 // A camera frame's luma plane for the marker tracker: Y' as captured from
 // the Y'CbCr formats, BT.601 weights from the RGB ones, rows at the frame's
-// stride; and no allocation on the capture thread that calls it.
+// stride, and the range its codes span; and no allocation on the capture
+// thread that calls it.
 #include <cstdint>
 #include <vector>
 
@@ -85,6 +86,22 @@ TEST(Luma, RgbFormatsWeighTheirChannelsAsBt601) {
     for (int x = 0; x < kW; ++x)
       EXPECT_NEAR(got[std::size_t(x)], want[x], 1) << base::pixel_format_name(pixel) << " x " << x;
   }
+}
+
+// Y'CbCr video's codes span 16-235 unless its format says full range; RGB
+// is always full. A view saved for `calibrate camera` (an 8-bit grey PNG,
+// full range by definition) is stretched: black to 0, white to 255, the
+// steps between rounded, and the foot- and headroom clipped.
+TEST(Luma, TheRangeOfTheCodesFollowsTheFormat) {
+  base::VideoFormat yuv = format(PixelFormat::nv12);
+  EXPECT_TRUE(luma_limited_range(yuv));
+  yuv.range = base::ColorRange::full;
+  EXPECT_FALSE(luma_limited_range(yuv));
+  EXPECT_FALSE(luma_limited_range(format(PixelFormat::rgb24)));
+
+  std::vector<std::uint8_t> codes = {0, 15, 16, 17, 126, 235, 236, 255};
+  luma_to_full_range(codes);
+  EXPECT_EQ(codes, (std::vector<std::uint8_t>{0, 0, 0, 1, 128, 255, 255, 255}));
 }
 
 TEST(Luma, CopyingAllocatesNothing) {

@@ -36,18 +36,20 @@ public:
                                   const cv::Mat &distortion, const cv::Vec3d &rvec,
                                   const cv::Vec3d &tvec, cv::Size picture);
 
-  // The board aligned with `image`, starting from (rvec, tvec) and
-  // blurred by `blur` pixels: the chessboard corners and where the
+  // The board aligned with `image` (its codes, and `to_light`, the table
+  // of 256 floats that decodes them to light), starting from (rvec, tvec)
+  // and blurred by `blur` pixels: the chessboard corners and where the
   // alignment puts them in the picture, for the pose solve; false where it
   // does not align (align_board's checks).
-  bool align(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion, cv::Vec3d rvec,
-             cv::Vec3d tvec, double blur, std::vector<cv::Point3f> &object,
-             std::vector<cv::Point2f> &image_points);
+  bool align(const cv::Mat &image, const cv::Mat &to_light, const cv::Matx33d &k,
+             const cv::Mat &distortion, cv::Vec3d rvec, cv::Vec3d tvec, double blur,
+             std::vector<cv::Point3f> &object, std::vector<cv::Point2f> &image_points);
 
 private:
-  bool align_once(const cv::Mat &image, const cv::Matx33d &k, const cv::Mat &distortion,
-                  const cv::Vec3d &rvec, const cv::Vec3d &tvec, double blur, bool fit_light,
-                  std::vector<cv::Point3f> &object, std::vector<cv::Point2f> &image_points);
+  bool align_once(const cv::Mat &image, const cv::Mat &to_light, const cv::Matx33d &k,
+                  const cv::Mat &distortion, const cv::Vec3d &rvec, const cv::Vec3d &tvec,
+                  double blur, bool fit_light, std::vector<cv::Point3f> &object,
+                  std::vector<cv::Point2f> &image_points);
   // The light across the board, fitted to the picture once aligned: a gain
   // that changes linearly over the picture (a lamp nearer one side).
   void fit_shading(const cv::Matx33d &warp, const cv::Rect &roi, double scale);
@@ -66,7 +68,7 @@ private:
   std::vector<cv::Point2f> predicted_, outline_image_, grid_, rays_, row_rays_;
   std::vector<int> column_ray_;
   std::vector<float> column_on_;
-  cv::Mat reduced_, picture_, drawn_sampled_, drawn_fine_, drawn_, map_x_, map_y_, mask_sampled_,
+  cv::Mat light_, picture_, drawn_sampled_, drawn_fine_, drawn_, map_x_, map_y_, mask_sampled_,
       mask_fine_, mask_, warped_, warped_mask_;
   // The gain's slope across the picture, per picture width, in x and in y
   // (relative to the gain at the picture's centre): fitted by one pass,

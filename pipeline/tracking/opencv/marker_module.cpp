@@ -2,16 +2,17 @@
 // on OpenCV 4.6's aruco, calib3d and video (ECC). Its one exported symbol is
 // the factory (marker_module_abi.h); everything else is hidden.
 //
-// Per picture: the board's markers are detected on the luma plane as it is
-// (no copy, no colour conversion); a ChArUco board's chessboard corners are
-// interpolated from them with the frame's lens (so that a distorting lens
-// does not bend the homography, opencv issue 23873) and refined to
-// sub-pixel; a field gives its markers' four corners. The pose is solved
-// from the corners: IPPE for a planar target (which gives both poses of the
-// planar ambiguity, opencv issue 8813), SQPnP for a field that is not flat,
-// then refined by Levenberg-Marquardt on all points. A ChArUco board blurred
-// past reading is followed from the pose before: its corners, or the whole
-// board drawn with the lens's blur and aligned (board_aligner.h).
+// Per picture: the board's markers are detected on the luma plane decoded to
+// light (a table lookup a pixel, light_table; no colour conversion); a
+// ChArUco board's chessboard corners are interpolated from them with the
+// frame's lens (so that a distorting lens does not bend the homography,
+// opencv issue 23873) and refined to sub-pixel; a field gives its markers'
+// four corners. The pose is solved from the corners: IPPE for a planar
+// target (which gives both poses of the planar ambiguity, opencv issue
+// 8813), SQPnP for a field that is not flat, then refined by
+// Levenberg-Marquardt on all points. A ChArUco board blurred past reading is
+// followed from the pose before: its corners, or the whole board drawn with
+// the lens's blur and aligned (board_aligner.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -74,6 +75,32 @@ constexpr double kNoLimit = std::numeric_limits<double>::infinity();
 // corners the alignment gives fit it this well.
 constexpr double kAlignFromBlurPx = 2.0;
 constexpr double kMaxAlignedReprojectionPx = 1.0;
+
+// The table that takes a picture's codes (LumaImage: sRGB over 16-235 or
+// 0-255) to light on a 0..255 scale, as `depth` (CV_8U or CV_32F) for
+// cv::LUT. A lens blurs light, and a camera codes it: sRGB's curve lifts a
+// blurred edge's mid-tones, so that a dark marker looks smaller than it is
+// and a blurred board is no blur of its page. On pictures coded as a
+// camera codes them (tests/markers/synthetic_view.h), read as codes, a
+// sharp board 2 m away seen low (23 degrees) read 17 of its 27 markers and
+// gave a pose 2.8 mm off (0.6 mm in light), and aligned through 20 px of
+// blur and more, the moving rig's board was 1.05 px off at the median (0.18
+// px in light; bench/RESULTS.md, "Late frames and the first").
+cv::Mat light_table(bool limited_range, int depth) {
+  cv::Mat table(1, 256, CV_32F);
+  for (int code = 0; code < 256; ++code) {
+    const double v = std::clamp(limited_range ? (code - 16.0) / 219.0 : code / 255.0, 0.0, 1.0);
+    // sRGB's decoding (IEC 61966-2-1), as renderer/shaders/video.glsl's.
+    table.at<float>(code) =
+        float(255.0 * (v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)));
+  }
+  if (depth == CV_32F)
+    return table;
+  cv::Mat rounded;
+  table.convertTo(rounded, depth);
+  return rounded;
+}
+
 cv::Matx33d camera_matrix(const CameraModel &c) {
   return {c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0};
 }
@@ -127,7 +154,9 @@ class OpenCvTracker final : public MarkerTracker {
 public:
   explicit OpenCvTracker(const MarkerBoard &board)
       : board_(board), dictionary_(cv::aruco::getPredefinedDictionary(board.dictionary)),
-        parameters_(cv::aruco::DetectorParameters::create()) {
+        parameters_(cv::aruco::DetectorParameters::create()), to_light_{light_table(false, CV_32F),
+                                                                        light_table(true, CV_32F)},
+        to_light8_{light_table(false, CV_8U), light_table(true, CV_8U)} {
     // One core: the tracker runs beside the renderer, which has the others.
     // (A process-wide setting; this module is camhead's only OpenCV user.)
     cv::setNumThreads(1);
@@ -161,8 +190,13 @@ public:
 private:
   MarkerPose track_or_throw(const LumaImage &luma, const CameraModel &camera,
                             const CameraPose *previous) {
-    const cv::Mat image(luma.height, luma.width, CV_8UC1, const_cast<std::uint8_t *>(luma.data),
+    const cv::Mat codes(luma.height, luma.width, CV_8UC1, const_cast<std::uint8_t *>(luma.data),
                         std::size_t(luma.stride));
+    // The markers and corners are read in light, to 8 bits (light_table);
+    // the aligner decodes the codes itself, to floats.
+    const int range = luma.limited_range ? 1 : 0;
+    cv::LUT(codes, to_light8_[range], light_);
+    const cv::Mat &image = light_;
     const cv::Matx33d k = camera_matrix(camera);
     const cv::Mat distortion(camera.distortion, false);
     object_.clear();
@@ -172,20 +206,23 @@ private:
     cv::Vec3d rvec, tvec;
     if (previous != nullptr)
       extrinsics(*previous, to_world_, rvec, tvec);
-    const double blur = aligner_ && previous != nullptr
-                            ? aligner_->board_blur(camera, k, distortion, rvec, tvec, image.size())
-                            : 0.0;
+    double blur = aligner_ && previous != nullptr
+                      ? aligner_->board_blur(camera, k, distortion, rvec, tvec, image.size())
+                      : 0.0;
+    // The board aligned from (rvec, tvec), blurred by `blur`, into
+    // `aligned`; `guide`: the pose that picks between a flip's two poses.
     MarkerPose aligned;
     bool tried_aligning = false;
-    const auto align = [&](const MarkerPose &so_far) {
+    const auto align = [&](const MarkerPose &so_far, const CameraPose *guide) {
       tried_aligning = true;
       aligned = so_far;
       aligned.followed = aligned.ambiguous = false;
       aligned.aligned = true;
-      return aligner_->align(image, k, distortion, rvec, tvec, blur, object_, image_points_) &&
-             solve(aligned, k, distortion, previous, kMaxAlignedReprojectionPx);
+      return aligner_->align(codes, to_light_[range], k, distortion, rvec, tvec, blur, object_,
+                             image_points_) &&
+             solve(aligned, k, distortion, guide, kMaxAlignedReprojectionPx);
     };
-    if (blur >= kAlignFromBlurPx && align(MarkerPose{}))
+    if (blur >= kAlignFromBlurPx && align(MarkerPose{}, previous))
       return aligned;
 
     corners_.clear();
@@ -233,10 +270,23 @@ private:
       }
     }
     out.followed = following_;
-    if (solve(out, k, distortion, previous, following_ ? kMaxFollowedReprojectionPx : kNoLimit))
+    if (solve(out, k, distortion, previous, following_ ? kMaxFollowedReprojectionPx : kNoLimit)) {
+      // Read without a pose before (the board's first frame, or its first
+      // after being lost): where the pose read puts the board blurred by
+      // kAlignFromBlurPx or more, the board is aligned whole from it, as
+      // it would have been with a pose before. The moving rig's first
+      // frame, read from 4 markers at 6.3 px of blur, was 2.6 px off; every
+      // aligned frame after it, 0.2 px.
+      if (aligner_ && previous == nullptr) {
+        extrinsics(out.pose, to_world_, rvec, tvec);
+        blur = aligner_->board_blur(camera, k, distortion, rvec, tvec, image.size());
+        if (blur >= kAlignFromBlurPx && align(out, &out.pose))
+          return aligned;
+      }
       return out;
+    }
     // Nothing read, nothing followed: the whole board, aligned.
-    if (aligner_ && previous != nullptr && !tried_aligning && align(out))
+    if (aligner_ && previous != nullptr && !tried_aligning && align(out, previous))
       return aligned;
     return out;
   }
@@ -393,6 +443,9 @@ private:
   bool following_ = false; // this picture's corners were followed from the previous pose
   std::vector<cv::Point3f> object_;
   std::optional<BoardAligner> aligner_; // a ChArUco board's
+  // light_table()s for full and limited range; the picture in light.
+  const cv::Mat to_light_[2], to_light8_[2];
+  cv::Mat light_;
 };
 
 // calibrate_camera() (marker_tracker.h). The corners of each view are
@@ -423,6 +476,7 @@ public:
     const auto charuco = cv::aruco::CharucoBoard::create(
         board.squares_x, board.squares_y, float(board.square_m), float(board.marker_m), dictionary);
     const auto parameters = cv::aruco::DetectorParameters::create();
+    const cv::Mat to_light8[2] = {light_table(false, CV_8U), light_table(true, CV_8U)};
     const cv::Size size(views.front().width, views.front().height);
     out = {};
     out.views.resize(views.size());
@@ -435,8 +489,10 @@ public:
         view.why_not = "its size differs from the first view's";
         continue;
       }
-      const cv::Mat image(luma.height, luma.width, CV_8UC1, const_cast<std::uint8_t *>(luma.data),
+      const cv::Mat codes(luma.height, luma.width, CV_8UC1, const_cast<std::uint8_t *>(luma.data),
                           std::size_t(luma.stride));
+      cv::Mat image;
+      cv::LUT(codes, to_light8[luma.limited_range ? 1 : 0], image);
       std::vector<std::vector<cv::Point2f>> marker_corners;
       std::vector<int> marker_ids;
       cv::aruco::detectMarkers(image, dictionary, marker_corners, marker_ids, parameters);
