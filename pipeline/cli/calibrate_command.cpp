@@ -220,6 +220,20 @@ int run_calibrate_camera(const CameraArgs &args) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
   }
+  if (!pictures.empty()) {
+    place.width_px = pictures.front().width;
+    place.height_px = pictures.front().height;
+  }
+  // --at and --sensor-width-mm against the profile before the fit, which
+  // takes a while: the point written into it with a nominal camera.
+  try {
+    const double w = place.width_px, h = place.height_px;
+    (void)profile_with_camera(profile_text, args.profile, place,
+                              CameraModel{w, w, 0.5 * w, 0.5 * h, {}});
+  } catch (const CameraProfileError &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
   std::fprintf(stderr, "camhead calibrate camera: %zu views of %s...\n", pictures.size(),
                board.name.c_str());
   std::vector<LumaImage> views;
@@ -248,8 +262,6 @@ int run_calibrate_camera(const CameraArgs &args) {
               "k1 %.5f  k2 %.5f  p1 %.6f  p2 %.6f  k3 %.5f\n",
               c.fx, c.fy, c.cx, c.cy, c.distortion[0], c.distortion[1], c.distortion[2],
               c.distortion[3], c.distortion[4]);
-  place.width_px = pictures.front().width;
-  place.height_px = pictures.front().height;
   std::string json;
   try {
     json = profile_with_camera(profile_text, args.profile, place, c);

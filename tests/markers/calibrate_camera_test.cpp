@@ -105,7 +105,8 @@ TEST(CalibrateCamera, RecoversTheSimulatedLens) {
 
 // The command, as a user runs it: PNG views, the example prime's profile,
 // the focus it was at. The profile becomes version 3 and gives the fitted
-// lens back at that focus; a failing run (too few views) leaves it whole.
+// lens back at that focus; a failing run (too few views) leaves it whole,
+// and one whose --at the profile cannot take says so before the fit.
 TEST(CalibrateCamera, TheCommandWritesTheCameraIntoTheProfile) {
   const camhead::test::ScratchDir scratch;
   const fs::path &dir = scratch.path();
@@ -127,12 +128,13 @@ TEST(CalibrateCamera, TheCommandWritesTheCameraIntoTheProfile) {
   { std::ofstream(dir / "floor.json") << test::kFloorBoardJson; }
   const fs::path profile = dir / "lens.json";
   fs::copy_file(fs::path(CAMHEAD_SOURCE_DIR) / "scenes/lenses/example_35mm.json", profile);
-  const auto run = [&](const std::vector<std::string> &files) {
+  const auto run = [&](const std::vector<std::string> &files,
+                       const std::string &at = "focus=9400 --sensor-width-mm 36") {
     std::string command = CAMHEAD_BINARY " calibrate camera";
     for (const std::string &f : files)
       command += " '" + f + "'";
     command += " --board '" + (dir / "floor.json").string() + "' --profile '" + profile.string() +
-               "' --at focus=9400 --sensor-width-mm 36 > '" + (dir / "out.txt").string() + "' 2>&1";
+               "' --at " + at + " > '" + (dir / "out.txt").string() + "' 2>&1";
     const int status = std::system(command.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   };
@@ -144,6 +146,15 @@ TEST(CalibrateCamera, TheCommandWritesTheCameraIntoTheProfile) {
   };
 
   const std::string before = text_of(profile);
+  // A zoom point for a prime, and no sensor width for a profile without a
+  // camera model: refused before the fit starts.
+  for (const std::string at : {"focus=9400,zoom=0 --sensor-width-mm 36", "focus=9400"}) {
+    EXPECT_EQ(run(names, at), 2) << at << ": " << text_of(dir / "out.txt");
+    const std::string out = text_of(dir / "out.txt");
+    EXPECT_NE(out.find(at == "focus=9400" ? "--sensor-width-mm" : "is a prime"), std::string::npos)
+        << out;
+    EXPECT_EQ(out.find("views of"), std::string::npos) << at << ": the fit started\n" << out;
+  }
   EXPECT_EQ(run({names[0], names[1]}), 3) << text_of(dir / "out.txt");
   EXPECT_NE(text_of(dir / "out.txt").find("views with the board usable, 4 needed"),
             std::string::npos)
