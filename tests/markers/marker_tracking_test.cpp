@@ -448,8 +448,8 @@ TEST(MarkerTracking, ABoardLitByALampToOneSideIsAlignedAsWellAsOneLitEvenly) {
 // are read, and from the pose they give, the board is aligned whole, as it
 // would have been with a guide. Through 4 px of blur in a grainy picture (8
 // digital numbers of noise) only 7-8 of the markers can be read, and the
-// pose they give puts the board's corners 0.27-0.52 px off (aligned from it,
-// 0.08-0.09 px); on the moving rig the first frame, read from 4 markers at
+// pose they give puts the board's corners 0.28-0.51 px off (aligned from it,
+// 0.11-0.14 px); on the moving rig the first frame, read from 4 markers at
 // 6.3 px of blur, was 2.6 px off where the frames aligned after it were 0.2
 // px (bench/RESULTS.md, "Late frames and the first").
 TEST(MarkerTracking, ABoardFirstSeenBlurredIsAlignedFromTheMarkersRead) {

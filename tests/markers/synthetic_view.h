@@ -77,29 +77,20 @@ inline cv::Matx33d supersampled(const CameraModel &camera) {
 // unoptimised sanitizer build.
 inline cv::Mat frame(const cv::Mat &light, double noise, std::mt19937 &random) {
   CV_Assert(light.type() == CV_32F);
-  static const cv::Mat kToCode = [] {
-    // sRGB's encoding (IEC 61966-2-1) of 0..255 light, at a 16th of a level.
-    cv::Mat lut(1, 256 * 16, CV_32F);
-    for (int i = 0; i < lut.cols; ++i) {
-      const double v = i / (255.0 * 16.0);
-      lut.at<float>(i) =
-          float(255.0 * (v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055));
-    }
-    return lut;
-  }();
-  cv::Mat sensed = light.clone(); // `light` is every frame's and stays as it is
+  cv::Mat v = light * (1.0 / 255.0); // `light` is every frame's and stays as it is
   if (noise > 0.0) {
     cv::Mat grain(light.size(), CV_32F);
-    cv::RNG(random()).fill(grain, cv::RNG::NORMAL, 0.0, noise);
-    sensed += grain;
+    cv::RNG(random()).fill(grain, cv::RNG::NORMAL, 0.0, noise / 255.0);
+    v += grain;
   }
-  cv::Mat code(light.size(), CV_32F);
-  for (int y = 0; y < light.rows; ++y) {
-    const float *in = sensed.ptr<float>(y);
-    float *out = code.ptr<float>(y);
-    for (int x = 0; x < light.cols; ++x)
-      out[x] = kToCode.at<float>(std::clamp(int(in[x] * 16.0f + 0.5f), 0, kToCode.cols - 1));
-  }
+  v = cv::max(cv::min(v, 1.0), 0.0);
+  // sRGB's encoding (IEC 61966-2-1), whole-picture operations (OpenCV's,
+  // fast in any build).
+  cv::Mat code;
+  cv::pow(v, 1.0 / 2.4, code);
+  code = code * (1.055 * 255.0) - 0.055 * 255.0;
+  const cv::Mat dark = v * (12.92 * 255.0);
+  dark.copyTo(code, v <= 0.0031308);
   cv::Mat out;
   code.convertTo(out, CV_8U); // rounded and saturated, as a sensor's ADC
   return out;
