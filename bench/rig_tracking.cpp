@@ -97,7 +97,8 @@ int run(int argc, char **argv) {
                                                     "monotonic clock (the truth)");
   const renderer::Scene scene = load_run_scene(board);
   const renderer::FrameCamera base = base_camera(board, scene);
-  const camhead::base::VideoFormat format{camhead::base::PixelFormat::yuyv, board.camera->width,
+  // The camera's own format (limited range, as the simulated camera's).
+  const camhead::base::VideoFormat format{board.camera->format, board.camera->width,
                                           board.camera->height};
   const std::int64_t interval_ns = std::llround(1e9 / sim->fps);
   const double path_s = double(path.rows().back().t_ns - path.rows().front().t_ns) * 1e-9;
