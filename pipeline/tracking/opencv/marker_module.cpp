@@ -32,6 +32,8 @@
 
 #include "../marker_module_abi.h"
 #include "board_aligner.h"
+#include "camera_calibrator.h"
+#include "code_to_light.h"
 
 namespace camhead::pipeline {
 namespace {
@@ -75,31 +77,6 @@ constexpr double kNoLimit = std::numeric_limits<double>::infinity();
 // corners the alignment gives fit it this well.
 constexpr double kAlignFromBlurPx = 2.0;
 constexpr double kMaxAlignedReprojectionPx = 1.0;
-
-// The table that takes a picture's codes (LumaImage: sRGB over 16-235 or
-// 0-255) to light on a 0..255 scale, as `depth` (CV_8U or CV_32F) for
-// cv::LUT. A lens blurs light, and a camera codes it: sRGB's curve lifts a
-// blurred edge's mid-tones, so that a dark marker looks smaller than it is
-// and a blurred board is no blur of its page. On pictures coded as a
-// camera codes them (tests/markers/synthetic_view.h), read as codes, a
-// sharp board 2 m away seen low (23 degrees) read 17 of its 27 markers and
-// gave a pose 2.8 mm off (0.6 mm in light), and aligned through 20 px of
-// blur and more, the moving rig's board was 1.05 px off at the median (0.18
-// px in light; bench/RESULTS.md, "Late frames and the first").
-cv::Mat light_table(bool limited_range, int depth) {
-  cv::Mat table(1, 256, CV_32F);
-  for (int code = 0; code < 256; ++code) {
-    const double v = std::clamp(limited_range ? (code - 16.0) / 219.0 : code / 255.0, 0.0, 1.0);
-    // sRGB's decoding (IEC 61966-2-1), as renderer/shaders/video.glsl's.
-    table.at<float>(code) =
-        float(255.0 * (v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)));
-  }
-  if (depth == CV_32F)
-    return table;
-  cv::Mat rounded;
-  table.convertTo(rounded, depth);
-  return rounded;
-}
 
 cv::Matx33d camera_matrix(const CameraModel &c) {
   return {c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0};
@@ -448,125 +425,6 @@ private:
   cv::Mat light_;
 };
 
-// calibrate_camera() (marker_tracker.h). The corners of each view are
-// ChArUco's, interpolated from its markers and refined on the chessboard
-// (OpenCV's interpolateCornersCharuco); the fit is calibrateCameraCharuco
-// with OpenCV's five coefficients (k1 k2 p1 p2 k3).
-class Calibrator {
-public:
-  // A view gives at least this many corners, and the fit this many views.
-  static constexpr int kLeastCorners = 8;
-  static constexpr int kLeastViews = 4;
-  // A view whose error is over this many times the median (and over
-  // kOutlierFloorPx) is left out and the fit repeated once.
-  static constexpr double kOutlierRatio = 3.0;
-  static constexpr double kOutlierFloorPx = 0.3;
-
-  bool run(const MarkerBoard &board, const std::vector<LumaImage> &views, CameraCalibration &out,
-           std::string &error) {
-    if (board.type != MarkerBoardType::charuco) {
-      error = "a camera is calibrated from a ChArUco board; this is a marker field";
-      return false;
-    }
-    if (views.empty()) {
-      error = "no views to calibrate from";
-      return false;
-    }
-    const auto dictionary = cv::aruco::getPredefinedDictionary(board.dictionary);
-    const auto charuco = cv::aruco::CharucoBoard::create(
-        board.squares_x, board.squares_y, float(board.square_m), float(board.marker_m), dictionary);
-    const auto parameters = cv::aruco::DetectorParameters::create();
-    const cv::Mat to_light8[2] = {light_table(false, CV_8U), light_table(true, CV_8U)};
-    const cv::Size size(views.front().width, views.front().height);
-    out = {};
-    out.views.resize(views.size());
-    std::vector<cv::Mat> corners, ids;
-    std::vector<std::size_t> view_of;
-    for (std::size_t i = 0; i < views.size(); ++i) {
-      const LumaImage &luma = views[i];
-      CalibrationView &view = out.views[i];
-      if (luma.width != size.width || luma.height != size.height) {
-        view.why_not = "its size differs from the first view's";
-        continue;
-      }
-      const cv::Mat codes(luma.height, luma.width, CV_8UC1, const_cast<std::uint8_t *>(luma.data),
-                          std::size_t(luma.stride));
-      cv::Mat image;
-      cv::LUT(codes, to_light8[luma.limited_range ? 1 : 0], image);
-      std::vector<std::vector<cv::Point2f>> marker_corners;
-      std::vector<int> marker_ids;
-      cv::aruco::detectMarkers(image, dictionary, marker_corners, marker_ids, parameters);
-      cv::Mat view_corners, view_ids;
-      if (!marker_ids.empty())
-        cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, image, charuco,
-                                             view_corners, view_ids);
-      view.corners = view_corners.rows;
-      if (view.corners < kLeastCorners) {
-        view.why_not = std::to_string(marker_ids.size()) + " markers and " +
-                       std::to_string(view.corners) + " corners found, " +
-                       std::to_string(kLeastCorners) + " corners needed";
-        continue;
-      }
-      corners.push_back(view_corners);
-      ids.push_back(view_ids);
-      view_of.push_back(i);
-    }
-    std::vector<double> errors;
-    if (!fit(corners, ids, charuco, size, out, errors, error))
-      return false;
-    // Outliers: far above the median view, left out once.
-    std::vector<double> sorted = errors;
-    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
-    const double limit = std::max(kOutlierRatio * sorted[sorted.size() / 2], kOutlierFloorPx);
-    std::vector<cv::Mat> kept_corners, kept_ids;
-    std::vector<std::size_t> kept_of;
-    for (std::size_t k = 0; k < errors.size(); ++k) {
-      if (errors[k] > limit) {
-        char why[128];
-        std::snprintf(why, sizeof why, "its error, %.2f px, is over %.1f times the median view's",
-                      errors[k], kOutlierRatio);
-        out.views[view_of[k]].why_not = why;
-        continue;
-      }
-      kept_corners.push_back(corners[k]);
-      kept_ids.push_back(ids[k]);
-      kept_of.push_back(view_of[k]);
-    }
-    if (kept_of.size() != view_of.size() &&
-        !fit(kept_corners, kept_ids, charuco, size, out, errors, error))
-      return false;
-    for (std::size_t k = 0; k < kept_of.size(); ++k) {
-      out.views[kept_of[k]].used = true;
-      out.views[kept_of[k]].rms_px = errors[k];
-    }
-    return true;
-  }
-
-private:
-  static bool fit(const std::vector<cv::Mat> &corners, const std::vector<cv::Mat> &ids,
-                  const cv::Ptr<cv::aruco::CharucoBoard> &charuco, cv::Size size,
-                  CameraCalibration &out, std::vector<double> &errors, std::string &error) {
-    if (int(corners.size()) < kLeastViews) {
-      error = std::to_string(corners.size()) + " views with the board usable, " +
-              std::to_string(kLeastViews) + " needed";
-      return false;
-    }
-    cv::Mat k, distortion, intrinsics_sd, extrinsics_sd, per_view;
-    std::vector<cv::Mat> rvecs, tvecs;
-    out.rms_px = cv::aruco::calibrateCameraCharuco(
-        corners, ids, charuco, size, k, distortion, rvecs, tvecs, intrinsics_sd, extrinsics_sd,
-        per_view, 0, cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
-    out.camera.fx = k.at<double>(0, 0);
-    out.camera.fy = k.at<double>(1, 1);
-    out.camera.cx = k.at<double>(0, 2);
-    out.camera.cy = k.at<double>(1, 2);
-    for (int i = 0; i < 5; ++i)
-      out.camera.distortion[std::size_t(i)] = distortion.at<double>(i);
-    errors.assign(per_view.begin<double>(), per_view.end<double>());
-    return true;
-  }
-};
-
 // draw_board_page() (marker_tracker.h).
 bool draw_page(const MarkerBoard &board, int pixels_per_square, BoardPage &out,
                std::string &error) {
@@ -608,7 +466,7 @@ public:
   bool calibrate(const MarkerBoard &board, const std::vector<LumaImage> &views,
                  CameraCalibration &out, std::string &error) override {
     try {
-      return Calibrator().run(board, views, out, error);
+      return calibrate_views(board, views, out, error);
     } catch (const std::exception &e) {
       error = std::string("OpenCV: ") + e.what();
       return false;
