@@ -15,7 +15,6 @@
 // the lens's blur and aligned (board_aligner.h).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <limits>
 #include <optional>
