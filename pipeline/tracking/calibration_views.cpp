@@ -95,6 +95,7 @@ void read_y4m(const fs::path &file, std::size_t most, std::vector<CalibrationPic
                                header->height,
                                {}};
     picture.luma.resize(luma_bytes); // the Y plane comes first
+    picture.limited_range = luma_limited_range(format);
     in.seekg(planes[k]);
     if (!in.read(reinterpret_cast<char *>(picture.luma.data()), std::streamsize(luma_bytes)))
       fail(file, "frame " + std::to_string(k) + " cannot be read");

@@ -198,6 +198,13 @@ TEST(CalibrateCamera, AVideosFramesAreViews) {
   ASSERT_EQ(some.size(), 6u);
   EXPECT_EQ(some[1].name, "take.y4m frame 3");
   EXPECT_TRUE(std::equal(some[5].luma.begin(), some[5].luma.end(), views[15].data));
+  // Their codes are decoded to light over the range the header states:
+  // 16-235 where it states none, as Y4M video most often is.
+  EXPECT_TRUE(all[0].image().limited_range);
+  std::string full = y4m;
+  full.insert(full.find('\n'), " XCOLORRANGE=FULL");
+  EXPECT_FALSE(
+      read_calibration_views({scratch.write("full.y4m", full)}, 1)[0].image().limited_range);
   // Cut short: refused by name.
   const fs::path cut = scratch.write("cut.y4m", y4m.substr(0, y4m.size() - 1000));
   try {
