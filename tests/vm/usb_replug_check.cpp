@@ -134,5 +134,8 @@ int main(int argc, char **argv) {
     detail = problem.empty() ? text : problem + "; " + text;
   }
   camhead::vm::print_result("usb_replug_backend", problem.empty(), detail);
-  return problem.empty() ? 0 : 1;
+  // The verdict is the RESULT line. The exit status is left to what the
+  // line cannot say (a crash, a sanitizer's report at exit): it fails every
+  // check of usb_lens.sh (lab_result.sh), not only this one.
+  return 0;
 }

@@ -309,5 +309,8 @@ int main(int argc, char **argv) {
         std::printf("LAB usb_run: camhead: %s\n", lines[n].c_str());
     }
   }
-  return problem.empty() ? 0 : 1;
+  // The verdict is the RESULT line. The exit status is left to what the
+  // line cannot say (a crash, a sanitizer's report at exit): it fails every
+  // check of usb_lens.sh (lab_result.sh), not only this one.
+  return 0;
 }
