@@ -15,7 +15,7 @@
 //
 // The pictures are kept in FILE (m.jsonl.luma where not given: their luma
 // planes, about 60 MB for the bundled loop) and read back by a later run
-// of the same board and samples, so that a change to the tracker is
+// of the same board, world and samples, so that a change to the tracker is
 // measured on the same pictures in seconds. The tracker gets the lens the camera filmed with (the
 // trace as the glass moved), not the lens chain's estimate of it: this measures the tracker alone.
 // No still filter: the rig never stands still.
@@ -25,7 +25,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <span>
@@ -58,6 +61,22 @@ using namespace camhead::pipeline;
 namespace renderer = camhead::renderer;
 
 const bool kModuleFound = setenv("CAMHEAD_MARKERS_MODULE", CAMHEAD_BENCH_MARKERS_MODULE, 0) == 0;
+
+std::string contents_of(const std::filesystem::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// What the kept pictures are of, so that pictures of another world are
+// never read back: the board, its scene, its path and its lens traces, byte
+// for byte (not the files the scene names: textures, meshes).
+std::size_t world_digest(const Board &board, const SimCameraConfig &sim) {
+  std::string all = contents_of(board.file) + contents_of(*board.scene) + contents_of(*sim.path);
+  for (const LensSourceConfig &source : board.lens.sources)
+    if (const auto *trace = std::get_if<TraceSourceConfig>(&source.kind))
+      all += contents_of(trace->file);
+  return std::hash<std::string>{}(all);
+}
 
 void write_vec(std::FILE *out, const char *key, const glm::dvec3 &v) {
   std::fprintf(out, "\"%s\":[%.6f,%.6f,%.6f]", key, v.x, v.y, v.z);
@@ -108,7 +127,8 @@ int run(int argc, char **argv) {
   // The loop's pictures: read back, or rendered and kept.
   std::vector<std::uint8_t> pictures(plane * std::size_t(frames));
   const std::string stamp = std::string(argv[1]) + " samples " + std::to_string(samples) + " " +
-                            std::to_string(frames) + "\n";
+                            std::to_string(frames) + " world " +
+                            std::to_string(world_digest(board, *sim)) + "\n";
   bool read_back = false;
   if (std::ifstream in(luma_path, std::ios::binary); in) {
     std::string line;
