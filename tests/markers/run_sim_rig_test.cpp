@@ -154,8 +154,9 @@ TEST_F(MovingRig, TheMarkerPoseRegistersTheVirtualWorldThroughAMoveAndAFocusPull
 // of 12-17 px, far past reading its markers or following its corners. Its
 // pose is found in every later frame by aligning the board drawn with the
 // lens's blur, within the 1 px of a sharp board (0.47-0.74 px in runs
-// here; the moving rig, at 720x576 and 10-27 px: 0.7 px median, 2.3 px
-// worst, bench/RESULTS.md, "Registration through defocus").
+// here; the moving rig, at 720x576 and up to 26 px of blur, in 60-s live
+// runs: 0.42 and 0.64 px worst, bench/RESULTS.md, "The simulated camera's
+// grain").
 TEST_F(MovingRig, TheMarkerPoseFollowsTheBoardThroughADeepDefocus) {
   ASSERT_TRUE(kModuleFound);
   const Registration r = run("# camhead lens trace v1\n"
