@@ -5,7 +5,9 @@
 //
 //   capture thread   submit(frame): the luma plane copied into a free slot
 //                    (the camera's buffer goes back at once); never waits
-//   camhead-track    tracks the newest frame handed over, with the lens at
+//   camhead-track    first tracks a picture of the board once (OpenCV's
+//                    set-up, paid before the first frame), then
+//                    tracks the newest frame handed over, with the lens at
 //                    its mid-exposure (focal length in pixels from the
 //                    profile's projection focal length: breathing and zoom
 //                    followed), holds it while the camera is still
@@ -152,6 +154,7 @@ private:
     double track_s = 0.0;
   };
 
+  void warm_up();
   void track_loop();
   [[nodiscard]] const Result *result_of(std::uint64_t sequence) const;
 
@@ -170,6 +173,7 @@ private:
   std::size_t next_result_ = 0;
   PoseTimeline found_; // the poses found: the tracker's guide, and frames without one
   StillPoseFilter still_;
+  const MarkerBoard board_;
   std::vector<glm::dvec3> board_extent_; // for the still filter
   std::atomic<bool> stop_{false};        // set under mutex_; read unlocked by the lens wait
   std::thread thread_;
