@@ -1,6 +1,7 @@
 #include "camera_calibrator.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
 
