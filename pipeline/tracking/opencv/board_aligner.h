@@ -68,8 +68,10 @@ private:
   std::vector<cv::Point2f> predicted_, outline_image_, grid_, rays_, row_rays_;
   std::vector<int> column_ray_;
   std::vector<float> column_on_;
-  cv::Mat light_, picture_, drawn_sampled_, drawn_fine_, drawn_, map_x_, map_y_, mask_sampled_,
-      mask_fine_, mask_, warped_, warped_mask_;
+  // The drawing reaches past the picture's edges (drawn_whole_,
+  // mask_whole_); drawn_ and mask_ are the picture's part of it.
+  cv::Mat light_, picture_, drawn_sampled_, drawn_fine_, drawn_whole_, drawn_, map_x_, map_y_,
+      mask_sampled_, mask_fine_, mask_whole_, mask_, warped_, warped_mask_;
   // The gain's slope across the picture, per picture width, in x and in y
   // (relative to the gain at the picture's centre): fitted by one pass,
   // drawn in by the next.
