@@ -19,8 +19,8 @@
 // Prints a table by blur (frames, median and worst registration, median
 // reprojection error), then one by how each pose was found (on the board
 // and at the virtual objects, how far the registration jumps from one
-// composite to the next, and how far out it puts the board's corners: a
-// scale error), then one of every found frame predicted as if its tracking
+// composite to the next, how far out it puts the board's corners: a scale
+// error, and the frames' tracking time where the record has it), then one of every found frame predicted as if its tracking
 // had come late (the marker source's rule, marker_source.h, against the
 // 20 ms it had before); OUT.csv gets a row per frame and OUT.png the chart.
 #include <algorithm>
@@ -76,6 +76,9 @@ struct Frame {
   // camera's own motion taken out).
   double jump = 0;
   std::string found_by; // the record's pose_found_by; empty: null
+  // The frame's tracking time (the record's track_ms), NaN where the
+  // record has none.
+  double track_ms = std::numeric_limits<double>::quiet_NaN();
 };
 
 CameraPose recorded_pose(const nlohmann::json &pose) {
@@ -208,6 +211,8 @@ int run(int argc, char **argv) {
     f.reprojection =
         r.at("reprojection_px").is_null() ? 0.0 : r.at("reprojection_px").get<double>();
     f.markers = r.value("markers_seen", 0);
+    if (const auto t = r.find("track_ms"); t != r.end() && t->is_number())
+      f.track_ms = t->get<double>();
     frames.push_back(f);
   }
 
@@ -260,9 +265,9 @@ int run(int argc, char **argv) {
   // pose measured afresh each frame jitters (the jump).
   std::printf("\n| found by | frames | on the board: median, p90, worst | at the virtual objects: "
               "median, p90, worst | within 1 px | jump since the composite before: median, p99, "
-              "worst | outward: median |\n|---|---|---|---|---|---|---|\n");
+              "worst | outward: median | tracking: median, p90 |\n|---|---|---|---|---|---|---|---|\n");
   for (const char *by : {"markers", "corners", "alignment"}) {
-    std::vector<double> board_px, virtual_px, jump_px, outward_px;
+    std::vector<double> board_px, virtual_px, jump_px, outward_px, track_ms;
     std::size_t within = 0;
     for (const Frame &f : frames)
       if (f.found && f.found_by == by) {
@@ -270,17 +275,19 @@ int run(int argc, char **argv) {
         virtual_px.push_back(f.at_virtual);
         jump_px.push_back(f.jump);
         outward_px.push_back(f.outward);
+        if (std::isfinite(f.track_ms))
+          track_ms.push_back(f.track_ms);
         within += f.registration <= 1.0 ? 1 : 0;
       }
     if (board_px.empty())
       continue;
     std::printf("| %s | %zu | %.2f, %.2f, %.2f px | %.2f, %.2f, %.2f px | %.1f %% | %.2f, %.2f, "
-                "%.2f px | %+.2f px |\n",
+                "%.2f px | %+.2f px | %.2f, %.2f ms |\n",
                 by, board_px.size(), quantile(board_px, 0.5), quantile(board_px, 0.9),
                 quantile(board_px, 1.0), quantile(virtual_px, 0.5), quantile(virtual_px, 0.9),
                 quantile(virtual_px, 1.0), 100.0 * double(within) / double(board_px.size()),
                 quantile(jump_px, 0.5), quantile(jump_px, 0.99), quantile(jump_px, 1.0),
-                quantile(outward_px, 0.5));
+                quantile(outward_px, 0.5), quantile(track_ms, 0.5), quantile(track_ms, 0.9));
   }
 
   // Each frame found as if its tracking had come late: predicted from the
@@ -322,12 +329,13 @@ int run(int argc, char **argv) {
     const std::string out = argv[3];
     std::ofstream csv(out + ".csv");
     csv << "t_s,pose_found,found_by,blur_px,registration_px,on_board_px,at_virtual_px,jump_px,"
-           "reprojection_px,markers_seen,outward_px\n";
+           "reprojection_px,markers_seen,outward_px,track_ms\n";
     for (const Frame &f : frames) {
-      char row[200];
-      std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%.4f\n", f.t_s,
-                    int(f.found), f.found_by.c_str(), f.blur_px, f.registration, f.on_board,
-                    f.at_virtual, f.jump, f.reprojection, f.markers, f.outward);
+      char row[220];
+      std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.3f\n",
+                    f.t_s, int(f.found), f.found_by.c_str(), f.blur_px, f.registration,
+                    f.on_board, f.at_virtual, f.jump, f.reprojection, f.markers, f.outward,
+                    f.track_ms);
       csv << row;
     }
     const chart::Panel panels[] = {{"pose found in the frame",

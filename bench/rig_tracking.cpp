@@ -7,7 +7,7 @@
 // run/trace_lens.h), tracks every one in order as the live source does
 // (the lens of its mid-exposure, guided by the poses found before:
 // tracker_guides, track_guided), and writes a record that registration_by_blur
-// reads like a run's:
+// reads like a run's (each frame's tracking time in it too, as track_ms):
 //
 //   build/bench/rig_tracking board/sim-moving.json m.jsonl [--samples N] [--loops N]
 //                            [--pictures FILE]
@@ -180,7 +180,8 @@ int run(int argc, char **argv) {
     const MarkerPose pose =
         track_guided(*tracker, luma, tracker_camera(state, format, board.camera->sensor_width_mm),
                      tracker_guides(found, mid), state.entrance_pupil_offset_mm.value / 1000.0);
-    track_s += double(camhead::base::monotonic_ns() - start) * 1e-9;
+    const double frame_s = double(camhead::base::monotonic_ns() - start) * 1e-9;
+    track_s += frame_s;
     if (pose.found)
       (void)found.push(mid, pose.pose);
     const CameraPose recorded = pose.found         ? pose.pose
@@ -203,9 +204,10 @@ int run(int argc, char **argv) {
     else
       std::fprintf(out, "null");
     if (pose.found)
-      std::fprintf(out, ",\"reprojection_px\":%.4f}\n", pose.reprojection_px);
+      std::fprintf(out, ",\"reprojection_px\":%.4f", pose.reprojection_px);
     else
-      std::fprintf(out, ",\"reprojection_px\":null}\n");
+      std::fprintf(out, ",\"reprojection_px\":null");
+    std::fprintf(out, ",\"track_ms\":%.3f}\n", 1e3 * frame_s);
   }
   std::fclose(out);
   std::printf("rig_tracking: %d frames tracked (%d loops of %d), %.1f ms a frame; wrote %s\n",
