@@ -20,9 +20,10 @@
 // reprojection error), then one by how each pose was found (on the board
 // and at the virtual objects, how far the registration jumps from one
 // composite to the next, how far out it puts the board's corners: a scale
-// error, and the frames' tracking time where the record has it), then one of every found frame predicted as if its tracking
-// had come late (the marker source's rule, marker_source.h, against the
-// 20 ms it had before); OUT.csv gets a row per frame and OUT.png the chart.
+// error, and the frames' tracking time where the record has it), then one
+// of every found frame predicted as if its tracking had come late (the
+// marker source's rule, marker_source.h, against the 20 ms it had before);
+// OUT.csv gets a row per frame and OUT.png the chart.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -263,9 +264,10 @@ int run(int argc, char **argv) {
   // Where the error is and how it moves, by how the pose was found: a
   // planar board pins its own corners better than points off it, and a
   // pose measured afresh each frame jitters (the jump).
-  std::printf("\n| found by | frames | on the board: median, p90, worst | at the virtual objects: "
-              "median, p90, worst | within 1 px | jump since the composite before: median, p99, "
-              "worst | outward: median | tracking: median, p90 |\n|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n| found by | frames | on the board: median, p90, worst | at the virtual objects: "
+      "median, p90, worst | within 1 px | jump since the composite before: median, p99, "
+      "worst | outward: median | tracking: median, p90 |\n|---|---|---|---|---|---|---|---|\n");
   for (const char *by : {"markers", "corners", "alignment"}) {
     std::vector<double> board_px, virtual_px, jump_px, outward_px, track_ms;
     std::size_t within = 0;
@@ -333,9 +335,8 @@ int run(int argc, char **argv) {
     for (const Frame &f : frames) {
       char row[220];
       std::snprintf(row, sizeof row, "%.4f,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.3f\n",
-                    f.t_s, int(f.found), f.found_by.c_str(), f.blur_px, f.registration,
-                    f.on_board, f.at_virtual, f.jump, f.reprojection, f.markers, f.outward,
-                    f.track_ms);
+                    f.t_s, int(f.found), f.found_by.c_str(), f.blur_px, f.registration, f.on_board,
+                    f.at_virtual, f.jump, f.reprojection, f.markers, f.outward, f.track_ms);
       csv << row;
     }
     const chart::Panel panels[] = {{"pose found in the frame",
