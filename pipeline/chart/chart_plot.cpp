@@ -67,6 +67,7 @@ constexpr Glyph kFont[] = {
     {'%', {0x19, 0x19, 0x02, 0x04, 0x08, 0x13, 0x13}},
     {'_', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1f}},
     {'*', {0x00, 0x04, 0x15, 0x0e, 0x15, 0x04, 0x00}},
+    {'\'', {0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00}},
 };
 
 const Glyph *find_glyph(char c) {
@@ -200,6 +201,14 @@ void draw_panel(Canvas &canvas, const Panel &panel, int left, int top, int width
   canvas.text((x0 + x1 - text_width(panel.x_label, 2)) / 2, y1 + 24, panel.x_label, kBlack, 2);
   canvas.text(left + 6, (y0 + y1 + text_width(panel.y_label, 2)) / 2, panel.y_label, kBlack, 2,
               true);
+
+  // A panel with nothing to plot (a run with no frame of that kind) says
+  // so, where an empty grid and a legend would suggest points missing.
+  if (!(max_x > 0.0)) {
+    const std::string none = "no points";
+    canvas.text((x0 + x1 - text_width(none, 2)) / 2, (y0 + y1) / 2 - 7, none, kBlack, 2);
+    return;
+  }
 
   // Series: lines between consecutive valid points, then markers on top.
   for (const Series &s : panel.series) {

@@ -1,5 +1,6 @@
 // The chart's drawing and CSV (pipeline/chart/chart_plot.h): every label the chart
 // writes has glyphs, series land in their colours, CSV fields are quoted.
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,8 @@ namespace {
 TEST(ChartPlot, FontCoversTheChartsText) {
   for (const std::string s :
        {"frame time (ms)", "relative RMSE", "pinhole+gather", "uniform", "1e-05", "0.001",
-        "depth edges (12% of pixels, 8 px)", "ar_basic 720x576, NVIDIA H100: labels/rpp"})
+        "depth edges (12% of pixels, 8 px)", "ar_basic 720x576, NVIDIA H100: labels/rpp",
+        "Moving rig: registration by the board's blur", "no points"})
     for (char c : s)
       EXPECT_TRUE(font_has(c)) << "'" << c << "' in " << s;
 }
@@ -42,6 +44,28 @@ TEST(ChartPlot, DrawsSeriesAxesAndLegend) {
   EXPECT_GT(reds, 200);    // lines and markers in both panels
   EXPECT_GT(blues, 40);    // one valid point (x = 0 has no log) and its legend entry
   EXPECT_GT(blacks, 2000); // axes, ticks, text
+}
+
+// A panel whose series have no point that a log axis can show (none, or
+// only zeros and NaN) says so in the middle of its plot, with no legend
+// for lines that are not there.
+TEST(ChartPlot, AnEmptyPanelSaysSo) {
+  const Rgb red{214, 39, 40};
+  Panel empty;
+  empty.title = "pose held or predicted";
+  empty.series.push_back({"worst", red, Marker::triangle, {0.0, 5.0}, {0.3, 0.0}, {}});
+  const Canvas canvas = plot_log_log("", std::vector<Panel>{empty}, 320, 240);
+  int reds = 0, middle_blacks = 0;
+  for (int y = 0; y < canvas.height; ++y)
+    for (int x = 0; x < canvas.width; ++x) {
+      const Rgb p = canvas.pixel(x, y);
+      reds += p == red;
+      const bool middle =
+          std::abs(x - canvas.width / 2) < 60 && std::abs(y - canvas.height / 2) < 20;
+      middle_blacks += middle && p == Rgb{0, 0, 0};
+    }
+  EXPECT_EQ(reds, 0) << "no line, marker or legend entry";
+  EXPECT_GT(middle_blacks, 50) << "the words in the middle";
 }
 
 TEST(ChartPlot, CsvQuotesWhereNeeded) {
