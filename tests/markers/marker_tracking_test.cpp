@@ -459,8 +459,9 @@ TEST(MarkerTracking, ABoardLitByALampToOneSideIsAlignedAsWellAsOneLitEvenly) {
 
 // The light of the board seen from `truth` through a lens whose blur is a
 // disc `blur` px across, out to the picture's edges: the view rendered
-// wider than the picture by the disc's radius, so that the light the lens
-// gathers from past the edge is in it, blurred, then cut to the picture.
+// wider than the picture by as much as `blurred`'s kernel reaches (its
+// diameter), so that the light the lens gathers from past the edge is in
+// it, blurred, then cut to the picture.
 cv::Mat blurred_to_the_edge(const CameraPose &truth, int blur) {
   const int pad = blur;
   CameraModel wider = camera();

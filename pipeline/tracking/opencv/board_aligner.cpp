@@ -22,7 +22,8 @@ namespace {
 // moved by more than this fraction of a square from where the previous pose
 // put it (a chessboard looks alike one square over: no slipping into that),
 // and if at least as many corners as a followed board needs are in the
-// picture. Two passes, the second from the first's pose.
+// picture. Two passes, the second from the first's pose (the first may
+// run one reduction further: kMinCoarsePassPixels).
 constexpr int kMaxAlignLevel = 2;
 constexpr double kMinAlignCorrelation = 0.8;
 constexpr double kAlignReach = 0.4;
@@ -46,7 +47,7 @@ constexpr int kMinAlignPixels = 200, kMaxAlignPixels = 8000;
 // where the board covers at least this many pixels there: on a quarter of
 // the pixels. The moving rig's aligned frames tracked in two thirds of the
 // time (at 1920x1080 the median and p90, at 720x576 the p90) and
-// registered as well (frame by frame, the mean difference within 0.03 px);
+// registered as well (frame by frame, the mean difference under 0.01 px);
 // with no such floor the synthetic boards of tests/markers, a few hundred
 // pixels there, were not aligned (bench/RESULTS.md, "A coarser first
 // pass").
