@@ -38,19 +38,23 @@ constexpr int kEccIterations = 30;
 constexpr double kEccEpsilon = 1e-3;
 // The board's outline is projected at this many points an edge (a
 // distorting lens bends it); at least this many pixels of the reduced
-// picture must be compared, and at most this many are (ECC's time grows
+// picture must be compared, and the reduction goes on (up to
+// kMaxAlignLevel) while more than this many would be (ECC's time grows
 // with them). Rays through the lens are undistorted at every kRayStep-th
 // pixel of the drawing's grid.
 constexpr int kOutlineSteps = 8;
 constexpr int kMinAlignPixels = 200, kMaxAlignPixels = 8000;
 // The first of the two passes runs one reduction further than the second
-// where the board covers at least this many pixels there: on a quarter of
-// the pixels. The moving rig's aligned frames tracked in two thirds of the
-// time (at 1920x1080 the median and p90, at 720x576 the p90) and
-// registered as well (frame by frame, the mean difference under 0.01 px);
-// with no such floor the synthetic boards of tests/markers, a few hundred
-// pixels there, were not aligned (bench/RESULTS.md, "A coarser first
-// pass").
+// where the board's outline (its bounding box in the picture) covers at
+// least this many pixels there: on a quarter of the pixels. The moving
+// rig's aligned frames tracked in two thirds of the time (at 1920x1080 the
+// median and p90, at 720x576 the p90) and registered as well (frame by
+// frame, the mean difference under 0.01 px; on two clean synthetic views
+// the camera's position came out 0.1-0.6 mm further off); with no such
+// floor the synthetic boards of tests/markers, a few hundred pixels there,
+// were not aligned. Where that pass fails all the same (a board seen edge
+// on, its eroded mask too small there), it runs again at the second's
+// reduction (bench/RESULTS.md, "A coarser first pass").
 constexpr int kMinCoarsePassPixels = 2000;
 constexpr int kRayStep = 8;
 // At most this many samples a grid pixel along one axis: for a board
@@ -155,8 +159,15 @@ bool BoardAligner::align(const cv::Mat &image, const cv::Mat &to_light, const cv
   shading_ = {0.0, 0.0};
   for (int pass = 0; pass < kAlignPasses; ++pass) {
     const bool last = pass + 1 == kAlignPasses;
-    if (!align_once(image, to_light, k, distortion, rvec, tvec, blur, pass == 0, object,
-                    image_points))
+    bool coarser = pass == 0;
+    bool aligned = align_once(image, to_light, k, distortion, rvec, tvec, blur, pass == 0, coarser,
+                              object, image_points);
+    if (!aligned && coarser) { // the coarser first pass failed: again at the second's reduction
+      coarser = false;
+      aligned = align_once(image, to_light, k, distortion, rvec, tvec, blur, pass == 0, coarser,
+                           object, image_points);
+    }
+    if (!aligned)
       return false;
     if (!last && !cv::solvePnP(object, image_points, k, distortion, rvec, tvec, true,
                                cv::SOLVEPNP_ITERATIVE))
@@ -167,10 +178,12 @@ bool BoardAligner::align(const cv::Mat &image, const cv::Mat &to_light, const cv
 
 // One pass: the board drawn from (rvec, tvec) and aligned; the corners
 // it moves into object and image_points. The `first` pass also fits the
-// light's gain across the picture for the next pass to draw.
+// light's gain across the picture for the next pass to draw. `coarser`:
+// one reduction further where the board allows it (kMinCoarsePassPixels);
+// false on return where it did not.
 bool BoardAligner::align_once(const cv::Mat &image, const cv::Mat &to_light, const cv::Matx33d &k,
                               const cv::Mat &distortion, const cv::Vec3d &rvec,
-                              const cv::Vec3d &tvec, double blur, bool first,
+                              const cv::Vec3d &tvec, double blur, bool first, bool &coarser,
                               std::vector<cv::Point3f> &object,
                               std::vector<cv::Point2f> &image_points) {
   const std::vector<cv::Point3f> &corners = charuco_->chessboardCorners;
@@ -199,9 +212,10 @@ bool BoardAligner::align_once(const cv::Mat &image, const cv::Mat &to_light, con
     ++level;
   level = std::min(level, kMaxAlignLevel);
   // The first pass only brings the drawing near the picture for the
-  // second, whose pose is the one kept: where the board still covers
-  // kMinCoarsePassPixels one reduction further, the first pass runs there.
-  if (first && (outline.area() >> (2 * (level + 1))) >= kMinCoarsePassPixels)
+  // second, whose pose is the one kept: where the board's outline still
+  // covers kMinCoarsePassPixels one reduction further, it may run there.
+  coarser = coarser && (outline.area() >> (2 * (level + 1))) >= kMinCoarsePassPixels;
+  if (coarser)
     ++level;
   const double scale = std::ldexp(1.0, -level);
   const cv::Size size(image.cols >> level, image.rows >> level);

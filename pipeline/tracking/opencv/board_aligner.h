@@ -48,7 +48,7 @@ public:
 private:
   bool align_once(const cv::Mat &image, const cv::Mat &to_light, const cv::Matx33d &k,
                   const cv::Mat &distortion, const cv::Vec3d &rvec, const cv::Vec3d &tvec,
-                  double blur, bool first, std::vector<cv::Point3f> &object,
+                  double blur, bool first, bool &coarser, std::vector<cv::Point3f> &object,
                   std::vector<cv::Point2f> &image_points);
   // The light across the board, fitted to the picture once aligned: a gain
   // that changes linearly over the picture (a lamp nearer one side).
