@@ -94,7 +94,8 @@ struct LogAxis {
 
 LogAxis axis_spanning(double min_v, double max_v) {
   LogAxis axis;
-  if (!(min_v > 0.0) || !std::isfinite(max_v)) {
+  // No data leaves min_v at infinity and max_v at 0.
+  if (!(min_v > 0.0) || !std::isfinite(min_v) || !(max_v > 0.0) || !std::isfinite(max_v)) {
     return axis; // no data: one decade, 1..10
   }
   axis.lo = int(std::floor(std::log10(min_v) + 1e-9));
