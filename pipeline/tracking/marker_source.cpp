@@ -39,17 +39,17 @@ std::vector<std::uint8_t> warm_up_picture(const MarkerBoard &board,
   std::vector<std::uint8_t> picture(std::size_t(format.width) * std::size_t(format.height), 128);
   if (board.type != MarkerBoardType::charuco)
     return picture;
-  // The page at 32 pixels a square, nearest, centred, shrunk to fit.
-  const BoardPage page = draw_board_page(board, 32);
-  const double scale =
-      std::min({1.0, 0.8 * format.width / page.width, 0.8 * format.height / page.height});
-  const int w = int(page.width * scale), h = int(page.height * scale);
+  // The page centred, drawn at as many pixels a square (up to 32) as fit
+  // four fifths of the frame.
+  const int pixels_per_square = std::clamp(
+      std::min(4 * format.width / (5 * board.squares_x), 4 * format.height / (5 * board.squares_y)),
+      1, 32);
+  const BoardPage page = draw_board_page(board, pixels_per_square);
+  const int w = std::min(page.width, format.width), h = std::min(page.height, format.height);
   const int x0 = (format.width - w) / 2, y0 = (format.height - h) / 2;
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      picture[std::size_t(y0 + y) * std::size_t(format.width) + std::size_t(x0 + x)] =
-          page.grey[std::size_t(int(y / scale)) * std::size_t(page.width) +
-                    std::size_t(int(x / scale))];
+    std::copy_n(page.grey.begin() + std::ptrdiff_t(y) * page.width, w,
+                picture.begin() + std::ptrdiff_t(y0 + y) * format.width + x0);
   return picture;
 }
 
