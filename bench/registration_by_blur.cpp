@@ -11,7 +11,8 @@
 // camera filmed with at that instant (the board's trace as the glass moved,
 // run/trace_lens.h): from its entrance pupil, at its projection focal
 // length, and its thin-lens blur. The composites before the board was first
-// found (the board file's rest pose) are left out.
+// found (the camera image alone, or in older records the board file's rest
+// pose) are left out.
 //
 //   build/camhead run --board sim-moving --duration 60 --output null --record-stats m.jsonl
 //   build/bench/registration_by_blur board/sim-moving.json m.jsonl [OUT]
@@ -162,8 +163,9 @@ int run(int argc, char **argv) {
   std::ifstream in(argv[2]);
   if (!in)
     throw std::runtime_error(std::string("cannot read ") + argv[2]);
-  // The composites before the board was first seen carry the board file's
-  // rest pose, not a tracker's: counted, left out.
+  // The composites before the board was first seen have no virtual objects
+  // (older records: drawn from the board file's rest pose): counted, left
+  // out.
   std::vector<Frame> frames;
   int composites = 0, before_first = 0;
   for (std::string line; std::getline(in, line);) {

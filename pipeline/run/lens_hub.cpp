@@ -100,7 +100,7 @@ PoseSnapshot LensHub::pose_at(std::int64_t t_ns, const CameraPose &rest) const {
   std::lock_guard lock(mutex_);
   const std::optional<PoseAt> at = channels_[*pose_channel_].pose_at(t_ns);
   if (!at)
-    return {rest, false};
+    return {rest, false, false};
   return {at->pose, at->fresh && connected_[*pose_channel_]};
 }
 

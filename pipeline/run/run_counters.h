@@ -15,6 +15,7 @@ struct RunCounters {
   std::atomic<std::int64_t> latency_ns{0};          // capture to output, last frame
   std::atomic<bool> camera_lost{false};
   std::atomic<bool> pose_stale{false};    // the last frame's pose was held or predicted
+  std::atomic<bool> pose_unknown{false};  // no pose yet: the last frame was the camera image alone
   std::atomic<bool> renderer_lost{false}; // the GPU is gone: placeholders from now on
 };
 

@@ -144,7 +144,9 @@ void Pipeline::render_loop() {
                                             ? placed(setup_->base_camera, pose.pose)
                                             : setup_->base_camera;
     r.pose_fresh = pose.fresh;
+    r.pose_known = pose.known;
     counters_.pose_stale = !pose.fresh;
+    counters_.pose_unknown = !pose.known;
     r.position = posed.position;
     r.forward = glm::normalize(posed.look_at - posed.position);
     r.up = posed.up;
@@ -152,6 +154,10 @@ void Pipeline::render_loop() {
     request.camera = lens_camera(posed, lens.state);
     request.rays_per_pixel = setup_->board.render.rays_per_pixel.value_or(budget.rpp());
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
+    // Before the pose source's first pose, virtual objects drawn from the
+    // board's rest pose would stand wherever that puts them (on the moving
+    // rig, 1200 px off): the frame goes out as the camera image alone.
+    request.plate_only = !pose.known;
     r.rpp = request.rays_per_pixel;
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
@@ -233,7 +239,7 @@ PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
   record.pose_found_by = found.found_by;
   record.track_s = found.track_s;
   record.pose_wait_s = found.wait_s;
-  return {found.pose, found.fresh};
+  return {found.pose, found.fresh, found.known};
 }
 
 template <typename Frame> void Pipeline::send(Frame frame, std::int64_t capture_ns) {

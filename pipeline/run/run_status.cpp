@@ -39,10 +39,12 @@ void RunStatus::second(std::int64_t now_ns, double dt, std::uint64_t in, std::ui
   if (const std::uint64_t errors = counters_.sink_errors; errors > 0)
     std::snprintf(output_errors, sizeof output_errors, "  OUTPUT ERRORS %" PRIu64, errors);
   // A tracked pose, and whether the last frame's was current.
-  char pose[96] = "";
+  char pose[128] = "";
   if (pose_source_ != "static")
     std::snprintf(pose, sizeof pose, "  pose %s%s", pose_source_.c_str(),
-                  counters_.pose_stale ? " (stale)" : "");
+                  counters_.pose_unknown ? " (none yet: camera image only)"
+                  : counters_.pose_stale ? " (stale)"
+                                         : "");
   char lens_late[64] = "";
   if (const std::uint64_t late = counters_.lens_late; late > 0)
     std::snprintf(lens_late, sizeof lens_late, " (%" PRIu64 " frames without it)", late);

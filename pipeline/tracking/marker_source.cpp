@@ -287,6 +287,7 @@ FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_ex
     if (result->pose.found) {
       out.pose = result->pose.pose;
       out.fresh = true;
+      out.known = true;
       out.reprojection_px = result->pose.reprojection_px;
       out.found_by = result->pose.aligned    ? "alignment"
                      : result->pose.followed ? "corners"
@@ -296,6 +297,7 @@ FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_ex
   }
   const std::optional<PoseAt> predicted = found_.at(mid_exposure_ns);
   out.pose = predicted ? predicted->pose : rest;
+  out.known = predicted.has_value();
   return out;
 }
 

@@ -251,6 +251,7 @@ std::string OperatorPage::state_json(const web_module::HttpStats &http) {
                       {"traced", r.traced},
                       {"history_samples", r.history_samples}};
     state["pose"] = {{"source", run_.pose_source},
+                     {"known", r.pose_known},
                      {"fresh", r.pose_fresh},
                      {"position", vec(r.position)},
                      {"forward", vec(r.forward)},
@@ -345,6 +346,9 @@ std::string OperatorPage::metrics(const web_module::HttpStats &http) {
           last->record.lens_fresh ? 1 : 0);
     m.one("camhead_pose_fresh", "gauge", "1 when the last composite's pose was current.",
           last->record.pose_fresh ? 1 : 0);
+    m.one("camhead_pose_known", "gauge",
+          "0 before the pose source's first pose: the composite is the camera image alone.",
+          last->record.pose_known ? 1 : 0);
   }
   m.family("camhead_stage_latency_seconds", "summary",
            "Each stage of a composite's way, over the last ten seconds.");

@@ -91,7 +91,7 @@ public:
     history_valid_ = false; // the region it traced is no longer in regions_
   }
 
-  FrameReport render(const FrameRequest &request, const VideoFrame &plate,
+  FrameReport render(const FrameRequest &asked, const VideoFrame &plate,
                      std::span<const VideoBuffer> outputs) override {
     FrameReport report;
     const int width = scene_.render.width;
@@ -99,13 +99,15 @@ public:
     const bool has_plate = !plate.bytes.empty();
     if (std::string reason = check_frames(plate, outputs, width, height); !reason.empty())
       return bad_frame(std::move(reason));
-    if (request.rays_per_pixel == 0)
+    if (asked.rays_per_pixel == 0)
       return bad_frame("0 rays per pixel");
-
-    if (request.accumulation.enabled && request.adaptive)
+    if (asked.accumulation.enabled && asked.adaptive)
       return bad_frame("adaptive frames do not accumulate");
-    if (request.accumulation.enabled && request.accumulation.max_samples == 0)
+    if (asked.accumulation.enabled && asked.accumulation.max_samples == 0)
       return bad_frame("a history of at most 0 samples");
+    if (asked.plate_only && !has_plate)
+      return bad_frame("a plate-only frame without a camera frame");
+    const FrameRequest request = as_rendered(asked);
 
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
@@ -153,8 +155,9 @@ public:
 
     Clock::time_point start = Clock::now();
     if (!continues) {
-      region_ = request.influence_region ? &regions_.build(frame)
-                                         : &regions_.whole_frame(frame.image.x, frame.image.y);
+      region_ = request.plate_only         ? &regions_.none(frame.image.x, frame.image.y)
+                : request.influence_region ? &regions_.build(frame)
+                                           : &regions_.whole_frame(frame.image.x, frame.image.y);
       region_kind_ = request.influence_region;
       spans_.clear();
       blocks_.clear();

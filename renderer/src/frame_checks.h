@@ -1,4 +1,5 @@
-// What both frame renderers refuse (frame_renderer.h), worded alike.
+// What both frame renderers refuse (frame_renderer.h), worded alike, and how
+// both read a plate-only request.
 #pragma once
 
 #include <cstddef>
@@ -44,6 +45,18 @@ check_frames(const VideoFrame &plate, std::span<const VideoBuffer> outputs, int 
 [[nodiscard]] inline bool same_pixels(base::VideoFormat a, base::VideoFormat b) {
   a.stride = b.stride = 0;
   return a == b;
+}
+
+// `request` as the executors render it: a plate-only frame traces
+// nothing, so it neither accumulates nor samples adaptively (and the
+// history before it ends, as after any frame that does not accumulate).
+[[nodiscard]] inline FrameRequest as_rendered(const FrameRequest &request) {
+  FrameRequest rendered = request;
+  if (request.plate_only) {
+    rendered.accumulation.enabled = false;
+    rendered.adaptive = false;
+  }
+  return rendered;
 }
 
 [[nodiscard]] inline FrameReport bad_frame(std::string detail) {

@@ -56,7 +56,7 @@ public:
                           std::span(pixels.data(), outputs.size()), request.adaptive);
   }
 
-  FrameReport render(const FrameRequest &request, const VideoFrame &plate,
+  FrameReport render(const FrameRequest &asked, const VideoFrame &plate,
                      std::span<const VideoBuffer> outputs) override {
     if (lost_)
       return lost("the GPU was lost earlier");
@@ -67,12 +67,15 @@ public:
     if (outputs.size() > VIDEO_MAX_OUTPUTS)
       return bad_frame(std::to_string(outputs.size()) + " outputs; the GPU executor takes " +
                        std::to_string(VIDEO_MAX_OUTPUTS));
-    if (request.rays_per_pixel == 0)
+    if (asked.rays_per_pixel == 0)
       return bad_frame("0 rays per pixel");
-    if (request.accumulation.enabled && request.adaptive)
+    if (asked.accumulation.enabled && asked.adaptive)
       return bad_frame("adaptive frames do not accumulate");
-    if (request.accumulation.enabled && request.accumulation.max_samples == 0)
+    if (asked.accumulation.enabled && asked.accumulation.max_samples == 0)
       return bad_frame("a history of at most 0 samples");
+    if (asked.plate_only && plate.bytes.empty())
+      return bad_frame("a plate-only frame without a camera frame");
+    const FrameRequest request = as_rendered(asked);
     gpu::FrameParams frame = frame_params(request, !plate.bytes.empty());
     const Shape shape = shape_of(plate, outputs, request.influence_region);
     std::optional<GpuTracer::SampleRange> samples;
@@ -98,8 +101,9 @@ public:
     }
     try {
       if (!continues) // a history keeps the region of its start (frame_history.h)
-        region_ = request.influence_region ? &regions_.build(frame)
-                                           : &regions_.whole_frame(frame.image.x, frame.image.y);
+        region_ = request.plate_only         ? &regions_.none(frame.image.x, frame.image.y)
+                  : request.influence_region ? &regions_.build(frame)
+                                             : &regions_.whole_frame(frame.image.x, frame.image.y);
       report.traced_pixels = region_->pixels();
       report.region = region_->rects;
       report.frame_pixels = std::uint64_t(frame.image.x) * frame.image.y;

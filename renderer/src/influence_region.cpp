@@ -410,6 +410,14 @@ const InfluenceRegion &InfluenceRegionBuilder::whole_frame(std::uint32_t width,
   return region;
 }
 
+const InfluenceRegion &InfluenceRegionBuilder::none(std::uint32_t width, std::uint32_t height) {
+  InfluenceRegion &region = state_->region;
+  region.width = width;
+  region.height = height;
+  region.rects.clear();
+  return region;
+}
+
 std::uint64_t InfluenceRegion::pixels() const {
   std::uint64_t sum = 0;
   for (const PixelRect &r : rects)

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,10 +64,14 @@ protected:
     std::vector<double> ball_x;    // the ball's centroid column in each fresh composite, px
     std::vector<double> forward_x; // the recorded view direction's x, likewise
     std::size_t composites = 0;
+    // The composites before the tracker's first pose, and the light above
+    // black in them (the room is black: the ball's).
+    std::size_t before_first = 0;
+    double light_before_first = 0.0;
   };
 
-  // Runs the rig while the tracker sends `pan_deg`.
-  Measured run_with_pan(const std::string &type, double pan_deg) const {
+  // Runs the rig while the tracker sends `pan_deg`; none sends without.
+  Measured run_with_pan(const std::string &type, std::optional<double> pan_deg) const {
     const std::uint16_t port = free_udp_port();
     RunOptions options;
     options.board = tracked_board(type, port);
@@ -77,7 +82,9 @@ protected:
     options.status = nullptr;
     RunSummary summary;
     {
-      const Tracker tracker(type, port, pan_deg);
+      std::optional<Tracker> tracker;
+      if (pan_deg)
+        tracker.emplace(type, port, *pan_deg);
       summary = run_pipeline(options);
     }
     EXPECT_GE(summary.frames_out, 4u);
@@ -90,11 +97,6 @@ protected:
         continue;
       ++m.composites;
       EXPECT_NE(line.find("\"pose_source\":\"" + type + ":tracker\""), std::string::npos) << line;
-      if (line.find("\"pose_fresh\":true") == std::string::npos)
-        continue; // before the tracker's first pose: the scene's camera
-      const std::size_t forward = line.find("\"forward\":[");
-      EXPECT_NE(forward, std::string::npos) << line;
-      m.forward_x.push_back(std::stod(line.substr(forward + 11)));
       const auto output_frame = std::size_t(json_number(line, "output_frame"));
       EXPECT_LT(output_frame, frames.size());
       if (output_frame >= frames.size())
@@ -108,6 +110,17 @@ protected:
           sum += v;
           weighted += v * x;
         }
+      if (line.find("\"pose_known\":false") != std::string::npos) {
+        EXPECT_NE(line.find("\"pose_fresh\":false"), std::string::npos) << line;
+        ++m.before_first;
+        m.light_before_first += sum;
+        continue;
+      }
+      if (line.find("\"pose_fresh\":true") == std::string::npos)
+        continue; // held
+      const std::size_t forward = line.find("\"forward\":[");
+      EXPECT_NE(forward, std::string::npos) << line;
+      m.forward_x.push_back(std::stod(line.substr(forward + 11)));
       EXPECT_GT(sum, 0.0) << "the ball is in the picture";
       m.ball_x.push_back(sum > 0.0 ? weighted / sum + 0.5 : 0.0); // pixel centres
     }
@@ -129,6 +142,7 @@ TEST_P(RunTracking, APanMovesTheVirtualObjectWhereTheLensPutsIt) {
   for (const Measured *m : {&still, &panned}) {
     EXPECT_GE(m->ball_x.size(), 2u)
         << "of " << m->composites << " composites, too few had the tracker's pose fresh";
+    EXPECT_EQ(m->light_before_first, 0.0) << "before the first pose, the camera image alone";
   }
   for (const double x : still.ball_x)
     EXPECT_NEAR(x, kWidth / 2.0, 0.25) << "pan 0: the ball dead ahead";
@@ -140,6 +154,16 @@ TEST_P(RunTracking, APanMovesTheVirtualObjectWhereTheLensPutsIt) {
   for (const double fx : panned.forward_x)
     EXPECT_NEAR(fx, std::sin(turn_right_deg * std::numbers::pi / 180.0), 1e-5)
         << "the recorded view";
+}
+
+// Before the tracker's first pose the frames are the camera image alone:
+// drawn from the scene's camera, the ball would stand dead ahead (as the
+// frames of a tracker at pan 0, above, show it).
+TEST_P(RunTracking, BeforeTheFirstPoseTheFramesAreTheCameraImage) {
+  const Measured silent = run_with_pan(GetParam(), std::nullopt);
+  EXPECT_GE(silent.composites, 4u);
+  EXPECT_EQ(silent.before_first, silent.composites);
+  EXPECT_EQ(silent.light_before_first, 0.0) << "the ball must not show";
 }
 
 INSTANTIATE_TEST_SUITE_P(Trackers, RunTracking, testing::Values("freed", "opentrackio"),

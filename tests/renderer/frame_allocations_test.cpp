@@ -189,6 +189,19 @@ TEST_P(FrameAllocations, APullThroughALensModelAllocatesNothingFrameAfterFrame) 
   EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull_and_pan(live, rest)); }), 0u);
 }
 
+// Frames whose pose is not known yet go out as the camera image alone
+// (FrameRequest::plate_only), as a run's do until its tracker first finds
+// the board, and between them frames that accumulate.
+TEST_P(FrameAllocations, PlateOnlyFramesAllocateNothing) {
+  LiveFrames live(GetParam());
+  if (!live.available())
+    GTEST_SKIP() << "no Vulkan device";
+  live.prepare();
+  EXPECT_EQ(live.allocations_in(
+                [&] { live.frames(20, [&](int k) { live.request.plate_only = k % 5 < 2; }); }),
+            0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Executors, FrameAllocations,
                          ::testing::Values(Executor::cpu, Executor::gpu),
                          [](const ::testing::TestParamInfo<Executor> &param) {

@@ -86,6 +86,28 @@ TEST_P(FrameHistoryOn, AFullHistoryTracesNothingMore) {
   EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
 }
 
+// A plate-only frame (a pose not known yet: frame_renderer.h) is the camera
+// image and traces nothing; the history before it ends, and the frame after
+// starts one afresh.
+TEST_P(FrameHistoryOn, APlateOnlyFrameEndsTheHistory) {
+  const Scene scene = ball_scene();
+  Frames frames(scene, false, GetParam());
+  if (!frames.available())
+    GTEST_SKIP() << "no Vulkan device";
+  (void)frames.render(still_uniform(scene, 2));
+  EXPECT_GT(bytes_differing(frames.out(), camera_frame()), 100u) << "the ball must show";
+  FrameRequest plate_only = still_uniform(scene, 2);
+  plate_only.plate_only = true;
+  const FrameReport report = frames.render(plate_only);
+  EXPECT_EQ(report.traced_pixels, 0u);
+  EXPECT_EQ(report.camera_rays, 0u);
+  EXPECT_EQ(report.history_samples, 0u);
+  EXPECT_EQ(bytes_differing(frames.out(), camera_frame()), 0u);
+  const FrameReport after = frames.render(still_uniform(scene, 2));
+  EXPECT_TRUE(after.history_restarted);
+  EXPECT_EQ(after.history_samples, 2u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Executors, FrameHistoryOn, ::testing::Values(Executor::cpu, Executor::gpu),
                          [](const ::testing::TestParamInfo<Executor> &executor) {
                            return executor.param == Executor::cpu ? "cpu" : "gpu";

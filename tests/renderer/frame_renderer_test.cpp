@@ -334,6 +334,46 @@ TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
   r = renderer->render(request, {right, plate}, std::span(&small, 1));
   EXPECT_EQ(r.status, FrameStatus::bad_input);
   EXPECT_NE(r.detail.find("output"), std::string::npos) << r.detail;
+  // A plate-only frame is the camera frame: it needs one.
+  request.plate_only = true;
+  r = renderer->render(request, {right, {}}, std::span(&target, 1));
+  EXPECT_EQ(r.status, FrameStatus::bad_input);
+  EXPECT_NE(r.detail.find("plate-only frame without a camera frame"), std::string::npos)
+      << r.detail;
+}
+
+// A frame whose camera pose is not known yet (FrameRequest::plate_only) is
+// the camera image, with the virtual ball in view: in the camera's format
+// byte for byte, converted as a scene with nothing virtual converts it; and
+// nothing is traced. The frame after it shows the ball again.
+TEST_P(FramePassThrough, APlateOnlyFrameIsTheCameraImage) {
+  const int w = 96, h = 64;
+  const Scene scene = scene_with_ball(w, h, {-0.4f, 0.2f, -3.0f});
+  auto renderer = make_renderer(GetParam(), scene);
+  auto nothing_virtual = make_renderer(GetParam(), real_only(w, h));
+  if (!renderer)
+    GTEST_SKIP() << "no Vulkan device";
+  const VideoFormat in = format(PixelFormat::yuyv, w, h);
+  const std::vector<std::uint8_t> plate = noise_frame(in, 5);
+  for (const VideoFormat &out : {in, format(PixelFormat::nv12, w, h),
+                                 format(PixelFormat::xrgb8888, w, h, base::ColorRange::full)}) {
+    SCOPED_TRACE(base::describe(out));
+    const std::vector<std::uint8_t> expected = render_through(*nothing_virtual, in, plate, out);
+    std::vector<std::uint8_t> bytes(base::frame_bytes(out), 0xAB);
+    const VideoBuffer target{out, bytes};
+    FrameRequest request;
+    request.camera = scene_camera(scene);
+    request.rays_per_pixel = 2;
+    request.plate_only = true;
+    const FrameReport report = renderer->render(request, {in, plate}, std::span(&target, 1));
+    ASSERT_EQ(report.status, FrameStatus::ok) << report.detail;
+    EXPECT_EQ(report.traced_pixels, 0u);
+    EXPECT_EQ(report.camera_rays, 0u);
+    EXPECT_TRUE(bytes == expected);
+    request.plate_only = false;
+    (void)renderer->render(request, {in, plate}, std::span(&target, 1));
+    EXPECT_FALSE(bytes == expected) << "the ball must show in the frame after";
+  }
 }
 
 // A virtual ball's shadow on a real floor whose camera pixels are darker

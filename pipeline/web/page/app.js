@@ -57,10 +57,11 @@ function show(state) {
   }
   const pose = state.pose;
   // A marker pose says how it was found: markers read, corners followed or
-  // the blurred board aligned.
+  // the blurred board aligned. Before the first, the composite is the
+  // camera image alone.
   health($('pose'), pose.fresh !== false,
          pose.source + (pose.fresh === false ? ', held' : pose.found_by ? ', by ' + pose.found_by : ''),
-         pose.source + ', held (stale)');
+         pose.source + (pose.known === false ? ', none yet: camera image only' : ', held (stale)'));
   text('in-fps', fixed(state.in_fps, 1));
   text('out-fps', fixed(state.out_fps, 1));
   text('executor', state.executor);

@@ -57,6 +57,12 @@ struct FrameRequest {
   // at the traced pixels only: accumulation.h). False traces every pixel,
   // for comparison.
   bool influence_region = true;
+  // The composite is the camera frame alone, as a frame outside the
+  // influence region is, bit for bit: nothing is traced, and an
+  // accumulating history ends. For a frame whose camera pose is not known
+  // yet, where virtual objects drawn from a guess would be worse than none.
+  // Needs a camera frame.
+  bool plate_only = false;
 };
 
 enum class FrameStatus {

@@ -77,6 +77,8 @@ public:
   [[nodiscard]] const InfluenceRegion &build(const gpu::FrameParams &frame);
   // Every pixel, in the same storage.
   [[nodiscard]] const InfluenceRegion &whole_frame(std::uint32_t width, std::uint32_t height);
+  // No pixel (a plate-only frame: frame_renderer.h), in the same storage.
+  [[nodiscard]] const InfluenceRegion &none(std::uint32_t width, std::uint32_t height);
 
 private:
   struct State;
