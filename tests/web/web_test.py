@@ -436,11 +436,14 @@ if markers:
                                                                  "reply": body.decode()})
             time.sleep(0.6)
         # The state says how the newest composite's pose was found: the
-        # board, sharp at this lens, by its markers (or null, held).
+        # board, sharp at this lens, by its markers (or null, held); found
+        # in the views above, it is known (before, the composites were the
+        # camera image alone).
         pose = run.state()["pose"]
-        check(pose.get("found_by") == ("markers" if pose.get("fresh") else None),
-              "state: the marker pose says how it was found: %s"
-              % {k: pose.get(k) for k in ("source", "fresh", "found_by", "markers_seen")})
+        check(pose.get("found_by") == ("markers" if pose.get("fresh") else None) and
+              pose.get("known") is True,
+              "state: the marker pose is known and says how it was found: %s"
+              % {k: pose.get(k) for k in ("source", "known", "fresh", "found_by", "markers_seen")})
     folder = os.path.join(scratch, "recordings", "camera-views", "focus-8000")
     seen = [v.get("markers_seen") for v in views]
     check([os.path.basename(v.get("file", "")) for v in views] ==
