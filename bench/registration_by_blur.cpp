@@ -11,8 +11,7 @@
 // camera filmed with at that instant (the board's trace as the glass moved,
 // run/trace_lens.h): from its entrance pupil, at its projection focal
 // length, and its thin-lens blur. The composites before the board was first
-// found (the camera image alone, or in older records the board file's rest
-// pose) are left out.
+// found (the camera image alone: `pose_known` false) are left out.
 //
 //   build/camhead run --board sim-moving --duration 60 --output null --record-stats m.jsonl
 //   build/bench/registration_by_blur board/sim-moving.json m.jsonl [OUT]
@@ -163,9 +162,10 @@ int run(int argc, char **argv) {
   std::ifstream in(argv[2]);
   if (!in)
     throw std::runtime_error(std::string("cannot read ") + argv[2]);
-  // The composites before the board was first seen have no virtual objects
-  // (older records: drawn from the board file's rest pose): counted, left
-  // out.
+  // The composites before the pose source's first pose have no virtual
+  // objects (`pose_known` false; in records without it, as `rig_tracking`
+  // writes them, those before the first pose found in its frame): counted,
+  // left out.
   std::vector<Frame> frames;
   int composites = 0, before_first = 0;
   for (std::string line; std::getline(in, line);) {
@@ -173,7 +173,10 @@ int run(int argc, char **argv) {
     if (r.value("kind", "") != "composite")
       continue;
     ++composites;
-    if (frames.empty() && !r.value("pose_fresh", false)) {
+    const bool before_first_pose = r.contains("pose_known")
+                                       ? !r.at("pose_known").get<bool>()
+                                       : frames.empty() && !r.value("pose_fresh", false);
+    if (before_first_pose) {
       ++before_first;
       continue;
     }

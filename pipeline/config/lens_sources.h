@@ -69,8 +69,8 @@ public:
   // OpenTrackIO tracker's, in that protocol's axes: `type`), moved back by
   // `delay_ms`, in camhead's world.
   void track_pose(PoseType type, double delay_ms);
-  // The pose at physical instant t_ns; empty before the first one, or when
-  // the channel does not track poses.
+  // The pose at physical instant t_ns (PoseTimeline::at); empty before the
+  // first one arrived, or when the channel does not track poses.
   [[nodiscard]] std::optional<PoseAt> pose_at(std::int64_t t_ns) const {
     return poses_ ? poses_->at(t_ns) : std::nullopt;
   }

@@ -29,7 +29,7 @@ struct FrameRecord {
   glm::vec3 position{0.0f}, forward{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
   bool pose_fresh = false; // a tracker's pose current at that instant; a static one always
   // False before the pose source's first pose: the frame is the camera
-  // image alone, and `position` and the rest are the board's rest pose.
+  // image alone, and `position` and the rest are the scene's camera's.
   bool pose_known = true;
   // A marker pose's: the board's markers found in the frame, and the RMS
   // distance of the corners used from where the pose puts them (NaN: none).

@@ -96,12 +96,12 @@ LensSnapshot LensHub::state_when_covered(std::int64_t t_ns, std::int64_t give_up
 
 PoseSnapshot LensHub::pose_at(std::int64_t t_ns, const CameraPose &rest) const {
   if (!pose_channel_)
-    return {rest, true};
+    return {rest, true, true}; // a static pose
   std::lock_guard lock(mutex_);
   const std::optional<PoseAt> at = channels_[*pose_channel_].pose_at(t_ns);
-  if (!at)
+  if (!at || at->before_first)
     return {rest, false, false};
-  return {at->pose, at->fresh && connected_[*pose_channel_]};
+  return {at->pose, at->fresh && connected_[*pose_channel_], true};
 }
 
 void LensHub::set_profile(const lens_control::LensProfile &profile) {

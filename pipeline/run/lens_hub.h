@@ -38,9 +38,10 @@ struct PoseSnapshot {
   // The tracker is there and its pose current at that instant; a static
   // pose always is.
   bool fresh = false;
-  // False before the source's first pose: `pose` is the board's rest pose,
-  // a stand-in, and the frame goes out as the camera image alone.
-  bool known = true;
+  // False for an instant before the source's first pose: `pose` is the
+  // scene's camera, a stand-in, and the frame goes out as the camera image
+  // alone.
+  bool known = false;
 };
 
 class LensHub {

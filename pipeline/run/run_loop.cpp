@@ -228,7 +228,7 @@ std::string Pipeline::pose_source_name() const {
 
 PoseSnapshot Pipeline::pose_at(std::uint64_t sequence, FrameRecord &record) {
   if (pose_trace_)
-    return {pose_trace_->at(record.exposure_mid_ns), true};
+    return {pose_trace_->at(record.exposure_mid_ns), true, true};
   if (!markers_)
     return lens_.pose_at(record.exposure_mid_ns, setup_->rest_pose);
   const std::int64_t deadline = record.delivered_ns + lens_wait_ns(lossless_, fps_);

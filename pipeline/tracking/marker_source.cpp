@@ -297,7 +297,10 @@ FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_ex
   }
   const std::optional<PoseAt> predicted = found_.at(mid_exposure_ns);
   out.pose = predicted ? predicted->pose : rest;
-  out.known = predicted.has_value();
+  // A frame earlier than every pose found (one a later frame's, tracked
+  // first) is before the first pose, whatever order the frames were
+  // tracked in: a take composited offline gives the same frames each time.
+  out.known = predicted && !predicted->before_first;
   return out;
 }
 

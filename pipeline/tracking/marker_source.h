@@ -90,7 +90,7 @@ struct TrackerGuides {
 struct FramePose {
   CameraPose pose;
   bool fresh = false; // found in this very frame
-  bool known = false; // found in this frame or one before (else `pose` is the rest pose)
+  bool known = false; // found at or before this instant (else `pose` is the scene's camera)
   int markers_seen = 0;
   double reprojection_px = std::numeric_limits<double>::quiet_NaN(); // NaN: not found
   // How the tracker found it: "markers" (read), "corners" (followed from

@@ -36,7 +36,7 @@ std::optional<PoseAt> PoseTimeline::at(std::int64_t t_ns) const {
   const Timed &oldest = ring_[0];
   const Timed &newest = ring_[n - 1];
   if (t_ns < oldest.t_ns)
-    return PoseAt{oldest.pose, false};
+    return PoseAt{oldest.pose, false, true};
   if (t_ns >= newest.t_ns) {
     const std::int64_t ahead = t_ns - newest.t_ns;
     const bool fresh = ahead <= p_.max_extrapolation_ns;

@@ -34,6 +34,9 @@ struct PoseTimelineParams {
 struct PoseAt {
   CameraPose pose;
   bool fresh = false;
+  // The instant is earlier than every pose: `pose` is the oldest, held back
+  // (what a source knew of that instant only later, if at all).
+  bool before_first = false;
 };
 
 class PoseTimeline {
@@ -43,7 +46,7 @@ public:
   // Adds a pose stamped t_ns (before the delay correction). A pose not later
   // than the newest is ignored: returns false.
   bool push(std::int64_t t_ns, const CameraPose &pose);
-  // The pose at physical instant t_ns; empty before the first pose.
+  // The pose at physical instant t_ns; empty while there is none.
   [[nodiscard]] std::optional<PoseAt> at(std::int64_t t_ns) const;
   [[nodiscard]] std::size_t size() const { return ring_.size(); }
   // The newest pose's physical instant; 0 when empty.

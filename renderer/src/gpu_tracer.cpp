@@ -501,7 +501,9 @@ int GpuTracer::Impl::trace_batches(gpu::FrameParams &frame, std::uint32_t first,
     ++submissions;
     // A batch that carries the frame's set-up or resolve looks a little
     // dearer per sample than it is: the next batch comes out a little smaller.
-    if (batch > 0)
+    // One over an empty region (a plate-only frame, the virtual objects out
+    // of view) traced nothing and says nothing of a sample's cost.
+    if (batch > 0 && frame_region.pixels() > 0)
       sizer.measured(batch, seconds_since(submitted));
     done += batch;
     if (report && batch > 0)

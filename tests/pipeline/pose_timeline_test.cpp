@@ -2,6 +2,7 @@
 // little, held and flagged beyond, and moved back by the source's delay.
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -82,6 +83,13 @@ TEST(PoseTimeline, TheDelayMovesPosesBackToTheirInstant) {
   ASSERT_TRUE(timeline.push(140 * kMs, at(1.0, 0.0))); // t = 110 ms
   EXPECT_NEAR(timeline.at(105 * kMs)->pose.position.x, 0.5, 1e-12);
   EXPECT_EQ(timeline.newest_ns(), 110 * kMs);
+  // Before the first pose's instant: the first, held back, and said so.
+  EXPECT_FALSE(timeline.at(100 * kMs)->before_first);
+  const std::optional<PoseAt> earlier = timeline.at(99 * kMs);
+  ASSERT_TRUE(earlier);
+  EXPECT_TRUE(earlier->before_first);
+  EXPECT_FALSE(earlier->fresh);
+  EXPECT_EQ(earlier->pose.position.x, 0.0);
 }
 
 TEST(PoseTimeline, RefusesAPoseNotLaterThanTheNewest) {

@@ -88,7 +88,7 @@ TEST_P(FrameHistoryOn, AFullHistoryTracesNothingMore) {
 
 // A plate-only frame (a pose not known yet: frame_renderer.h) is the camera
 // image and traces nothing; the history before it ends, and the frame after
-// starts one afresh.
+// starts one afresh, byte for byte as a new renderer's first frame.
 TEST_P(FrameHistoryOn, APlateOnlyFrameEndsTheHistory) {
   const Scene scene = ball_scene();
   Frames frames(scene, false, GetParam());
@@ -106,6 +106,10 @@ TEST_P(FrameHistoryOn, APlateOnlyFrameEndsTheHistory) {
   const FrameReport after = frames.render(still_uniform(scene, 2));
   EXPECT_TRUE(after.history_restarted);
   EXPECT_EQ(after.history_samples, 2u);
+  // Nothing of the frames before: the same as a new renderer's first frame.
+  Frames fresh(scene, false, GetParam());
+  (void)fresh.render(still_uniform(scene, 2));
+  EXPECT_EQ(bytes_differing(frames.out(), fresh.out()), 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Executors, FrameHistoryOn, ::testing::Values(Executor::cpu, Executor::gpu),
