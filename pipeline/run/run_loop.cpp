@@ -155,8 +155,9 @@ void Pipeline::render_loop() {
     request.rays_per_pixel = setup_->board.render.rays_per_pixel.value_or(budget.rpp());
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     // Before the pose source's first pose, virtual objects drawn from the
-    // board's rest pose would stand wherever that puts them (on the moving
-    // rig, 1200 px off): the frame goes out as the camera image alone.
+    // stand-in (the scene's camera) would stand wherever that puts them (on
+    // the moving rig, 1200 px off): the frame goes out as the camera image
+    // alone.
     request.plate_only = !pose.known;
     r.rpp = request.rays_per_pixel;
 
