@@ -90,12 +90,26 @@ enum class Shot {
 
 class RunMarkers : public RunLoop {
 protected:
+  // The take played offline (take_board's), every frame composited into
+  // out.y4m, the record in stats.jsonl.
+  RunOptions offline_take(Shot shot, bool profiled = false) const {
+    RunOptions options;
+    options.board = take_board(false, shot, profiled);
+    options.outputs = {"file:" + (dir_ / "out.y4m").string()};
+    options.stats_file = dir_ / "stats.jsonl";
+    options.frames = kBoardFrames + kEmptyFrames;
+    options.duration_s = 300.0;
+    options.status = nullptr;
+    return options;
+  }
+
   // The take, its lens and scene, and a board that finds its pose in it;
   // `realtime`: played at its 25 fps as a live camera delivers (else
-  // offline, every frame composited); `profiled`: the lens is the example 35 mm prime's profile at
-  // 2 m and f/8 (projection focal length 35.6 mm, entrance pupil 68 mm ahead of the reference plane
-  // the poses are of), else calibrated values of a plain 35 mm (no profile: no breathing, no pupil
-  // offset).
+  // offline, every frame composited); `profiled`: the lens is the example
+  // 35 mm prime's profile at 2 m and f/8 (projection focal length 35.6 mm,
+  // entrance pupil 68 mm ahead of the reference plane the poses are of),
+  // else calibrated values of a plain 35 mm (no profile: no breathing, no
+  // pupil offset).
   Board take_board(bool realtime, Shot shot = Shot::move, bool profiled = false) const {
     const MarkerBoard board = test::floor_board();
     write("floor.json", test::kFloorBoardJson);
@@ -174,13 +188,7 @@ class RunMarkersLens : public RunMarkers, public testing::WithParamInterface<boo
 // reference plane the record's pose is of: left out, the pose would be
 // 68 mm off along the view.
 TEST_P(RunMarkersLens, EachFramesPoseIsFoundInThatFrame) {
-  RunOptions options;
-  options.board = take_board(false, Shot::move, GetParam());
-  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
-  options.stats_file = dir_ / "stats.jsonl";
-  options.frames = kBoardFrames + kEmptyFrames;
-  options.duration_s = 300.0;
-  options.status = nullptr;
+  const RunOptions options = offline_take(Shot::move, GetParam());
   const RunSummary summary = run_pipeline(options);
   EXPECT_EQ(summary.frames_out, std::uint64_t(kBoardFrames + kEmptyFrames));
 
@@ -248,13 +256,7 @@ INSTANTIATE_TEST_SUITE_P(Lenses, RunMarkersLens, testing::Bool(),
 // the scene's camera, would stand in the picture); from then on the ball
 // is composited, found or predicted.
 TEST_F(RunMarkers, UntilTheBoardIsFirstFoundTheFramesAreTheCameraImage) {
-  RunOptions options;
-  options.board = take_board(false, Shot::away_first);
-  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
-  options.stats_file = dir_ / "stats.jsonl";
-  options.frames = kBoardFrames + kEmptyFrames;
-  options.duration_s = 300.0;
-  options.status = nullptr;
+  const RunOptions options = offline_take(Shot::away_first);
   const RunSummary summary = run_pipeline(options);
   ASSERT_EQ(summary.frames_out, std::uint64_t(kBoardFrames + kEmptyFrames));
   const std::size_t frame_bytes = std::size_t(kWidth) * kHeight * 2;
@@ -289,7 +291,7 @@ TEST_F(RunMarkers, UntilTheBoardIsFirstFoundTheFramesAreTheCameraImage) {
 // the board is asked for first, then the one before it, where the camera
 // looked away. Live or offline, the render thread can be behind the
 // tracker; that frame, rendered with the later frame's pose held back,
-// made the test above fail in about one run of twenty.
+// made the test above fail in two runs of about 45.
 TEST_F(RunMarkers, AFrameBeforeTheFirstPoseFoundIsBeforeItWhateverTheOrder) {
   const Board board = take_board(false, Shot::away_first);
   const std::vector<std::string> take =
@@ -369,13 +371,7 @@ TEST_F(RunMarkers, AFrameReadyBeforeItsLensReadingsWaitsForThem) {
 // still view to move; held while still (still_pose.h), it lets the
 // picture's history grow frame after frame as it does on a static pose.
 TEST_F(RunMarkers, ALockedOffCamerasPoseHoldsStillEnoughToAccumulate) {
-  RunOptions options;
-  options.board = take_board(false, Shot::locked_off);
-  options.outputs = {"file:" + (dir_ / "out.y4m").string()};
-  options.stats_file = dir_ / "stats.jsonl";
-  options.frames = kBoardFrames + kEmptyFrames;
-  options.duration_s = 300.0;
-  options.status = nullptr;
+  const RunOptions options = offline_take(Shot::locked_off);
   (void)run_pipeline(options);
   std::vector<double> history;
   double worst_mm = 0.0;
