@@ -3,6 +3,7 @@
 // UDP on this host, and the virtual object lands where that pan puts it in
 // the composites, with the pose in the per-frame record, fresh.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -10,8 +11,11 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "camhead/base/monotonic_clock.h"
+#include "run/lens_hub.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
 #include "tracker_sender.h"
@@ -164,6 +168,27 @@ TEST_P(RunTracking, BeforeTheFirstPoseTheFramesAreTheCameraImage) {
   EXPECT_GE(silent.composites, 4u);
   EXPECT_EQ(silent.before_first, silent.composites);
   EXPECT_EQ(silent.light_before_first, 0.0) << "the ball must not show";
+}
+
+// An instant before the tracker's first pose stays before it once poses
+// have come: a frame of that instant, rendered late, would otherwise take
+// the first pose held back (PoseAt::before_first).
+TEST_P(RunTracking, AnInstantBeforeTheFirstPoseStaysBeforeIt) {
+  const std::uint16_t port = free_udp_port();
+  LensHub lens(tracked_board(GetParam(), port));
+  const std::int64_t before_ns = base::monotonic_ns();
+  lens.start();
+  const Tracker tracker(GetParam(), port, 2.0);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  PoseSnapshot now = lens.pose_at(base::monotonic_ns(), CameraPose{});
+  while (!now.known && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    now = lens.pose_at(base::monotonic_ns(), CameraPose{});
+  }
+  ASSERT_TRUE(now.known) << "no pose from the tracker in 10 s";
+  const PoseSnapshot earlier = lens.pose_at(before_ns, CameraPose{});
+  EXPECT_FALSE(earlier.known);
+  EXPECT_FALSE(earlier.fresh);
 }
 
 INSTANTIATE_TEST_SUITE_P(Trackers, RunTracking, testing::Values("freed", "opentrackio"),
