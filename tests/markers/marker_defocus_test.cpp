@@ -86,8 +86,7 @@ cv::Mat blurred(const cv::Mat &light, int diameter) {
 TEST(MarkerTracking, ABlurredBoardIsFollowedLostAndFoundAgain) {
   const auto tracker = open_marker_tracker(kCharuco);
   std::mt19937 random(6);
-  const CameraPose truth =
-      looking_at(kBoardCentre + 2.0 * glm::normalize(glm::dvec3(0.0, 1.2, 1.6)), kBoardCentre);
+  const CameraPose truth = seeing_the_board_from(glm::dvec3(0.0, 1.2, 1.6));
   const cv::Mat sharp = test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight});
   const MarkerPose first = tracker->track(luma(test::frame(sharp, 1.0, random)), camera(), nullptr);
   ASSERT_TRUE(first.found);
@@ -138,7 +137,7 @@ TEST(MarkerTracking, ABoardTooBlurredToReadIsAlignedWholeWithTheLensBlur) {
   const CameraModel lens = focused_at_infinity(kBlur);
   for (const glm::dvec3 &offset :
        {glm::dvec3(0.0, 1.2, 1.6), glm::dvec3(0.6, 1.3, 1.4), glm::dvec3(0.1, 0.75, 1.8)}) {
-    const CameraPose truth = looking_at(kBoardCentre + 2.0 * glm::normalize(offset), kBoardCentre);
+    const CameraPose truth = seeing_the_board_from(offset);
     const cv::Mat sharp = test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight});
     const MarkerPose first =
         tracker->track(luma(test::frame(sharp, 1.0, random)), camera(), nullptr);
@@ -180,7 +179,7 @@ struct SharpView {
 };
 SharpView sharp_view(MarkerTracker &tracker, const glm::dvec3 &offset, std::mt19937 &random) {
   SharpView v;
-  v.truth = looking_at(kBoardCentre + 2.0 * glm::normalize(offset), kBoardCentre);
+  v.truth = seeing_the_board_from(offset);
   v.light = test::charuco_view(kCharuco, camera(), v.truth, {kWidth, kHeight});
   const MarkerPose first =
       tracker.track(luma(test::frame(v.light, 1.0, random)), camera(), nullptr);
@@ -339,7 +338,7 @@ TEST(MarkerTracking, ABoardFirstSeenBlurredIsAlignedFromTheMarkersRead) {
   const CameraModel lens = focused_at_infinity(kBlur);
   // (From the third, lowest view no marker is readable through this blur.)
   for (const glm::dvec3 &offset : {kThreeViews[0], kThreeViews[1]}) {
-    const CameraPose truth = looking_at(kBoardCentre + 2.0 * glm::normalize(offset), kBoardCentre);
+    const CameraPose truth = seeing_the_board_from(offset);
     const cv::Mat picture = test::frame(
         blurred(test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight}), kBlur), kGrain,
         random);
@@ -373,8 +372,7 @@ TEST(MarkerTracking, APredictionThatOvershootsATurnFallsBackToTheLastPoseFound) 
   std::mt19937 random(11);
   constexpr int kBlur = 11;
   const CameraModel lens = focused_at_infinity(kBlur);
-  const CameraPose truth =
-      looking_at(kBoardCentre + 2.0 * glm::normalize(glm::dvec3(0.0, 1.2, 1.6)), kBoardCentre);
+  const CameraPose truth = seeing_the_board_from(glm::dvec3(0.0, 1.2, 1.6));
   const cv::Mat picture =
       test::frame(blurred(test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight}), kBlur),
                   1.0, random);

@@ -62,8 +62,7 @@ TEST(MarkerTracking, ACharucoBoardAt2mGivesTheCameraWithin2mmAndATenthOfADegree)
 TEST(MarkerTracking, AStillCamerasPoseJittersUnderAFifthOfAMillimetre) {
   const auto tracker = open_marker_tracker(kCharuco);
   std::mt19937 random(2);
-  const CameraPose truth =
-      looking_at(kBoardCentre + 2.0 * glm::normalize(glm::dvec3(0.3, 1.2, 1.5)), kBoardCentre);
+  const CameraPose truth = seeing_the_board_from(glm::dvec3(0.3, 1.2, 1.5));
   const cv::Mat light = test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight});
   for (const double noise : {0.5, 1.0, 2.0, 4.0}) {
     std::vector<MarkerPose> poses;
@@ -162,8 +161,7 @@ TEST(MarkerTracking, PartOfTheBoardStillGivesThePose) {
 TEST(MarkerTracking, EveryOtherRowOfMarkersUnreadableStillGivesThePose) {
   const auto tracker = open_marker_tracker(kCharuco);
   std::mt19937 random(5);
-  const CameraPose truth =
-      looking_at(kBoardCentre + 2.0 * glm::normalize(glm::dvec3(0.0, 1.2, 1.6)), kBoardCentre);
+  const CameraPose truth = seeing_the_board_from(glm::dvec3(0.0, 1.2, 1.6));
   cv::Mat light = test::charuco_view(kCharuco, camera(), truth, {kWidth, kHeight});
   const MarkerPose whole = tracker->track(luma(test::frame(light, 1.0, random)), camera(), nullptr);
   ASSERT_TRUE(whole.found);

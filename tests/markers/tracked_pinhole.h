@@ -52,4 +52,10 @@ inline LumaImage luma(const cv::Mat &m) {
 inline const MarkerBoard kCharuco = floor_board();
 inline const glm::dvec3 kBoardCentre = kFloorBoardCentre;
 
+// The camera 2 m from the board's centre towards `direction`, looking at
+// the centre.
+inline CameraPose seeing_the_board_from(glm::dvec3 direction) {
+  return looking_at(kBoardCentre + 2.0 * glm::normalize(direction), kBoardCentre);
+}
+
 } // namespace camhead::pipeline::test
