@@ -4,10 +4,11 @@
 #
 #   cmake/bootstrap.sh [--run] [BUILD_DIR] [extra cmake -D options...]
 #
-# --run: only what `camhead run` needs (README command 1): the packages that
-#   build camhead, and camhead alone; no tests, benchmarks, hardware lab or
-#   optional modules (the marker tracker's OpenCV, libcamera), which a later
-#   run without --run adds to the same build folder.
+# --run: only what `camhead run` needs (README command 1, the moving rig):
+#   the packages that build camhead and the modules it opens at run time (the
+#   marker tracker's OpenCV, the operator page's libevent), and camhead with
+#   those modules alone; no tests, benchmarks, hardware lab or libcamera,
+#   which a later run without --run adds to the same build folder.
 # Without it, everything (README command 2, CI): the test suite, the
 #   benchmarks, the hardware lab's QEMU guest and kernel modules, and the
 #   modules of the boards that need OpenCV or libcamera.
@@ -45,6 +46,11 @@ run_packages=(
   # hal/output/drm: the kernel's DRM uapi headers (drm.h, drm_mode.h), which
   # Debian ships in libdrm-dev only; nothing links libdrm.
   libdrm-dev
+  # The marker pose source's module (pipeline/tracking/opencv), which the
+  # moving rig of README command 1 (board/sim-moving.json) tracks with:
+  # OpenCV 4.6 with contrib's aruco; camhead itself opens the module at run
+  # time. 368 packages and 215 MiB of the download (bench/RESULTS.md).
+  libopencv-dev libopencv-contrib-dev
 )
 # What the tests, benchmarks, tools and optional modules add.
 test_packages=(
@@ -63,9 +69,6 @@ test_packages=(
   # The demo scene's bunny (scenes/ar_demo.json), which tests and
   # benchmarks render.
   glmark2-data
-  # The marker pose source's module (pipeline/tracking/opencv): OpenCV 4.6
-  # with contrib's aruco; camhead itself opens the module at run time.
-  libopencv-dev libopencv-contrib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # bench/embree_peer: Embree 3 as the CPU ceiling for ray throughput.
   libembree-dev
