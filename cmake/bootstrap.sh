@@ -49,7 +49,8 @@ run_packages=(
   # The marker pose source's module (pipeline/tracking/opencv), which the
   # moving rig of README command 1 (board/sim-moving.json) tracks with:
   # OpenCV 4.6 with contrib's aruco; camhead itself opens the module at run
-  # time. 368 packages and 215 MiB of the download (bench/RESULTS.md).
+  # time. On a fresh Debian 12, 302 more packages and 192 MB more of the
+  # download (bench/RESULTS.md, "README command 1 runs the moving rig").
   libopencv-dev libopencv-contrib-dev
 )
 # What the tests, benchmarks, tools and optional modules add.

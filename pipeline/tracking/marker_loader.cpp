@@ -34,8 +34,7 @@ marker_module::Module &module() {
   throw MarkerModuleError(
       std::string("marker tracking: ") + kModuleName + " is not in " + search.searched +
       ": camhead builds it where libopencv-contrib-dev is installed (cmake/bootstrap.sh "
-      "without --run installs it), and it "
-      "needs the Debian package " +
+      "installs it), and it needs the Debian package " +
       kOpenCvPackage + " to run");
 }
 

@@ -273,12 +273,12 @@ cv::Mat blurred_to_the_edge(const CameraPose &truth, int blur) {
 // board is aligned with must too. Drawn only up to the edge, its last rows
 // went on as they were there, and the alignment leant on them: cut by the
 // bottom edge, 0.74-0.87 px off, and not aligned at all from the lowest
-// view (now 0.16-0.41 px); on the moving rig at 1920x1080, whose board the
+// view (now 0.16-0.38 px); on the moving rig at 1920x1080, whose board the
 // bottom edge cuts, 4.9 px off at the median through 55-70 px of blur
 // (bench/RESULTS.md, "The board past the picture's edge"). Cut by the left
 // edge, the drawing starts left of the picture (the other way round in
 // the aligner's arithmetic), and a board seen from low with a fifth of it
-// past the edge is harder to place whatever is drawn: 0.58 px off from the
+// past the edge is harder to place whatever is drawn: 0.59 px off from the
 // lowest view, 0.66 px before the change, 0.23-0.30 px uncut; within a pixel
 // there.
 TEST(MarkerTracking, ABoardCutByThePicturesEdgeIsAligned) {

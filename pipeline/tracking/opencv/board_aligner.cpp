@@ -59,13 +59,14 @@ constexpr int kMinCoarsePassPixels = 2000;
 constexpr int kRayStep = 8;
 // The drawing is blurred on its grid twice as fine as the reduced picture,
 // then reduced; where the blur spans this many reduced pixels or more, it
-// is reduced first and blurred there, on a quarter of the pixels (OpenCV's
-// filter2D goes by DFT at these sizes). At 1920x1080 through 40-70 px of
-// blur that took the aligned frames' p90 from 25 to 19 ms, and they
-// registered as well (all within 1 px, the worst 0.87 -> 0.90 px); from 4
-// reduced pixels on, a sharp synthetic board lit by a lamp through 19 px of
-// blur aligned twice as far off (bench/RESULTS.md, "Aligned frames at
-// 1920x1080: the blur on the reduced drawing").
+// is reduced first and blurred there, with a disc a quarter the area on a
+// quarter of the pixels. On the moving rig at 1920x1080 (32 px of blur and
+// more at the reduction by 4) that took the aligned frames' p90 from 25 to
+// 19 ms, and they registered as well (all within 1 px, the worst 0.87 ->
+// 0.90 px: bench/RESULTS.md, "Aligned frames at 1920x1080: the blur on the
+// reduced drawing"). From 4 reduced pixels on, a sharp synthetic board lit
+// by a lamp through 19 px of blur aligned twice as far off at one view
+// (0.13 -> 0.26 px: "Aligned frames at 1920x1080, against 12 ms").
 constexpr double kBlurAfterReduction = 8.0;
 // At most this many samples a grid pixel along one axis: for a board
 // foreshortened 4 times or more (seen from 15 degrees above its plane).
