@@ -31,9 +31,12 @@ std::string json_string(std::string_view text) {
 
 void write_composite_record(std::FILE *out, std::uint64_t output_frame, const FrameRecord &r,
                             std::int64_t output_ns, const RunRecordFields &run) {
-  char reprojection[32] = "null"; // JSON has no NaN: a pose not found in the frame
+  // JSON has no NaN: a pose not found in the frame, a tracking time not known.
+  char reprojection[32] = "null", track_ms[32] = "null";
   if (std::isfinite(r.reprojection_px))
     std::snprintf(reprojection, sizeof reprojection, "%.4f", r.reprojection_px);
+  if (std::isfinite(r.track_s))
+    std::snprintf(track_ms, sizeof track_ms, "%.3f", 1e3 * r.track_s);
   std::fprintf(
       out,
       "{\"output_frame\":%" PRIu64 ",\"kind\":\"composite\",\"sequence\":%" PRIu64
@@ -47,7 +50,7 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"pose\":{\"position\":[%.7g,%.7g,%.7g],\"forward\":[%.6g,%.6g,%.6g]"
       ",\"up\":[%.6g,%.6g,%.6g]},\"markers_seen\":%d,\"pose_found_by\":%s%s%s"
       ",\"reprojection_px\":%s"
-      ",\"track_ms\":%.3f,\"pose_wait_ms\":%.3f}\n",
+      ",\"track_ms\":%s,\"pose_wait_ms\":%.3f}\n",
       output_frame, r.sequence, r.setup, r.capture_ns, r.exposure_mid_ns, r.delivered_ns,
       r.render_start_ns, r.render_end_ns, output_ns,
       std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
@@ -57,7 +60,7 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       r.pose_known ? "true" : "false", r.pose_fresh ? "true" : "false", r.position.x, r.position.y,
       r.position.z, r.forward.x, r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z, r.markers_seen,
       r.pose_found_by ? "\"" : "", r.pose_found_by ? r.pose_found_by : "null",
-      r.pose_found_by ? "\"" : "", reprojection, 1e3 * r.track_s, 1e3 * r.pose_wait_s);
+      r.pose_found_by ? "\"" : "", reprojection, track_ms, 1e3 * r.pose_wait_s);
   std::fflush(out);
 }
 

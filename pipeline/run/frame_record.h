@@ -36,8 +36,9 @@ struct FrameRecord {
   int markers_seen = 0;
   double reprojection_px = std::numeric_limits<double>::quiet_NaN();
   const char *pose_found_by = nullptr; // FramePose::found_by: a literal, or null
-  // The tracker's time on the frame, and how long rendering it waited for
-  // the tracker (marker poses; 0 otherwise).
+  // The tracker's time on the frame (NaN: not done when the frame went
+  // out), and how long rendering it waited for the tracker (marker poses;
+  // 0 otherwise).
   double track_s = 0.0, pose_wait_s = 0.0;
   std::uint32_t rpp = 0;
   std::uint64_t camera_rays = 0;

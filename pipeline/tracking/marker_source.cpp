@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include <glm/geometric.hpp>
 
@@ -281,6 +282,8 @@ FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_ex
   FramePose out;
   out.wait_s = double(base::monotonic_ns() - wait_start_ns) * 1e-9;
   const Result *result = result_of(sequence);
+  if (result == nullptr)
+    out.track_s = std::numeric_limits<double>::quiet_NaN(); // still tracking, or not yet begun
   if (result != nullptr && result->tracked) {
     out.markers_seen = result->pose.markers_seen;
     out.track_s = result->track_s;

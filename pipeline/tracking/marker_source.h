@@ -97,8 +97,10 @@ struct FramePose {
   // the pose before), "alignment" (the whole board drawn blurred and
   // aligned: marker_tracker.h); null when not found in the frame.
   const char *found_by = nullptr;
-  // The tracker's time on this frame (0: not tracked), and how long the
-  // render thread waited for it in pose_for(): the latency tracking adds.
+  // The tracker's time on this frame (0: left for a newer frame; NaN: not
+  // done by the frame's deadline, so not known when it went out), and how
+  // long the render thread waited for it in pose_for(): the latency
+  // tracking adds.
   double track_s = 0.0, wait_s = 0.0;
 };
 
