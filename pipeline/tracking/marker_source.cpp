@@ -299,11 +299,12 @@ FramePose MarkerPoseSource::pose_for(std::uint64_t sequence, std::int64_t mid_ex
     }
   }
   const std::optional<PoseAt> predicted = found_.at(mid_exposure_ns);
-  out.pose = predicted ? predicted->pose : rest;
   // A frame earlier than every pose found (one a later frame's, tracked
   // first) is before the first pose, whatever order the frames were
   // tracked in: a take composited offline gives the same frames each time.
+  // Its pose is the stand-in, as LensHub::pose_at gives a tracker's.
   out.known = predicted && !predicted->before_first;
+  out.pose = out.known ? predicted->pose : rest;
   return out;
 }
 

@@ -328,6 +328,7 @@ TEST_F(RunMarkers, AFrameBeforeTheFirstPoseFoundIsBeforeItWhateverTheOrder) {
   const FramePose before = markers->pose_for(0, away_ns, deadline, CameraPose{});
   EXPECT_FALSE(before.fresh);
   EXPECT_FALSE(before.known) << "the first pose, held back to a frame before it";
+  EXPECT_EQ(before.pose.position, CameraPose{}.position) << "the stand-in, the record's pose";
   // After it, held: known. Its frame never reached the tracker: how long its
   // tracking took is not known when it goes out.
   const FramePose after =
