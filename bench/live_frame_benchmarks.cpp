@@ -53,13 +53,13 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
 }
 
 // How the frames are made: each afresh (the live path before issue 24); as
-// camhead run makes them, accumulating (on the CPU reference with the
-// shares by noise and the reconstruction; on the GPU every pixel alike),
-// during the pull (each frame starts a new history, with the samples of the
-// frames before moved through the new focus: accumulation.h, reproject;
-// the CPU reference's only), the same without them (pull_afresh), and with
-// the lens still.
-enum class Method { fresh, pull, pull_afresh, still };
+// camhead run makes them, accumulating and reconstructed (on the CPU
+// reference with the shares by noise; on the GPU every pixel alike), during
+// the pull (each frame starts a new history, with the samples of the frames
+// before moved through the new focus: accumulation.h, reproject; the CPU
+// reference's only), the same without them (pull_afresh), and with the lens
+// still, reconstructed and not (still_raw: what the reconstruction costs).
+enum class Method { fresh, pull, pull_afresh, still, still_raw };
 
 void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   const renderer::Scene scene = sim_rig_scene();
@@ -85,12 +85,14 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   request.influence_region = region;
   request.accumulation.enabled = method != Method::fresh;
   request.accumulation.reproject = method != Method::pull_afresh;
+  request.accumulation.reconstruct = method != Method::still_raw;
   request.camera.f_number = 2.8f;
   std::uint64_t frame = 0;
   double traced = 0.0;
   for (auto _ : state) {
     // Equal steps of 1 / distance (the way a focus scale runs), one a frame.
-    const int step = method == Method::still ? 0 : int(frame % (2 * kLensStates - 2));
+    const bool still = method == Method::still || method == Method::still_raw;
+    const int step = still ? 0 : int(frame % (2 * kLensStates - 2));
     const double t =
         double(step < kLensStates ? step : 2 * kLensStates - 2 - step) / double(kLensStates - 1);
     request.camera.focus_distance_m = float(1.0 / (1.0 / 14.0 + t * (1.0 / 0.4 - 1.0 / 14.0)));
@@ -114,7 +116,7 @@ void register_live_frame_benchmarks() {
   for (const bool gpu : {false, true})
     for (const bool region : {true, false})
       for (const Method method :
-           {Method::fresh, Method::pull, Method::pull_afresh, Method::still}) {
+           {Method::fresh, Method::pull, Method::pull_afresh, Method::still, Method::still_raw}) {
         if (method != Method::fresh && !region)
           continue; // a history is kept over the region
         if (method == Method::pull_afresh && gpu)
@@ -122,7 +124,8 @@ void register_live_frame_benchmarks() {
         const char *name = method == Method::fresh         ? "fresh"
                            : method == Method::pull        ? "live_pull"
                            : method == Method::pull_afresh ? "live_pull_afresh"
-                                                           : "live_still";
+                           : method == Method::still       ? "live_still"
+                                                           : "live_still_raw";
         benchmark::RegisterBenchmark((std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
                                       "/sim_rig/720x576/rpp:1/" +
                                       (region ? "region" : "every_pixel") + "/" + name)

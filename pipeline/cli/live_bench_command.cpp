@@ -1,13 +1,14 @@
 // camhead bench live: the live frame's virtual image as a viewer sees it, as
 // error against time (a still shot within 1 s as clean as 49 rays per pixel,
 // a focus pull as clean as 9, without ghosting). For each lens state the live
-// renderer (the CPU reference frame renderer that `camhead run` drives)
-// renders a still shot frame after frame at the rays per frame the rig holds
-// at the camera's rate, accumulating (frame_history.h), and each frame's
-// composite is measured against a converged render of the same camera; so
-// are fresh frames of 1, 9 and 49 rays per pixel (the paper's settings, in
-// the same run), and frames of a focus pull: each state reached by a pull at
-// the rig's speed, every frame a new history, which starts with the frames
+// renderer (a frame renderer as `camhead run` drives it: the CPU reference's
+// or, with --executor gpu, the Vulkan tracer's) renders a still shot frame
+// after frame at the rays per frame the rig holds at the camera's rate,
+// accumulating (frame_history.h), and each frame's composite is measured
+// against a converged render of the same camera; so are fresh frames of 1, 9
+// and 49 rays per pixel (the paper's settings, in the same run, by the same
+// executor), and frames of a focus pull: each state reached by a pull at the
+// rig's speed, every frame a new history, which starts with the frames
 // before moved through the new focus (accumulation.h, reproject) or, as
 // before that, afresh. Error = relative RMSE of the composite over the
 // influence region (elsewhere the composite is the camera image, exactly),
@@ -54,7 +55,16 @@ struct LiveArgs {
   double fps = 25.0;
   int threads = 0;
   double reconstruct = 1.0; // the filter's strength; 0: off
+  std::string executor = "cpu";
+  std::string device; // the Vulkan device, for the GPU executor
 };
+
+// The live frames' renderer; the camera image and the reference are the CPU
+// reference's whatever it is.
+std::unique_ptr<FrameRenderer> live_renderer(const Scene &scene, const LiveArgs &args) {
+  return args.executor == "gpu" ? make_gpu_frame_renderer(scene, args.device)
+                                : make_cpu_frame_renderer(scene, args.threads);
+}
 
 // A lens state of the rig (scenes/lenses/make_sim_focus_pull.py's holds).
 struct LensPoint {
@@ -87,7 +97,7 @@ public:
   Shot(const Scene &scene, const CompiledScene &compiled, const LensPoint &lens,
        const LiveArgs &args)
       : args_(args), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
-        renderer_(make_cpu_frame_renderer(scene, args.threads)) {
+        renderer_(live_renderer(scene, args)) {
     // The camera image: the proxy alone through the same lens, 16 rpp.
     Scene real = scene;
     std::erase_if(real.objects, [](const Object &o) { return !o.real; });
@@ -114,9 +124,12 @@ public:
     reference.camera = camera_;
     reference.rays_per_pixel = std::uint32_t(args.ref_rpp);
     reference.seed = 0x5eedu;
-    render(reference, "the reference");
+    auto reference_renderer = make_cpu_frame_renderer(scene, args.threads);
+    const VideoBuffer target{format_, out_};
+    check(reference_renderer->render(reference, {format_, plate_}, std::span(&target, 1)),
+          "the reference");
     progress.finish();
-    const std::span<const glm::vec4> c = renderer_->last_composite();
+    const std::span<const glm::vec4> c = reference_renderer->last_composite();
     reference_.assign(c.begin(), c.end());
     reference_picture_ = out_;
   }
@@ -181,7 +194,8 @@ private:
       throw std::runtime_error(what + ": " + report.detail);
   }
 
-  FrameReport render(const FrameRequest &request, const std::string &what) {
+  FrameReport render(FrameRequest request, const std::string &what) {
+    request.keep_composite = true; // the GPU's, read back for error()
     const VideoBuffer target{format_, out_};
     const FrameReport report = renderer_->render(request, {format_, plate_}, std::span(&target, 1));
     check(report, what);
@@ -288,8 +302,9 @@ void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
     panel.series = {live, u9, u49};
     panels.push_back(std::move(panel));
   }
-  const chart::Canvas canvas =
-      chart::plot_log_log("camhead run, still shots: error against time", panels, 520, 420);
+  const chart::Canvas canvas = chart::plot_log_log("camhead run on the " + args.executor +
+                                                       ", still shots: error against time",
+                                                   panels, 520, 420);
   write_canvas(args.out_dir / "live.png", canvas);
 }
 
@@ -411,9 +426,10 @@ int run_live(const LiveArgs &args) {
         (is_still ? rest : pull).push_back(std::move(c));
       }
 
-    std::printf("\n%s, %dx%d, reference %d rpp; live: %u rpp a frame at %.0f fps\n\n",
+    std::printf("\n%s, %dx%d, reference %d rpp; live on the %s executor: %u rpp a frame at %.0f "
+                "fps\n\n",
                 scene_file.string().c_str(), scene.render.width, scene.render.height, args.ref_rpp,
-                args.rpp, args.fps);
+                args.executor.c_str(), args.rpp, args.fps);
     std::printf("| still shot | region | uniform 1 / 9 / 49 rpp | live after 1 / 5 / 12 / 25 / "
                 "%d frames | frames to 9 rpp's error | frames to 49 rpp's |\n|---|---|---|---|---|"
                 "---|\n",
@@ -455,18 +471,18 @@ int run_live(const LiveArgs &args) {
 void add_bench_live_command(CLI::App &bench) {
   auto args = std::make_shared<LiveArgs>();
   CLI::App *cmd = bench.add_subcommand(
-      "live", "The live frame's error against time, as camhead run renders it on the CPU\n"
-              "reference: for three still lens states (the simulated rig's far and near\n"
-              "holds and the scene's own focus) each frame's composite after the lens\n"
-              "came to rest, accumulating --rpp rays a frame, and for five states of a\n"
-              "focus pull the frame that reaches it after 12 frames of a pull at the\n"
-              "rig's speed, its history started with the frames before moved through\n"
-              "the new focus, and afresh; each against a --ref-rpp reference\n"
-              "of the same camera and against fresh frames of 1, 9 and 49 rays per pixel\n"
-              "measured in the same run. Error: relative RMSE of the composite over the\n"
-              "influence region, linear light. Writes DIR/live.csv, DIR/live.png (the\n"
-              "error against time) and DIR/live_pull.png (the pull frames, cropped).\n"
-              "About 3 minutes on 2 cores for the simulated rig.\n"
+      "live", "The live frame's error against time, as camhead run renders it (the CPU\n"
+              "reference, or --executor gpu): for three still lens states (the simulated\n"
+              "rig's far and near holds and the scene's own focus) each frame's composite\n"
+              "after the lens came to rest, accumulating --rpp rays a frame, and for five\n"
+              "states of a focus pull the frame that reaches it after 12 frames of a pull\n"
+              "at the rig's speed, its history started with the frames before moved\n"
+              "through the new focus, and afresh; each against a --ref-rpp reference of\n"
+              "the same camera (the CPU reference's) and against fresh frames of 1, 9 and\n"
+              "49 rays per pixel measured in the same run. Error: relative RMSE of the\n"
+              "composite over the influence region, linear light. Writes DIR/live.csv,\n"
+              "DIR/live.png (the error against time) and DIR/live_pull.png (the pull\n"
+              "frames, cropped). About 3 minutes on 2 cores for the simulated rig.\n"
               "Example:\n"
               "  camhead bench live -o /tmp/live");
   cmd->add_option("--scene", args->scene, "Scene file (default: the simulated rig's)")
@@ -489,6 +505,14 @@ void add_bench_live_command(CLI::App &bench) {
       ->check(CLI::Range(2, 1 << 20))
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "CPU threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--executor", args->executor,
+                  "cpu (the CPU reference) or gpu (the Vulkan tracer, lavapipe included) for\n"
+                  "the live and the fresh frames; the reference and the camera image are\n"
+                  "the CPU reference's either way. The GPU's history shares no rays by noise\n"
+                  "and moves no samples through a new focus (frame_renderer.h)")
+      ->check(CLI::IsMember({"cpu", "gpu"}))
+      ->capture_default_str();
+  cmd->add_option("--device", args->device, "Vulkan device by index or name substring");
   cmd->add_option("--reconstruct", args->reconstruct,
                   "Strength of the reconstruction from neighbours' samples (renderer\n"
                   "defocus_filter.h: sigma = strength sqrt(blur radius) / samples^(1/3)); 0 = off")

@@ -112,6 +112,10 @@ struct FrameParams {
   // across it (fy / fx; fx is lens.z, which breathes); w k3.
   vec4 projection;
   vec4 distortion; // k1, k2, p1, p2 (OpenCV's order and convention)
+  // A live frame's reconstruction (reconstruct.glsl), read only with
+  // RESOLVE_FILTERED: x strength, y the least sigma (px) that borrows, z the
+  // widest reach (px); all zero for every other frame.
+  vec4 reconstruct;
 };
 
 // Camera-ray samplers (FrameParams.tracing.z, sampling.glsl).
@@ -159,6 +163,9 @@ struct FrameParams {
 #define RESOLVE_MASK_AND_DEPTH 8u
 #define RESOLVE_DISPLAY 16u
 #define RESOLVE_ALL 31u
+// Not a layer: the composite from the reconstruction's means (reconstruct.glsl)
+// rather than from the accumulators.
+#define RESOLVE_FILTERED 32u
 
 // Descriptor bindings, one set shared by the trace and resolve kernels.
 #define BINDING_PRIMITIVES 0
@@ -198,7 +205,13 @@ struct FrameParams {
 #define GROUP_LIST_TILES 0u
 #define GROUP_LIST_VIDEO(tiles) (1u + (tiles))
 #define BINDING_SURFACES 25 // texture coordinates and albedo textures (Material, above)
-#define BINDING_COUNT 26
+// The reconstruction's (reconstruct.glsl), vec4 per pixel: x the signed blur
+// radius (px), y the samples (0: a pixel outside the traced ones); and the
+// row pass's sums: mixed, and real with the weight in w.
+#define BINDING_FILTER_PIXELS 26
+#define BINDING_FILTER_ROWS_MIXED 27
+#define BINDING_FILTER_ROWS_REAL 28
+#define BINDING_COUNT 29
 
 // Histogram bins of the adaptive weights: 16 per octave over every
 // non-negative float (adaptive.glsl).

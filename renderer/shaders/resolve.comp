@@ -3,6 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "buffers.glsl"
 #include "kernel.glsl"
+#include "reconstruct.glsl"
 
 layout(local_size_x = CAMHEAD_TILE_X, local_size_y = CAMHEAD_TILE_Y) in;
 
@@ -28,8 +29,27 @@ void main() {
   // The samples the accumulators hold: the last batch's end, the frame's
   // count (or, continuing a history, the history's: GpuTracer::render_video).
   uint samples = frame.tracing.y != 0u ? sample_counts[i] : frame.sampling.y;
-  Resolved r = resolve_pixel(imageLoad(accum_mixed, i), imageLoad(accum_real, i),
-                             imageLoad(accum_aux, i), camera, has_plate, samples);
+  vec4 mixed = imageLoad(accum_mixed, i);
+  vec4 real = imageLoad(accum_real, i);
+  if ((RESOLVE_LAYERS & RESOLVE_FILTERED) != 0u) {
+    // The reconstruction's last pass, the columns, where the pixel was
+    // traced: means, which resolve as one sample. Elsewhere the
+    // accumulators' zeros, the camera image.
+    vec4 pixel = imageLoad(filter_pixels, i);
+    if (pixel.y > 0.0f) {
+      mixed = imageLoad(filter_rows_mixed, i);
+      real = imageLoad(filter_rows_real, i);
+      float sigma = reconstruct_sigma(pixel);
+      if (sigma >= frame.reconstruct.y) {
+        reconstruct_gather(i, pixel, sigma, int(p.y), int(frame.image.y), int(frame.image.x),
+                           true, mixed, real);
+      }
+      mixed /= real.w;
+      real /= real.w;
+      samples = 1u;
+    }
+  }
+  Resolved r = resolve_pixel(mixed, real, imageLoad(accum_aux, i), camera, has_plate, samples);
   if ((RESOLVE_LAYERS & RESOLVE_COMPOSITE) != 0u) {
     imageStore(out_composite, i, vec4(r.composite, 1.0f));
   }

@@ -142,6 +142,7 @@ KERNEL_TABLE uint SOBOL_DIRECTIONS[96] = {
     0x79e00020u, 0xb6d00050u, 0x800800f8u, 0xc00c0074u, 0x200200a2u, 0x50050093u,
 };
 
+#ifdef __cplusplus
 uvec3 sobol_u32_123(uint i) {
   uvec3 result = uvec3(0u, 0u, 0u);
   if (i == 0u) {
@@ -156,6 +157,39 @@ uvec3 sobol_u32_123(uint i) {
   } while (i != 0u);
   return result;
 }
+#else
+// The same numbers on the GPU, made as the loop goes by the polynomials'
+// recurrences (Bratley and Fox: v_k = a_1 v_(k-1) ^ ... ^ v_(k-s) ^
+// v_(k-s) >> s) rather than read from the table: a table indexed per lane
+// is a gather, and lavapipe spent over ten times a CMJ frame's time on it
+// (bench/RESULTS.md, "The GPU executor's history, in Sobol'"). Every bit of
+// i, in registers alone.
+uvec3 sobol_u32_123(uint i) {
+  uvec3 result = uvec3(0u, 0u, 0u);
+  uint d1 = 0x80000000u;                           // x + 1: v_k
+  uint d2 = 0x80000000u, d2_before = 0u;           // x^2 + x + 1: v_k, v_(k-1)
+  uint d3 = 0x80000000u, d3_1 = 0u, d3_2 = 0u;     // x^3 + x + 1: v_k, v_(k-1), v_(k-2)
+  uint k = 0u;
+  do {
+    uint bit = 0u - ((i >> k) & 1u);
+    result ^= uvec3(d1, d2, d3) & uvec3(bit);
+    // The next direction numbers; the first ones of dimensions 2 and 3 are
+    // their initial m (3 and 3, then 1 for dimension 3), not the recurrence's.
+    d1 ^= d1 >> 1u;
+    uint d2_next = k == 0u ? 0xc0000000u : d2 ^ d2_before ^ (d2_before >> 2u);
+    d2_before = d2;
+    d2 = d2_next;
+    uint d3_next = k == 0u ? 0xc0000000u
+                   : k == 1u ? 0x20000000u
+                             : d3_1 ^ d3_2 ^ (d3_2 >> 3u);
+    d3_2 = d3_1;
+    d3_1 = d3;
+    d3 = d3_next;
+    ++k;
+  } while (k < 32u);
+  return result;
+}
+#endif
 
 // Laine and Karras' hash, an Owen scramble of the bit-reversed value.
 uint laine_karras_permutation(uint x, uint seed) {

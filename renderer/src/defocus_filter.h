@@ -20,6 +20,9 @@
 // Only traced pixels take part and only the layers are filtered, never the
 // camera image: a pixel whose neighbourhood saw nothing virtual (I_m == I_r,
 // no mask) keeps I_m == I_r, and its composite stays the camera's.
+//
+// The GPU executor's twin is renderer/shaders/reconstruct.glsl, the same
+// steps in the same order (its exp and cube root the device's).
 #pragma once
 
 #include <cstdint>

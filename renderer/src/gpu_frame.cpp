@@ -34,6 +34,10 @@ struct GpuTracer::Impl::Frame {
   bool region_video = false;
   // Kernels read pixels outside the region, which must be zeros.
   bool reads_untraced_pixels = false;
+  // A live frame reconstructed (frame.reconstruct, reconstruct.glsl), after
+  // `clear_filter` the clear of the reconstruction's per-pixel state.
+  bool reconstruct = false;
+  bool clear_filter = false;
   Kernel decode;
   std::array<Kernel, VIDEO_MAX_OUTPUTS> encode{};
   Kernel resolve;
@@ -147,7 +151,14 @@ GpuTracer::Impl::Frame GpuTracer::Impl::plan_frame(const gpu::FrameParams &reque
   frame.reads_untraced_pixels =
       !frame_region.whole_frame() && (!frame.region_video || adaptive != nullptr);
 
+  frame.reconstruct = requested.reconstruct.x > 0.0f;
+  if (frame.reconstruct && (video == nullptr || adaptive != nullptr))
+    throw GpuError("only a live frame that is not adaptive reconstructs");
+  frame.clear_filter = frame.reconstruct && (frame.first == 0 || !filter_ready);
+  filter_ready = frame.reconstruct;
+
   std::uint32_t layers = 0;
+  layers |= frame.reconstruct ? RESOLVE_FILTERED : 0u;
   layers |=
       selection.composite || video_outputs > 0 ? RESOLVE_COMPOSITE : 0u; // video_encode reads it
   layers |= selection.mixed ? RESOLVE_MIXED : 0u;
@@ -171,9 +182,12 @@ void GpuTracer::Impl::record_frame_start(VkCommandBuffer command_buffer, const F
   }
 }
 
-// The resolve kernel reads sampling.z and tracing.y alone, so it shares the
-// last batch's uniform and submission.
+// The resolve and the reconstruction read of the frame parameters the
+// samples held (sampling.y, the last batch's end), tracing.y and those that
+// no batch changes, so they share the last batch's uniform and submission.
 void GpuTracer::Impl::record_frame_end(VkCommandBuffer command_buffer, const Frame &frame) {
+  if (frame.reconstruct)
+    record_reconstruction(command_buffer, frame.clear_filter);
   if (frame.region_video)
     dispatch_region(command_buffer, frame.resolve);
   else

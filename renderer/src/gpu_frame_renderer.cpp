@@ -2,20 +2,23 @@
 // frame's conversion, the trace and the outputs' conversion all on the
 // device, one submission for a steady frame (GpuTracer::render_video). A
 // held shot accumulates in the device's accumulators (frame_history.h):
-// every pixel of the region the next samples of one CMJ pattern,
-// the shares by noise and the reconstruction being the CPU reference's
-// alone so far.
+// every pixel of the region the next samples of one Sobol' pattern, and the
+// reconstruction on the device too (reconstruct.glsl); the shares by noise
+// and the samples moved through a new lens are the CPU reference's alone so
+// far.
 #include <algorithm>
 #include <array>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "camhead/renderer/compiled_scene.h"
 #include "camhead/renderer/frame_history.h"
 #include "camhead/renderer/frame_renderer.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "camhead/renderer/influence_region.h"
+#include "defocus_filter.h"
 #include "frame_checks.h"
 #include "vulkan_context.h"
 
@@ -77,13 +80,17 @@ public:
       return bad_frame("a plate-only frame without a camera frame");
     const FrameRequest request = as_rendered(asked);
     gpu::FrameParams frame = frame_params(request, !plate.bytes.empty());
-    const Shape shape = shape_of(plate, outputs, request.influence_region);
+    const Shape shape = shape_of(plate, outputs, request);
     std::optional<GpuTracer::SampleRange> samples;
     const bool continues = request.accumulation.enabled && continues_history(request, frame, shape);
     FrameReport report;
     if (request.accumulation.enabled) {
       if (continues) {
-        frame = history_; // its camera and seed, so that the samples stay one pattern's
+        // Its camera and seed, so that the samples stay one pattern's; the
+        // reconstruction is the frame's own.
+        const gpu::vec4 reconstruct = frame.reconstruct;
+        frame = history_;
+        frame.reconstruct = reconstruct;
       } else {
         history_ = frame;
         history_shape_ = shape;
@@ -109,7 +116,15 @@ public:
       report.frame_pixels = std::uint64_t(frame.image.x) * frame.image.y;
       const RenderResult result = tracer_.render_video(
           frame, plate, outputs, request.adaptive ? &request.adaptive_settings : nullptr, region_,
-          samples);
+          samples, request.keep_composite);
+      if (request.keep_composite) {
+        composite_.resize(result.composite.pixel_count());
+        for (std::size_t i = 0; i < composite_.size(); ++i)
+          composite_[i] = glm::vec4(result.composite.data[3 * i], result.composite.data[3 * i + 1],
+                                    result.composite.data[3 * i + 2], 0.0f);
+      } else {
+        composite_.clear();
+      }
       report.camera_rays = result.camera_rays;
       // The conversions run on the device inside the frame's one
       // submission: their time is part of the trace time here.
@@ -129,6 +144,8 @@ public:
     return report;
   }
 
+  std::span<const glm::vec4> last_composite() const override { return composite_; }
+
 private:
   gpu::FrameParams frame_params(const FrameRequest &request, bool has_plate) const {
     gpu::FrameParams frame =
@@ -138,39 +155,50 @@ private:
     frame.image.z = has_plate ? 1u : 0u; // the camera frame is the plate
     if (request.accumulation.enabled) {
       // One pattern of the history's greatest size, its samples taken in
-      // order, every sample traced on its own. CMJ, not the CPU reference's
-      // Owen-scrambled Sobol': each CMJ sample is uniform on its own, so any
-      // prefix is an unbiased estimate (less evenly spread than a Sobol' one),
-      // and on lavapipe a Sobol' frame of the rig costs 13 times a CMJ one
-      // (bench/RESULTS.md, "The GPU executor's history").
+      // order, every sample traced on its own. Owen-scrambled Sobol', as the
+      // CPU reference's: progressive, so that every prefix is an evenly
+      // spread estimate (a prefix of one CMJ pattern is unbiased but hardly
+      // stratified: after 50 frames it had 1.6-1.9 times the error of 49
+      // fresh CMJ rays, bench/RESULTS.md, "The GPU executor's history, in
+      // Sobol'").
+      frame.tracing.z = SAMPLER_SOBOL;
       frame.sampling.z = std::max(request.accumulation.max_samples, 1u);
       frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
+      if (request.accumulation.reconstruct && request.accumulation.reconstruct_strength > 0.0) {
+        const cpu::DefocusFilterSettings filter; // the CPU reference's reach and least sigma
+        frame.reconstruct =
+            gpu::vec4(float(request.accumulation.reconstruct_strength), float(filter.min_sigma_px),
+                      float(filter.max_radius_px), 0.0f);
+      }
     }
     return frame;
   }
 
   // What a history's frames must share besides the camera: the kinds of
-  // frames in and out, and whether the region or every pixel is traced (the
-  // accumulators outside a region are cleared only where a frame reads them,
-  // which depends on the outputs' formats: GpuTracer::render_video).
+  // frames in and out, whether the region or every pixel is traced, and
+  // whether the composite comes back (the accumulators outside a region are
+  // cleared only where a frame reads them, which depends on the outputs'
+  // formats and on that: GpuTracer::render_video).
   struct Shape {
     bool plate = false;
     base::PixelFormat plate_pixel = base::PixelFormat::yuyv;
     std::size_t outputs = 0;
     std::array<base::PixelFormat, VIDEO_MAX_OUTPUTS> output_pixels{};
     bool influence_region = true;
+    bool keep_composite = false;
     bool operator==(const Shape &) const = default;
   };
 
   static Shape shape_of(const VideoFrame &plate, std::span<const VideoBuffer> outputs,
-                        bool influence_region) {
+                        const FrameRequest &request) {
     Shape shape;
     shape.plate = !plate.bytes.empty();
     shape.plate_pixel = plate.format.pixel;
     shape.outputs = outputs.size();
     for (std::size_t k = 0; k < outputs.size(); ++k)
       shape.output_pixels[k] = outputs[k].format.pixel;
-    shape.influence_region = influence_region;
+    shape.influence_region = request.influence_region;
+    shape.keep_composite = request.keep_composite;
     return shape;
   }
 
@@ -208,6 +236,7 @@ private:
   bool history_valid_ = false;
   std::uint32_t history_samples_ = 0; // every pixel of the region alike
   bool lost_ = false;
+  std::vector<glm::vec4> composite_; // the last frame's, where it asked (keep_composite)
 };
 
 } // namespace

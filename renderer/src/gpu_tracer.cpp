@@ -22,6 +22,7 @@
 #include "gpu_group_lists.h"
 #include "gpu_tracer_impl.h"
 #include "gpu_video_frames.h"
+#include "reconstruct_spv.h"
 #include "resolve_spv.h"
 #include "trace_spv.h"
 #include "video_decode_spv.h"
@@ -44,7 +45,8 @@ std::array<VkDescriptorType, BINDING_COUNT> binding_types() {
   types[BINDING_VIDEO_IN] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   types[BINDING_GROUP_LIST] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   for (const int binding : {BINDING_ACCUM_MIXED, BINDING_ACCUM_REAL, BINDING_ACCUM_AUX,
-                            BINDING_PLATE, BINDING_OUT_COMPOSITE})
+                            BINDING_PLATE, BINDING_OUT_COMPOSITE, BINDING_FILTER_PIXELS,
+                            BINDING_FILTER_ROWS_MIXED, BINDING_FILTER_ROWS_REAL})
     types[std::size_t(binding)] = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER; // read per pixel
   return types;
 }
@@ -254,6 +256,12 @@ void GpuTracer::Impl::load(const CompiledScene &scene) {
     buffers[binding] =
         vk::Buffer(device, binding_buffer(binding, layer_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                           "output layer"));
+  for (const int binding :
+       {BINDING_FILTER_PIXELS, BINDING_FILTER_ROWS_MIXED, BINDING_FILTER_ROWS_REAL})
+    buffers[binding] =
+        vk::Buffer(device, binding_buffer(binding, layer_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                          "reconstruction"));
+  filter_ready = false;
   buffers[BINDING_OUT_DISPLAY] = vk::Buffer(
       device, {.size = pixels * sizeof(std::uint32_t),
                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -337,6 +345,10 @@ GpuTracer::Impl::Kernel GpuTracer::Impl::trace_kernel(const gpu::FrameParams &fr
 
 GpuTracer::Impl::Kernel GpuTracer::Impl::resolve_kernel(std::uint32_t layers) {
   return {resolve_spv, "resolve.comp", KERNEL_ALL, layers};
+}
+
+GpuTracer::Impl::Kernel GpuTracer::Impl::reconstruct_kernel(std::uint32_t pass) {
+  return {reconstruct_spv, "reconstruct.comp", KERNEL_ALL, pass};
 }
 
 GpuTracer::Impl::Kernel GpuTracer::Impl::decode_kernel(base::PixelFormat format) {
@@ -424,6 +436,21 @@ void GpuTracer::Impl::record_clear(VkCommandBuffer command_buffer) const {
   vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+void GpuTracer::Impl::record_reconstruction(VkCommandBuffer command_buffer, bool clear) {
+  if (clear) {
+    vkCmdFillBuffer(command_buffer, buffers[BINDING_FILTER_PIXELS].get(), 0, VK_WHOLE_SIZE, 0);
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  }
+  for (const std::uint32_t pass : {0u, 1u}) {
+    dispatch_region(command_buffer, reconstruct_kernel(pass));
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  }
 }
 
 void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) {
@@ -517,9 +544,15 @@ void GpuTracer::Impl::prepare_video(const gpu::FrameParams &frame,
                                     std::span<const base::PixelFormat> outputs, bool adaptive) {
   if (!loaded)
     throw GpuError("GpuTracer::prepare_video() before a successful load()");
+  const bool reconstructs = frame.reconstruct.x > 0.0f;
   for (const bool group_list : {false, true}) {
     static_cast<void>(pipeline(trace_kernel(frame), group_list));
-    static_cast<void>(pipeline(resolve_kernel(RESOLVE_COMPOSITE), group_list));
+    static_cast<void>(pipeline(resolve_kernel(RESOLVE_COMPOSITE), group_list)); // plate-only too
+    if (reconstructs) {
+      static_cast<void>(pipeline(resolve_kernel(RESOLVE_COMPOSITE | RESOLVE_FILTERED), group_list));
+      for (const std::uint32_t pass : {0u, 1u})
+        static_cast<void>(pipeline(reconstruct_kernel(pass), group_list));
+    }
     if (plate)
       static_cast<void>(pipeline(decode_kernel(*plate), group_list));
     for (const base::PixelFormat out : outputs)
@@ -564,9 +597,9 @@ RenderResult GpuTracer::render_video(const gpu::FrameParams &frame, const VideoF
                                      std::span<const VideoBuffer> outputs,
                                      const AdaptiveSampling *adaptive,
                                      const InfluenceRegion *region,
-                                     std::optional<SampleRange> samples) {
+                                     std::optional<SampleRange> samples, bool composite) {
   const VideoJob job{plate, outputs, samples.value_or(SampleRange{0, frame.sampling.z})};
-  return impl_->render(frame, {}, LayerSelection{false, false, false, false, false, false},
+  return impl_->render(frame, {}, LayerSelection{composite, false, false, false, false, false},
                        adaptive, region, &job);
 }
 

@@ -107,6 +107,10 @@ struct GpuTracer::Impl {
                      std::span<const base::PixelFormat> outputs, bool adaptive);
   // Records the accumulators' clear, ordered before the kernels.
   void record_clear(VkCommandBuffer command_buffer) const;
+  // Records the reconstruction's first passes over the frame's region
+  // (reconstruct.glsl), after `clear` the clear of its per-pixel state,
+  // ordered before the resolve.
+  void record_reconstruction(VkCommandBuffer command_buffer, bool clear);
   // Records adaptive_weights, _solve and _shares (adaptive.glsl) and
   // adaptive_queue_bins and _fill (sample_queue.glsl) after the pilot, over
   // the frame's region: sample_counts (0 outside the region), the adaptive
@@ -133,6 +137,8 @@ struct GpuTracer::Impl {
   Kernel trace_kernel(const gpu::FrameParams &frame, bool from_queue = false) const;
   // The resolve kernel writing `layers` (RESOLVE_*).
   static Kernel resolve_kernel(std::uint32_t layers);
+  // reconstruct.comp's pass `pass` (reconstruct.glsl).
+  static Kernel reconstruct_kernel(std::uint32_t pass);
   // video_decode.comp and video_encode.comp for frames of `format`.
   static Kernel decode_kernel(base::PixelFormat format);
   static Kernel encode_kernel(base::PixelFormat format);
@@ -202,6 +208,10 @@ struct GpuTracer::Impl {
   glm::vec3 origin{0.0f};                    // CompiledScene::origin of the loaded scene
   std::uint32_t scene_features = KERNEL_ALL; // scene_kernel_features of the loaded scene
   bool specialize = true;                    // set_kernel_specialization
+  // Whether BINDING_FILTER_PIXELS is zero outside the frame's region: set by
+  // a reconstructed frame, which clears it where a history starts or the
+  // frame before did not reconstruct; any other frame unsets it.
+  bool filter_ready = false;
   // Batch sizes, one per kind of pass, for the loaded scene.
   BatchSizer uniform_sizer;
   BatchSizer second_pass_sizer;

@@ -49,7 +49,8 @@ struct FrameRequest {
   // Add this frame's `rays_per_pixel` samples to those of the frames before
   // while the camera stays within the tolerance (frame_history.h); not with
   // `adaptive`. The GPU executor gives every pixel of the region the same
-  // samples: it neither shares them by noise nor reconstructs yet.
+  // samples: it does not share them by noise, nor move them through a new
+  // lens, yet.
   AccumulationSettings accumulation;
   // Trace only where the virtual objects can change the composite
   // (influence_region.h); the outputs are the same bit for bit, except for
@@ -63,6 +64,12 @@ struct FrameRequest {
   // yet, where virtual objects drawn from a guess would be worse than none.
   // Needs a camera frame.
   bool plate_only = false;
+  // For measurement (camhead bench live): keep the frame's float composite
+  // for last_composite() on an executor that otherwise leaves it on the
+  // device. The GPU's then resolves every pixel and reads the composite
+  // back, a copy of the whole layer and allocations each frame; the outputs
+  // are the same bytes.
+  bool keep_composite = false;
 };
 
 enum class FrameStatus {
@@ -126,7 +133,8 @@ public:
 
   // The last frame's composite in linear RGB (alpha unused), row by row, for
   // measurement before the outputs' 8-bit rounding: set over the frame's
-  // influence region only. Empty on an executor that keeps it on the device.
+  // influence region only. Empty on an executor that keeps it on the device,
+  // unless the frame asked for it (FrameRequest::keep_composite).
   [[nodiscard]] virtual std::span<const glm::vec4> last_composite() const { return {}; }
 };
 

@@ -17,7 +17,7 @@ static_assert(sizeof(Primitive) == 48);
 static_assert(sizeof(BvhNode) == 32);
 static_assert(sizeof(Material) == 32);
 static_assert(sizeof(Light) == 80);
-static_assert(sizeof(FrameParams) == 12 * 16);
+static_assert(sizeof(FrameParams) == 13 * 16);
 static_assert(sizeof(AdaptiveSolution) == 2 * 16);
 static_assert(sizeof(VideoFrames) == (2 * (1 + VIDEO_MAX_OUTPUTS) + 1) * 16);
 

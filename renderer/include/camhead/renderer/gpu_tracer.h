@@ -70,7 +70,9 @@ public:
   // mean of samples [0, end): the frame before must have been render_video()
   // of the same loaded scene, pattern, region and outputs, ending at
   // `first`. Without it, samples [0, frame.sampling.z), afresh. Not with
-  // `adaptive`.
+  // `adaptive`. A frame whose frame.reconstruct.x > 0 is reconstructed
+  // (layout.h; not with `adaptive`). With `composite`, the float composite
+  // comes back too (RenderResult::composite), for measurement.
   struct SampleRange {
     std::uint32_t first = 0, end = 0;
   };
@@ -78,7 +80,8 @@ public:
                                           std::span<const VideoBuffer> outputs,
                                           const AdaptiveSampling *adaptive = nullptr,
                                           const InfluenceRegion *region = nullptr,
-                                          std::optional<SampleRange> samples = std::nullopt);
+                                          std::optional<SampleRange> samples = std::nullopt,
+                                          bool composite = false);
 
   // Builds every pipeline render_video() takes for frames like `frame`
   // with a camera frame in `plate` (none: no decode) and outputs in
