@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 namespace camhead::cli::chart {
 
@@ -111,6 +112,11 @@ std::string tick_label(double v) {
   return buf;
 }
 
+// Whether a point has a place on log axes: positive and finite both ways.
+bool on_log_axes(double x, double y) {
+  return x > 0.0 && y > 0.0 && std::isfinite(x) && std::isfinite(y);
+}
+
 void draw_marker(Canvas &canvas, int cx, int cy, Marker marker, Rgb color) {
   constexpr int r = 4;
   for (int dy = -r; dy <= r; ++dy)
@@ -149,7 +155,7 @@ void draw_panel(Canvas &canvas, const Panel &panel, int left, int top, int width
   double min_y = min_x, max_y = 0.0;
   for (const Series &s : panel.series)
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if (!(s.x[i] > 0.0) || !(s.y[i] > 0.0) || !std::isfinite(s.x[i]) || !std::isfinite(s.y[i]))
+      if (!on_log_axes(s.x[i], s.y[i]))
         continue;
       min_x = std::min(min_x, s.x[i]);
       max_x = std::max(max_x, s.x[i]);
@@ -216,7 +222,7 @@ void draw_panel(Canvas &canvas, const Panel &panel, int left, int top, int width
     bool have_previous = false;
     double px_prev = 0.0, py_prev = 0.0;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if (!(s.x[i] > 0.0) || !(s.y[i] > 0.0) || !std::isfinite(s.x[i]) || !std::isfinite(s.y[i]))
+      if (!on_log_axes(s.x[i], s.y[i]))
         continue;
       const double px = ax.map(s.x[i]), py = ay.map(s.y[i]);
       if (have_previous)
@@ -226,7 +232,7 @@ void draw_panel(Canvas &canvas, const Panel &panel, int left, int top, int width
       have_previous = true;
     }
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if (!(s.x[i] > 0.0) || !(s.y[i] > 0.0) || !std::isfinite(s.x[i]) || !std::isfinite(s.y[i]))
+      if (!on_log_axes(s.x[i], s.y[i]))
         continue;
       const int px = int(std::lround(ax.map(s.x[i]))), py = int(std::lround(ay.map(s.y[i])));
       draw_marker(canvas, px, py, s.marker, s.color);
@@ -235,14 +241,38 @@ void draw_panel(Canvas &canvas, const Panel &panel, int left, int top, int width
     }
   }
 
-  // Legend in the top-right corner, where error-versus-time charts are empty.
+  // The legend in the corner where it hides the fewest points: the top
+  // right, unless the series reach it (a wide legend over a falling error
+  // hides its first frames; a rising series ends there).
   int legend_w = 0;
   for (const Series &s : panel.series)
     legend_w = std::max(legend_w, text_width(s.name, 2));
   legend_w += 50;
   const int row_h = 20;
   const int legend_h = int(panel.series.size()) * row_h + 8;
-  const int lx = x1 - legend_w - 8, ly = y0 + 8;
+  const auto hidden = [&](int lx, int ly) {
+    int points = 0;
+    for (const Series &s : panel.series)
+      for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+        if (!on_log_axes(s.x[i], s.y[i]))
+          continue;
+        const double px = ax.map(s.x[i]), py = ay.map(s.y[i]);
+        points += px >= lx - 5 && px <= lx + legend_w + 5 && py >= ly - 5 &&
+                  py <= ly + legend_h + 5; // a marker's reach
+      }
+    return points;
+  };
+  int lx = x1 - legend_w - 8, ly = y0 + 8;
+  int least = hidden(lx, ly);
+  for (const auto &[cx, cy] : {std::pair{x0 + 8, y1 - legend_h - 8}, std::pair{x0 + 8, y0 + 8},
+                               std::pair{x1 - legend_w - 8, y1 - legend_h - 8}}) {
+    const int points = hidden(cx, cy);
+    if (points < least) {
+      least = points;
+      lx = cx;
+      ly = cy;
+    }
+  }
   canvas.fill_rect(lx, ly, lx + legend_w, ly + legend_h, kWhite);
   canvas.line(lx, ly, lx + legend_w, ly, kBlack);
   canvas.line(lx, ly + legend_h, lx + legend_w, ly + legend_h, kBlack);

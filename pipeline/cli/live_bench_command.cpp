@@ -456,6 +456,9 @@ int run_live(const LiveArgs &args) {
                   100.0 * c.region, fmt(c.uniform1).c_str(), fmt(c.uniform9).c_str(),
                   fmt(c.uniform49).c_str(), fmt(c.afresh).c_str(), fmt(c.error.front()).c_str(),
                   c.samples.front(), c.error.front() / c.uniform9);
+    if (args.executor == "gpu")
+      std::printf("\n(The GPU executor moves no samples through a new focus: its pull frames "
+                  "start afresh either way.)\n");
     std::printf("\n");
     write_outputs(args, rest, pull);
     write_pull_pictures(args, scene, pull);

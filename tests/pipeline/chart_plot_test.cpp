@@ -2,6 +2,7 @@
 // writes has glyphs, series land in their colours, CSV fields are quoted.
 #include <cstdlib>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "chart/chart_plot.h"
@@ -44,6 +45,33 @@ TEST(ChartPlot, DrawsSeriesAxesAndLegend) {
   EXPECT_GT(reds, 200);    // lines and markers in both panels
   EXPECT_GT(blues, 40);    // one valid point (x = 0 has no log) and its legend entry
   EXPECT_GT(blacks, 2000); // axes, ticks, text
+}
+
+// The legend goes where it hides no point: a series that rises into the
+// top-right corner shows as much of itself as its mirror image, which falls
+// away from it (the legend there would hide the last marker and segment).
+TEST(ChartPlot, TheLegendHidesNoPoint) {
+  const Rgb red{214, 39, 40};
+  const auto reds = [&](std::vector<double> ys) {
+    Panel panel;
+    panel.series.push_back(
+        {"rises", red, Marker::square, {1.5, 4.0, 12.0, 30.0, 70.0}, std::move(ys), {}});
+    const Canvas canvas = plot_log_log("", std::vector<Panel>{panel}, 480, 360);
+    int n = 0;
+    for (int y = 0; y < canvas.height; ++y)
+      for (int x = 0; x < canvas.width; ++x)
+        n += canvas.pixel(x, y) == red;
+    return n;
+  };
+  // On axes of 1 .. 100 and 0.01 .. 1: y and 0.01 / y mirror each other.
+  const std::vector<double> up = {0.012, 0.04, 0.12, 0.35, 0.85};
+  std::vector<double> down;
+  for (const double y : up)
+    down.push_back(0.01 / y);
+  const int rising = reds(up);
+  const int falling = reds(down);
+  EXPECT_GT(rising, 200);
+  EXPECT_NEAR(rising, falling, 8);
 }
 
 // A panel whose series have no point that a log axis can show (none, or
