@@ -3,10 +3,11 @@
 # after bench/gpu_check.sh: the renderer's tests on the GPU (every kernel
 # against the CPU reference on that driver), the adaptive second pass's
 # longest thread (the same mean rays with the largest share capped lower),
-# the live frame (the sim rig's frame renderer, and `camhead run` on the
-# sim rig for 30 s with its record), and the speed-accuracy chart of
-# uniform and adaptive sampling timed on the GPU. Prints Markdown; the log,
-# the record and the chart (CSV, PNGs) go to OUT_DIR.
+# the live frame (the sim rig's frame renderer, `camhead run` on the sim
+# rig for 30 s with its record, and its error against time), and the
+# speed-accuracy chart of uniform and adaptive sampling timed on the GPU.
+# Prints Markdown; the log, the record and the charts (CSV, PNGs) go to
+# OUT_DIR.
 #
 #   bench/gpu_live_check.sh BIN_DIR [OUT_DIR]
 #
@@ -56,6 +57,11 @@ step "$bin/camhead" bench --scene scenes/ar_demo.json --rpp 9,49 --frames 21 --w
 step "$bin/camhead_benchmarks" --benchmark_filter='LiveFrame/gpu'
 step "$bin/camhead" run --board sim --executor gpu --duration 30 --output null \
   --record-stats "$out/run_gpu.jsonl"
+# The live frame's error against time on this driver (its exp and cube
+# root in the reconstruction): lavapipe's figures are in bench/RESULTS.md,
+# "The GPU executor reconstructs". Its references take about a minute on
+# 16 cores.
+step "$bin/camhead" bench live --executor gpu -o "$out/live"
 
 # Speed against accuracy, timed on the GPU.
 # The references stay behind in the chart's cache; the CSV and the charts
