@@ -9,8 +9,9 @@
 //   resolve.comp with RESOLVE_FILTERED: the columns' sums, their means and
 //                     the composite from them.
 // Only traced pixels take part (BINDING_FILTER_PIXELS.y > 0: the host
-// clears it before a history's first frame), and only the layers are
-// filtered, never the camera image.
+// clears it where a history starts or the frame before did not
+// reconstruct, and the first pass writes it over the region), and only the
+// layers are filtered, never the camera image.
 // Needs buffers.glsl first.
 
 layout(binding = BINDING_FILTER_PIXELS, rgba32f) uniform restrict imageBuffer filter_pixels;
