@@ -112,9 +112,10 @@ struct FrameParams {
   // across it (fy / fx; fx is lens.z, which breathes); w k3.
   vec4 projection;
   vec4 distortion; // k1, k2, p1, p2 (OpenCV's order and convention)
-  // A live frame's reconstruction (reconstruct.glsl), read only with
-  // RESOLVE_FILTERED: x strength, y the least sigma (px) that borrows, z the
-  // widest reach (px); all zero for every other frame.
+  // A live frame's reconstruction (reconstruct.glsl), read by
+  // reconstruct.comp and by the resolve with RESOLVE_FILTERED: x strength, y
+  // the least sigma (px) that borrows, z the widest reach (px); x zero for
+  // every other frame.
   vec4 reconstruct;
 };
 

@@ -121,8 +121,8 @@ vec2 sample_dimension(uint s, uint n, uint pixel_pattern, uint dimension) {
 // (dimension 0 is the bit reversal of i): the XOR of the direction numbers
 // of i's set bits. The numbers are those of the primitive polynomials
 // x + 1, x^2 + x + 1 and x^3 + x + 1 with initial m = {1}, {1, 3},
-// {1, 3, 1} (Joe and Kuo), 32 a dimension; the loop visits the set bits
-// only, and the three dimensions share it.
+// {1, 3, 1} (Joe and Kuo), 32 a dimension; the C++ loop visits the set
+// bits only, and the three dimensions share it.
 KERNEL_TABLE uint SOBOL_DIRECTIONS[96] = {
     0x80000000u, 0xc0000000u, 0xa0000000u, 0xf0000000u, 0x88000000u, 0xcc000000u,
     0xaa000000u, 0xff000000u, 0x80800000u, 0xc0c00000u, 0xa0a00000u, 0xf0f00000u,
@@ -162,8 +162,8 @@ uvec3 sobol_u32_123(uint i) {
 // recurrences (Bratley and Fox: v_k = a_1 v_(k-1) ^ ... ^ v_(k-s) ^
 // v_(k-s) >> s) rather than read from the table: a table indexed per lane
 // is a gather, and lavapipe spent over ten times a CMJ frame's time on it
-// (bench/RESULTS.md, "The GPU executor's history, in Sobol'"). Every bit of
-// i, in registers alone.
+// (bench/RESULTS.md, "The GPU executor reconstructs; its history in
+// Sobol'"). Every bit of i, in registers alone.
 uvec3 sobol_u32_123(uint i) {
   uvec3 result = uvec3(0u, 0u, 0u);
   uint d1 = 0x80000000u;                           // x + 1: v_k

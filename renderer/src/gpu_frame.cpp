@@ -159,8 +159,9 @@ GpuTracer::Impl::Frame GpuTracer::Impl::plan_frame(const gpu::FrameParams &reque
 
   std::uint32_t layers = 0;
   layers |= frame.reconstruct ? RESOLVE_FILTERED : 0u;
-  layers |=
-      selection.composite || video_outputs > 0 ? RESOLVE_COMPOSITE : 0u; // video_encode reads it
+  // video_encode reads it; a live frame always writes it, so that one
+  // without outputs takes a resolve that prepare_video() built.
+  layers |= selection.composite || video != nullptr ? RESOLVE_COMPOSITE : 0u;
   layers |= selection.mixed ? RESOLVE_MIXED : 0u;
   layers |= selection.real ? RESOLVE_REAL : 0u;
   layers |= selection.mask_and_depth ? RESOLVE_MASK_AND_DEPTH : 0u;

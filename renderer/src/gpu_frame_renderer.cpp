@@ -158,9 +158,9 @@ private:
       // order, every sample traced on its own. Owen-scrambled Sobol', as the
       // CPU reference's: progressive, so that every prefix is an evenly
       // spread estimate (a prefix of one CMJ pattern is unbiased but hardly
-      // stratified: after 50 frames it had 1.6-1.9 times the error of 49
-      // fresh CMJ rays, bench/RESULTS.md, "The GPU executor's history, in
-      // Sobol'").
+      // stratified: at the rig's far and scene focus, after 50 frames it had
+      // 1.6-1.9 times the error of 49 fresh CMJ rays; bench/RESULTS.md, "The
+      // GPU executor reconstructs; its history in Sobol'").
       frame.tracing.z = SAMPLER_SOBOL;
       frame.sampling.z = std::max(request.accumulation.max_samples, 1u);
       frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;

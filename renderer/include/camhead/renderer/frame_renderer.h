@@ -68,7 +68,8 @@ struct FrameRequest {
   // for last_composite() on an executor that otherwise leaves it on the
   // device. The GPU's then resolves every pixel and reads the composite
   // back, a copy of the whole layer and allocations each frame; the outputs
-  // are the same bytes.
+  // get the bytes they would get without it. On the GPU a change of it
+  // starts a new history.
   bool keep_composite = false;
 };
 

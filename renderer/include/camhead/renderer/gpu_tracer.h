@@ -68,8 +68,8 @@ public:
   // samples (CMJ or Sobol': any prefix is unbiased) add to those that the frames
   // before left in the accumulators when first > 0, and the composite is the
   // mean of samples [0, end): the frame before must have been render_video()
-  // of the same loaded scene, pattern, region and outputs, ending at
-  // `first`. Without it, samples [0, frame.sampling.z), afresh. Not with
+  // of the same loaded scene, pattern, region, outputs and `composite`,
+  // ending at `first`. Without it, samples [0, frame.sampling.z), afresh. Not with
   // `adaptive`. A frame whose frame.reconstruct.x > 0 is reconstructed
   // (layout.h; not with `adaptive`). With `composite`, the float composite
   // comes back too (RenderResult::composite), for measurement.
