@@ -123,6 +123,7 @@ vec2 sample_dimension(uint s, uint n, uint pixel_pattern, uint dimension) {
 // x + 1, x^2 + x + 1 and x^3 + x + 1 with initial m = {1}, {1, 3},
 // {1, 3, 1} (Joe and Kuo), 32 a dimension; the C++ loop visits the set
 // bits only, and the three dimensions share it.
+#ifdef __cplusplus
 KERNEL_TABLE uint SOBOL_DIRECTIONS[96] = {
     0x80000000u, 0xc0000000u, 0xa0000000u, 0xf0000000u, 0x88000000u, 0xcc000000u,
     0xaa000000u, 0xff000000u, 0x80800000u, 0xc0c00000u, 0xa0a00000u, 0xf0f00000u,
@@ -142,7 +143,6 @@ KERNEL_TABLE uint SOBOL_DIRECTIONS[96] = {
     0x79e00020u, 0xb6d00050u, 0x800800f8u, 0xc00c0074u, 0x200200a2u, 0x50050093u,
 };
 
-#ifdef __cplusplus
 uvec3 sobol_u32_123(uint i) {
   uvec3 result = uvec3(0u, 0u, 0u);
   if (i == 0u) {
