@@ -58,8 +58,11 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
 // the pull (each frame starts a new history, with the samples of the frames
 // before moved through the new focus: accumulation.h, reproject; the CPU
 // reference's only), the same without them (pull_afresh), and with the lens
-// still, reconstructed and not (still_raw: what the reconstruction costs).
-enum class Method { fresh, pull, pull_afresh, still, still_raw };
+// still, reconstructed and not (still_raw: what the reconstruction costs),
+// and held so long that the history has all it may take (still_capped: 8
+// samples a pixel at most, as a locked-off shot's 256 after about 10 s;
+// from about the 8th frame on, few rays or none a frame).
+enum class Method { fresh, pull, pull_afresh, still, still_raw, still_capped };
 
 void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   const renderer::Scene scene = sim_rig_scene();
@@ -86,12 +89,15 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   request.accumulation.enabled = method != Method::fresh;
   request.accumulation.reproject = method != Method::pull_afresh;
   request.accumulation.reconstruct = method != Method::still_raw;
+  if (method == Method::still_capped)
+    request.accumulation.max_samples = 8;
   request.camera.f_number = 2.8f;
   std::uint64_t frame = 0;
   double traced = 0.0;
   for (auto _ : state) {
     // Equal steps of 1 / distance (the way a focus scale runs), one a frame.
-    const bool still = method == Method::still || method == Method::still_raw;
+    const bool still =
+        method == Method::still || method == Method::still_raw || method == Method::still_capped;
     const int step = still ? 0 : int(frame % (2 * kLensStates - 2));
     const double t =
         double(step < kLensStates ? step : 2 * kLensStates - 2 - step) / double(kLensStates - 1);
@@ -115,8 +121,8 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
 void register_live_frame_benchmarks() {
   for (const bool gpu : {false, true})
     for (const bool region : {true, false})
-      for (const Method method :
-           {Method::fresh, Method::pull, Method::pull_afresh, Method::still, Method::still_raw}) {
+      for (const Method method : {Method::fresh, Method::pull, Method::pull_afresh, Method::still,
+                                  Method::still_raw, Method::still_capped}) {
         if (method != Method::fresh && !region)
           continue; // a history is kept over the region
         if (method == Method::pull_afresh && gpu)
@@ -125,7 +131,8 @@ void register_live_frame_benchmarks() {
                            : method == Method::pull        ? "live_pull"
                            : method == Method::pull_afresh ? "live_pull_afresh"
                            : method == Method::still       ? "live_still"
-                                                           : "live_still_raw";
+                           : method == Method::still_raw   ? "live_still_raw"
+                                                           : "live_still_capped";
         benchmark::RegisterBenchmark((std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
                                       "/sim_rig/720x576/rpp:1/" +
                                       (region ? "region" : "every_pixel") + "/" + name)

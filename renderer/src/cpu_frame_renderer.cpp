@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -232,9 +233,13 @@ public:
       for (const std::uint32_t n : counts_)
         report.camera_rays += n;
     }
-    // Reconstructed layers are means already.
+    // Reconstructed layers are means already. A frame that added no ray to
+    // the history (a whole one, or one whose shares by noise all came out
+    // 0) has the means of the frame before, if that one reconstructed them
+    // as this one would.
     const bool filtered = request.accumulation.enabled && request.accumulation.reconstruct;
-    if (filtered) {
+    if (filtered && !(continues && report.camera_rays == 0 && filtered_strength_ &&
+                      *filtered_strength_ == request.accumulation.reconstruct_strength)) {
       cpu::DefocusFilterSettings settings;
       settings.strength = request.accumulation.reconstruct_strength;
       cpu::filter_defocus(
@@ -242,6 +247,8 @@ public:
           {filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_, scratch_weight_, blur_},
           pool_);
     }
+    filtered_strength_ =
+        filtered ? std::optional(request.accumulation.reconstruct_strength) : std::nullopt;
     report.trace_s = seconds_since(start);
 
     start = Clock::now();
@@ -518,6 +525,9 @@ private:
   // The reconstruction's means and passes (defocus_filter.h).
   std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_;
   std::vector<float> scratch_weight_, blur_;
+  // The strength whose means filtered_* hold, of the accumulators as the
+  // last frame left them; none where it did not reconstruct.
+  std::optional<double> filtered_strength_;
   bool region_kind_ = true; // the region's: request.influence_region
 };
 

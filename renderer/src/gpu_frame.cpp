@@ -34,9 +34,11 @@ struct GpuTracer::Impl::Frame {
   bool region_video = false;
   // Kernels read pixels outside the region, which must be zeros.
   bool reads_untraced_pixels = false;
-  // A live frame reconstructed (frame.reconstruct, reconstruct.glsl), after
-  // `clear_filter` the clear of the reconstruction's per-pixel state.
+  // A live frame reconstructed (frame.reconstruct, reconstruct.glsl): its
+  // first passes (`filter_rows`, else those of the frame before stand),
+  // after `clear_filter` the clear of their per-pixel state.
   bool reconstruct = false;
+  bool filter_rows = false;
   bool clear_filter = false;
   Kernel decode;
   std::array<Kernel, VIDEO_MAX_OUTPUTS> encode{};
@@ -155,7 +157,12 @@ GpuTracer::Impl::Frame GpuTracer::Impl::plan_frame(const gpu::FrameParams &reque
   if (frame.reconstruct && (video == nullptr || adaptive != nullptr))
     throw GpuError("only a live frame that is not adaptive reconstructs");
   frame.clear_filter = frame.reconstruct && (frame.first == 0 || !filter_ready);
+  // A frame that adds no sample to a history (a whole one) reads the rows'
+  // sums that the frame before left, if it made them as this one would.
+  frame.filter_rows = frame.reconstruct && !(frame.first == frame.total && filter_ready &&
+                                             filter_settings == requested.reconstruct);
   filter_ready = frame.reconstruct;
+  filter_settings = requested.reconstruct;
 
   std::uint32_t layers = 0;
   layers |= frame.reconstruct ? RESOLVE_FILTERED : 0u;
@@ -187,7 +194,7 @@ void GpuTracer::Impl::record_frame_start(VkCommandBuffer command_buffer, const F
 // samples held (sampling.y, the last batch's end), tracing.y and those that
 // no batch changes, so they share the last batch's uniform and submission.
 void GpuTracer::Impl::record_frame_end(VkCommandBuffer command_buffer, const Frame &frame) {
-  if (frame.reconstruct)
+  if (frame.filter_rows)
     record_reconstruction(command_buffer, frame.clear_filter);
   if (frame.region_video)
     dispatch_region(command_buffer, frame.resolve);

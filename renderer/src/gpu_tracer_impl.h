@@ -208,10 +208,13 @@ struct GpuTracer::Impl {
   glm::vec3 origin{0.0f};                    // CompiledScene::origin of the loaded scene
   std::uint32_t scene_features = KERNEL_ALL; // scene_kernel_features of the loaded scene
   bool specialize = true;                    // set_kernel_specialization
-  // Whether BINDING_FILTER_PIXELS is zero outside the frame's region: set by
-  // a reconstructed frame, which clears it where a history starts or the
-  // frame before did not reconstruct; any other frame unsets it.
+  // Whether BINDING_FILTER_PIXELS is zero outside the frame's region, and
+  // the rows' sums those of the accumulators with `filter_settings`
+  // (FrameParams::reconstruct): set by a reconstructed frame, which clears
+  // it where a history starts or the frame before did not reconstruct; any
+  // other frame unsets it.
   bool filter_ready = false;
+  gpu::vec4 filter_settings{0.0f};
   // Batch sizes, one per kind of pass, for the loaded scene.
   BatchSizer uniform_sizer;
   BatchSizer second_pass_sizer;

@@ -89,6 +89,45 @@ TEST_P(FrameHistoryOn, AFullHistoryTracesNothingMore) {
   EXPECT_EQ(bytes_differing(frames.out(), full), 0u);
 }
 
+// A whole history adds no sample, and its frames take the last frame's
+// reconstruction rather than making it again (bench/RESULTS.md, "A frame
+// that adds no ray is not reconstructed again"): only where that frame
+// made it as this one would. Another strength, or the reconstruction off
+// and on, gives what a history that always had it gives.
+TEST_P(FrameHistoryOn, AWholeHistoryFollowsTheReconstructionsStrength) {
+  const Scene scene = defocused_ball_scene();
+  const auto frame_at = [](const Scene &s, double strength, bool reconstruct = true) {
+    FrameRequest request = still_uniform(s, 4);
+    request.accumulation.max_samples = 8;
+    request.accumulation.reconstruct = reconstruct;
+    request.accumulation.reconstruct_strength = strength;
+    return request;
+  };
+  // What each setting gives a history made whole with it.
+  const auto whole = [&](double strength, bool reconstruct) {
+    Frames frames(scene, false, GetParam());
+    for (int n = 0; n < 3; ++n)
+      (void)frames.render(frame_at(scene, strength, reconstruct));
+    return frames.out();
+  };
+  Frames frames(scene, false, GetParam());
+  if (!frames.available())
+    GTEST_SKIP() << "no Vulkan device";
+  const std::vector<std::uint8_t> at_1 = whole(1.0, true), at_3 = whole(3.0, true),
+                                  raw = whole(1.0, false);
+  ASSERT_GT(bytes_differing(at_1, at_3), 100u) << "the strength must show";
+  ASSERT_GT(bytes_differing(at_1, raw), 100u) << "the reconstruction must show";
+  for (int n = 0; n < 3; ++n)
+    (void)frames.render(frame_at(scene, 1.0));
+  EXPECT_EQ(bytes_differing(frames.out(), at_1), 0u);
+  EXPECT_EQ(frames.render(frame_at(scene, 3.0)).camera_rays, 0u) << "the history is whole";
+  EXPECT_EQ(bytes_differing(frames.out(), at_3), 0u);
+  (void)frames.render(frame_at(scene, 1.0, false));
+  EXPECT_EQ(bytes_differing(frames.out(), raw), 0u);
+  (void)frames.render(frame_at(scene, 1.0));
+  EXPECT_EQ(bytes_differing(frames.out(), at_1), 0u);
+}
+
 // A plate-only frame (a pose not known yet: frame_renderer.h) is the camera
 // image and traces nothing; the history before it ends, and the frame after
 // starts one afresh, byte for byte as a new renderer's first frame.
