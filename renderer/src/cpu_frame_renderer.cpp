@@ -238,8 +238,10 @@ public:
     // 0) has the means of the frame before, if that one reconstructed them
     // as this one would.
     const bool filtered = request.accumulation.enabled && request.accumulation.reconstruct;
-    if (filtered && !(continues && report.camera_rays == 0 && filtered_strength_ &&
-                      *filtered_strength_ == request.accumulation.reconstruct_strength)) {
+    const bool kept = continues && report.camera_rays == 0 && filtered_strength_ &&
+                      *filtered_strength_ == request.accumulation.reconstruct_strength;
+    filtered_strength_.reset(); // until the means are whole again
+    if (filtered && !kept) {
       cpu::DefocusFilterSettings settings;
       settings.strength = request.accumulation.reconstruct_strength;
       cpu::filter_defocus(

@@ -51,6 +51,9 @@ RenderResult GpuTracer::Impl::render(const gpu::FrameParams &requested, const Pr
   const GpuClock::time_point start = GpuClock::now();
   Frame frame = plan_frame(requested, selection, adaptive, region, video);
   FrameTimings timings = trace_frame(frame, progress);
+  // Only a frame that ran leaves its reconstruction's state to the next.
+  filter_ready = frame.reconstruct;
+  filter_settings = frame.params.reconstruct;
   timings.submit_s = seconds_since(start);
   const GpuClock::time_point unpacking = GpuClock::now();
   RenderResult result = read_layers(frame);
@@ -161,8 +164,7 @@ GpuTracer::Impl::Frame GpuTracer::Impl::plan_frame(const gpu::FrameParams &reque
   // sums that the frame before left, if it made them as this one would.
   frame.filter_rows = frame.reconstruct && !(frame.first == frame.total && filter_ready &&
                                              filter_settings == requested.reconstruct);
-  filter_ready = frame.reconstruct;
-  filter_settings = requested.reconstruct;
+  filter_ready = false; // until the frame has run: render()
 
   std::uint32_t layers = 0;
   layers |= frame.reconstruct ? RESOLVE_FILTERED : 0u;

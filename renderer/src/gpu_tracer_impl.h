@@ -209,10 +209,10 @@ struct GpuTracer::Impl {
   std::uint32_t scene_features = KERNEL_ALL; // scene_kernel_features of the loaded scene
   bool specialize = true;                    // set_kernel_specialization
   // Whether BINDING_FILTER_PIXELS is zero outside the frame's region, and
-  // the rows' sums those of the accumulators with `filter_settings`
-  // (FrameParams::reconstruct): set by a reconstructed frame, which clears
-  // it where a history starts or the frame before did not reconstruct; any
-  // other frame unsets it.
+  // it and the rows' sums are those of the accumulators with
+  // `filter_settings` (FrameParams::reconstruct): set by a reconstructed
+  // frame that ran, which clears it where a history starts or the frame
+  // before did not reconstruct; any other frame unsets it.
   bool filter_ready = false;
   gpu::vec4 filter_settings{0.0f};
   // Batch sizes, one per kind of pass, for the loaded scene.
