@@ -192,6 +192,21 @@ void GpuTracer::Impl::record_frame_start(VkCommandBuffer command_buffer, const F
   }
 }
 
+void GpuTracer::Impl::record_reconstruction(VkCommandBuffer command_buffer, bool clear) {
+  if (clear) {
+    vkCmdFillBuffer(command_buffer, buffers[BINDING_FILTER_PIXELS].get(), 0, VK_WHOLE_SIZE, 0);
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  }
+  for (const std::uint32_t pass : {0u, 1u}) {
+    dispatch_region(command_buffer, reconstruct_kernel(pass));
+    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  }
+}
+
 // The resolve and the reconstruction read of the frame parameters the
 // samples held (sampling.y, the last batch's end), tracing.y and those that
 // no batch changes, so they share the last batch's uniform and submission.

@@ -438,21 +438,6 @@ void GpuTracer::Impl::record_clear(VkCommandBuffer command_buffer) const {
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
-void GpuTracer::Impl::record_reconstruction(VkCommandBuffer command_buffer, bool clear) {
-  if (clear) {
-    vkCmdFillBuffer(command_buffer, buffers[BINDING_FILTER_PIXELS].get(), 0, VK_WHOLE_SIZE, 0);
-    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  }
-  for (const std::uint32_t pass : {0u, 1u}) {
-    dispatch_region(command_buffer, reconstruct_kernel(pass));
-    vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  }
-}
-
 void GpuTracer::Impl::record_allocation(VkCommandBuffer command_buffer) {
   const auto compute_to_compute = [&] {
     vk::memory_barrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
