@@ -353,6 +353,13 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
 }
 
 int run_live(const LiveArgs &args) {
+  if (!args.device.empty() && args.executor != "gpu") {
+    std::fprintf(stderr,
+                 "bench live: --device '%s' picks a Vulkan device for --executor gpu; the "
+                 "live frames are the %s executor's\n",
+                 args.device.c_str(), args.executor.c_str());
+    return 2;
+  }
   try {
     const fs::path scene_file =
         args.scene.empty() ? pipeline::data_dir() / "scenes" / "sim_rig.json" : args.scene;
