@@ -6,6 +6,7 @@
 // rays the GPU traces.
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -67,12 +68,20 @@ struct CpuKernel {
     return (x >> 16u) | (x << 16u);
   }
 
+  // GLSL's findLSB for the Sobol' loop, which calls it once a set bit of a
+  // scrambled index (some 16 a dimension triple): glm's counts the bits
+  // below the lowest in five steps of masks, where the CPU has one
+  // instruction (bsf or tzcnt). Found by class scope before glm's.
+  static constexpr int findLSB(uint x) { return x == 0u ? -1 : std::countr_zero(x); }
+
 #include "kernel.glsl"
 };
 
 static_assert(CpuKernel::bitfieldReverse(0x00000001u) == 0x80000000u);
 static_assert(CpuKernel::bitfieldReverse(0x12345678u) == 0x1e6a2c48u);
 static_assert(CpuKernel::bitfieldReverse(0xf0000001u) == 0x8000000fu);
+static_assert(CpuKernel::findLSB(0u) == -1 && CpuKernel::findLSB(1u) == 0);
+static_assert(CpuKernel::findLSB(0x80000000u) == 31 && CpuKernel::findLSB(0x00f0a800u) == 11);
 
 #undef INOUT
 #undef OUT
