@@ -14,6 +14,7 @@
 // influence region (elsewhere the composite is the camera image, exactly),
 // in linear light before the outputs' 8-bit rounding.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -327,15 +328,21 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
   const int x0 = std::clamp(cx - crop_w / 2, 0, w - crop_w);
   const int y0 = std::clamp(cy - crop_h / 2, 0, h - crop_h);
 
-  const std::string titles[] = {"1 RPP, FRESH (BEFORE)",
-                                "LIVE IN A PULL: " + std::to_string(args.rpp) + " RPP" +
-                                    (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : ""),
-                                "9 RPP", std::to_string(args.ref_rpp) + " RPP (REFERENCE)"};
-  const int gap = 6, left = 120, top = 24;
+  // Two lines a column: one line of the live frame's title is wider than
+  // its picture.
+  const std::array<std::array<std::string, 2>, 4> titles = {
+      {{"1 RPP, FRESH", "(BEFORE)"},
+       {"LIVE IN A PULL", std::to_string(args.rpp) + " RPP" +
+                              (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : "")},
+       {"9 RPP", ""},
+       {std::to_string(args.ref_rpp) + " RPP", "(REFERENCE)"}}};
+  const int gap = 6, left = 120, top = 28;
   chart::Canvas canvas(left + 4 * (crop_w + gap), top + int(pull.size()) * (crop_h + gap),
                        {255, 255, 255});
   for (int col = 0; col < 4; ++col)
-    canvas.text(left + col * (crop_w + gap), 8, titles[col], {0, 0, 0});
+    for (int line = 0; line < 2; ++line)
+      canvas.text(left + col * (crop_w + gap), 4 + 10 * line,
+                  titles[std::size_t(col)][std::size_t(line)], {0, 0, 0});
   for (std::size_t row = 0; row < pull.size(); ++row) {
     const int oy = top + int(row) * (crop_h + gap);
     canvas.text(4, oy + crop_h / 2, fmt(pull[row].lens.focus_m, "%.2f M"), {0, 0, 0});
