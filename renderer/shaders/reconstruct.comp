@@ -18,9 +18,8 @@ void main() {
   if (RECONSTRUCT_PASS == 0u) {
     // The signed blur radius at the pixel's mean depth (a miss: at
     // infinity), and the samples the accumulators hold (the last batch's end).
-    vec4 aux = imageLoad(accum_aux, i);
-    float inverse_depth = aux.y > 0.0f ? aux.y / aux.x : 0.0f;
-    float blur = frame.lens.x * frame.lens.z * (inverse_depth - 1.0f / frame.lens.y);
+    float blur = reconstruct_blur(imageLoad(accum_aux, i), frame.lens.x * frame.lens.z,
+                                  1.0f / frame.lens.y);
     imageStore(filter_pixels, i, vec4(blur, float(frame.sampling.y), 0.0f, 0.0f));
     return;
   }

@@ -18,23 +18,19 @@ layout(binding = BINDING_FILTER_PIXELS, rgba32f) uniform restrict imageBuffer fi
 layout(binding = BINDING_FILTER_ROWS_MIXED, rgba32f) uniform restrict imageBuffer filter_rows_mixed;
 layout(binding = BINDING_FILTER_ROWS_REAL, rgba32f) uniform restrict imageBuffer filter_rows_real;
 
-// The pixel's Gaussian: at most half the widest reach, so that it is cut at
-// 2 sigma (and a hit at depth 0, an infinite blur, is bounded).
-float reconstruct_sigma(vec4 pixel) {
-  return min(frame.reconstruct.x * sqrt(abs(pixel.x)) / pow(max(pixel.y, 1.0f), 1.0f / 3.0f),
-             0.5f * frame.reconstruct.z);
-}
+#define CUBE_ROOT(x) pow(x, 1.0f / 3.0f)
+#include "reconstruct_rules.glsl"
 
-int reconstruct_reach(float sigma) {
-  return int(min(ceil(2.0f * sigma), frame.reconstruct.z));
+// A pixel's Gaussian (filter_pixels: its blur radius and samples), with
+// the frame's strength and widest reach.
+float reconstruct_sigma(vec4 pixel) {
+  return reconstruct_sigma_of(pixel.x, pixel.y, frame.reconstruct.x, frame.reconstruct.z);
 }
 
 // Whether neighbour `other` may lend its samples to `pixel`: a traced pixel
-// whose blur differs by no more than the larger of the two (or a pixel).
+// of alike blur.
 bool reconstruct_alike(vec4 pixel, vec4 other) {
-  float b = pixel.x;
-  float c = other.x;
-  return other.y > 0.0f && abs(c - b) <= max(max(1.0f, abs(b)), abs(c));
+  return other.y > 0.0f && reconstruct_blurs_alike(pixel.x, other.x);
 }
 
 // The neighbours at +-1 .. +-reach steps of `step` pixels (`along` the
@@ -48,7 +44,7 @@ void reconstruct_gather(int i, vec4 pixel, float sigma, int along, int size, int
   float w = exp(falloff);
   float ratio = exp(3.0f * falloff);
   float ratio_step = exp(2.0f * falloff);
-  int reach = reconstruct_reach(sigma);
+  int reach = reconstruct_reach_of(sigma, frame.reconstruct.z);
   for (int k = 1; k <= reach; ++k) {
     for (int side = -1; side <= 1; side += 2) {
       int at = along + side * k;

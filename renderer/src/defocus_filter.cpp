@@ -5,7 +5,16 @@
 #include <cstddef>
 #include <initializer_list>
 
+#include <glm/common.hpp>
+#include <glm/exponential.hpp>
+
 namespace camhead::renderer::cpu {
+namespace rules {
+using namespace glm; // GLSL's built-ins, unqualified
+#define CUBE_ROOT(x) std::cbrt(x)
+#include "reconstruct_rules.glsl"
+#undef CUBE_ROOT
+} // namespace rules
 
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
                     std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,
@@ -16,6 +25,8 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   const int height = int(frame.image.y);
   const float lens = frame.lens.x * frame.lens.z; // A f: blur radius per dioptre, pixels
   const float inverse_focus = 1.0f / frame.lens.y;
+  const float strength = float(settings.strength);
+  const float max_reach = float(settings.max_radius_px);
   const auto at = [width](std::uint32_t y, int x) { return std::size_t(y) * width + x; };
 
   // Each pixel's signed blur radius at its mean depth (a miss: at infinity).
@@ -23,30 +34,23 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const float inverse_depth = aux[i].y > 0.0f ? aux[i].y / aux[i].x : 0.0f;
-      buffers.blur[i] = lens * (inverse_depth - inverse_focus);
+      buffers.blur[i] = rules::reconstruct_blur(aux[i], lens, inverse_focus);
     }
   };
   pool.run(int(spans.size()), blur_of);
 
-  // At most half the reach, so that the Gaussian is cut at 2 sigma (and a
-  // hit at depth 0, an infinite blur, is bounded); NaN, which no comparison
-  // passes, leaves the pixel its own samples.
+  // A sigma of NaN, which no comparison passes, leaves the pixel its own
+  // samples.
   const auto sigma_of = [&](std::size_t i) {
-    return std::min(float(settings.strength) * std::sqrt(std::abs(buffers.blur[i])) /
-                        std::cbrt(float(std::max(counts[i], 1u))),
-                    0.5f * float(settings.max_radius_px));
+    return rules::reconstruct_sigma_of(buffers.blur[i], float(counts[i]), strength, max_reach);
   };
-  // Neighbours whose blur circles are alike: differing by no more than the
-  // larger of the two (or a pixel), which keeps a sharp surface's samples
-  // from a far more blurred one's and lets a blurred silhouette's pixels
-  // share theirs with the background they spill over. A tighter rule (half
-  // the pixel's own radius) left a 1-rpp frame of the rig focused far twice
-  // as noisy (bench/RESULTS.md).
+  // Neighbours whose blur circles are alike, which keeps a sharp surface's
+  // samples from a far more blurred one's and lets a blurred silhouette's
+  // pixels share theirs with the background they spill over. A tighter rule
+  // (within half the pixel's own radius) left a 1-rpp frame of the rig
+  // focused far twice as noisy (bench/RESULTS.md).
   const auto alike = [&](std::size_t i, std::size_t j) {
-    const float b = buffers.blur[i];
-    const float c = buffers.blur[j];
-    return std::abs(c - b) <= std::max({1.0f, std::abs(b), std::abs(c)});
+    return rules::reconstruct_blurs_alike(buffers.blur[i], buffers.blur[j]);
   };
 
   // Adds the neighbours at +-1 .. +-reach steps of `step` (whose offsets
@@ -74,9 +78,7 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
       ratio *= ratio_step;
     }
   };
-  const auto reach_of = [&](float sigma) {
-    return std::min(settings.max_radius_px, int(std::ceil(2.0f * sigma)));
-  };
+  const auto reach_of = [&](float sigma) { return rules::reconstruct_reach_of(sigma, max_reach); };
 
   // Rows: weighted sums of the sums, and of the counts.
   auto rows = [&](int k) {

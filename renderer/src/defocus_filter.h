@@ -22,7 +22,10 @@
 // no mask) keeps I_m == I_r, and its composite stays the camera's.
 //
 // The GPU executor's twin is renderer/shaders/reconstruct.glsl, the same
-// steps in the same order (its exp and cube root the device's).
+// steps in the same order (its exp and cube root the device's). The rules
+// for one pixel (its blur, its sigma and reach, which neighbours are alike)
+// are written once, in renderer/shaders/reconstruct_rules.glsl, which both
+// compile.
 #pragma once
 
 #include <cstdint>
