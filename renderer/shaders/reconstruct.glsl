@@ -20,6 +20,7 @@ layout(binding = BINDING_FILTER_ROWS_REAL, rgba32f) uniform restrict imageBuffer
 
 #define CUBE_ROOT(x) pow(x, 1.0f / 3.0f)
 #include "reconstruct_rules.glsl"
+#undef CUBE_ROOT
 
 // A pixel's Gaussian (filter_pixels: its blur radius and samples), with
 // the frame's strength and widest reach.

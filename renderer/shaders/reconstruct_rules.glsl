@@ -3,6 +3,9 @@
 // C++ (glm's functions for GLSL's), the GPU's reconstruct.glsl as GLSL.
 // renderer/src/defocus_filter.h says what each rule is and why.
 // The includer defines CUBE_ROOT(x): std::cbrt on the CPU, pow on the GPU.
+#ifndef CUBE_ROOT
+#error "reconstruct_rules.glsl: define CUBE_ROOT(x) before including it"
+#endif
 
 // A pixel's signed blur radius in pixels at its mean depth, from its
 // accumulated depth sum and hit count (aux.x, aux.y; no hit: at infinity),
@@ -15,7 +18,9 @@ float reconstruct_blur(vec4 aux, float blur_per_dioptre, float inverse_focus) {
 
 // The pixel's Gaussian, sigma = strength sqrt(|blur|) / samples^(1/3): at
 // most half the widest reach, so that it is cut at 2 sigma (and a hit at
-// depth 0, an infinite blur, is bounded). NaN where the blur is.
+// depth 0, an infinite blur, is bounded). Where the blur is NaN the CPU's
+// sigma is NaN, which no comparison with the least sigma passes; a GPU's min
+// may give the bound instead, whose pass then finds no neighbour alike.
 float reconstruct_sigma_of(float blur, float samples, float strength, float max_reach) {
   return min(strength * sqrt(abs(blur)) / CUBE_ROOT(max(samples, 1.0f)), 0.5f * max_reach);
 }

@@ -1,6 +1,5 @@
 #include "defocus_filter.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <initializer_list>
@@ -10,10 +9,13 @@
 
 namespace camhead::renderer::cpu {
 namespace rules {
+namespace {
 using namespace glm; // GLSL's built-ins, unqualified
+using std::abs;      // fabs, as GLSL's; found before glm's x >= 0 ? x : -x
 #define CUBE_ROOT(x) std::cbrt(x)
 #include "reconstruct_rules.glsl"
 #undef CUBE_ROOT
+} // namespace
 } // namespace rules
 
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
