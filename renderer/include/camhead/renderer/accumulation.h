@@ -41,11 +41,11 @@ struct AccumulationSettings {
   // not trace are left out). Off, the first frame after a change carries
   // nothing of the frames before it. The CPU reference's only, so far.
   bool reproject = true;
-  // At most this many frames' samples, as many as the CPU reference's store
-  // holds (two pictures' worth: 13 frames of 1 rpp where the influence
+  // At most this many frames' samples, fewer where the CPU reference's store
+  // holds fewer (two pictures' worth: 13 frames of 1 rpp where the influence
   // region is 15 % of the picture, 9 where it is 22 %). 12 rather than 8
-  // brings the simulated rig's pull frame focused at 1.47 m under 9 rpp's
-  // error, for about 1 ms a pull frame (bench/RESULTS.md).
+  // brings `camhead bench live`'s pull frame focused at 1.47 m under 9
+  // rpp's error, for about 1 ms a pull frame (bench/RESULTS.md).
   std::uint32_t reproject_frames = 12;
 };
 
