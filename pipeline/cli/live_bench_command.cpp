@@ -56,6 +56,7 @@ struct LiveArgs {
   double fps = 25.0;
   int threads = 0;
   double reconstruct = 1.0; // the filter's strength; 0: off
+  std::uint32_t seed = 0;   // 0: the figures in bench/RESULTS.md
   std::string executor = "cpu";
   std::string device; // the Vulkan device, for the GPU executor
 };
@@ -332,8 +333,8 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
   // its picture.
   const std::array<std::array<std::string, 2>, 4> titles = {
       {{"1 RPP, FRESH", "(BEFORE)"},
-       {"LIVE IN A PULL", std::to_string(args.rpp) + " RPP" +
-                              (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : "")},
+       {"LIVE IN A PULL",
+        std::to_string(args.rpp) + " RPP" + (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : "")},
        {"9 RPP", ""},
        {std::to_string(args.ref_rpp) + " RPP", "(REFERENCE)"}}};
   const int gap = 6, left = 120, top = 28;
@@ -402,6 +403,9 @@ int run_live(const LiveArgs &args) {
       return focus;
     };
 
+    // Another --seed draws every live and uniform frame's samples anew (the
+    // reference's stay), to see how far a figure is the seed's.
+    const std::uint32_t salt = args.seed * 0x10000u;
     std::vector<RestCurve> rest, pull;
     for (const bool is_still : {true, false})
       for (const LensPoint &lens : is_still ? still : pulling) {
@@ -409,26 +413,27 @@ int run_live(const LiveArgs &args) {
         RestCurve c;
         c.lens = lens;
         c.region = shot.region_fraction();
-        c.uniform1 = shot.uniform_error(1, 0x1001u);
+        c.uniform1 = shot.uniform_error(1, salt + 0x1001u);
         if (!is_still)
           c.pictures.push_back(shot.picture());
-        c.uniform9 = shot.uniform_error(9, 0x1009u);
+        c.uniform9 = shot.uniform_error(9, salt + 0x1009u);
         const std::vector<std::uint8_t> nine = shot.picture();
-        c.uniform49 = shot.uniform_error(49, 0x1049u);
+        c.uniform49 = shot.uniform_error(49, salt + 0x1049u);
         // Still: frame after frame; pulling: the state's frame at the end
         // of the pull, afresh, then with the frames before moved.
         if (is_still) {
           for (int k = 0; k < args.frames; ++k) {
             std::uint32_t samples = 0;
-            c.error.push_back(shot.live_error(args.rpp, 0x2000u + std::uint32_t(k), &samples));
+            c.error.push_back(
+                shot.live_error(args.rpp, salt + 0x2000u + std::uint32_t(k), &samples));
             c.samples.push_back(samples);
             c.seconds.push_back((k + 1) * frame_s);
           }
         } else {
           const std::vector<float> before = approach(lens);
-          c.afresh = shot.pull_error(args.rpp, 0x2000u, before, false, &c.afresh_samples);
+          c.afresh = shot.pull_error(args.rpp, salt + 0x2000u, before, false, &c.afresh_samples);
           std::uint32_t samples = 0;
-          c.error.push_back(shot.pull_error(args.rpp, 0x2000u, before, true, &samples));
+          c.error.push_back(shot.pull_error(args.rpp, salt + 0x2000u, before, true, &samples));
           c.samples.push_back(samples);
           c.seconds.push_back(frame_s);
         }
@@ -520,6 +525,11 @@ void add_bench_live_command(CLI::App &bench) {
       ->capture_default_str();
   cmd->add_option("--ref-rpp", args->ref_rpp, "Rays per pixel of the reference")
       ->check(CLI::Range(2, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed,
+                  "Draws the live and uniform frames' samples anew (not the reference's): a\n"
+                  "margin that holds under several seeds is not one seed's luck")
+      ->check(CLI::Range(0, 65535))
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "CPU threads (0 = all cores)")->capture_default_str();
   cmd->add_option("--executor", args->executor,
