@@ -197,7 +197,7 @@ private:
   static RenderConfig read_render(const JsonValue &d) {
     d.object({}, {"executor", "rays_per_pixel", "min_rays_per_pixel", "max_rays_per_pixel",
                   "adaptive", "accumulate", "accumulate_tolerance_px", "accumulate_max_samples",
-                  "reconstruct", "reproject"});
+                  "reconstruct", "reproject", "reproject_frames"});
     RenderConfig render;
     if (const auto executor = d.find("executor")) {
       const std::string e = executor->string();
@@ -237,6 +237,10 @@ private:
       accumulation.reconstruct = d.at("reconstruct").boolean();
     if (d.has("reproject"))
       accumulation.reproject = d.at("reproject").boolean();
+    if (d.has("reproject_frames"))
+      accumulation.reproject_frames =
+          std::uint32_t(d.at("reproject_frames")
+                            .integer(1, renderer::AccumulationSettings::kMostReprojectFrames));
     return render;
   }
 

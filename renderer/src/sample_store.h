@@ -48,6 +48,7 @@
 
 #include <glm/vec4.hpp>
 
+#include "camhead/renderer/accumulation.h"
 #include "camhead/renderer/frame_settings.h"
 #include "camhead/renderer/gpu_layout.h"
 #include "camhead/renderer/influence_region.h"
@@ -74,7 +75,7 @@ struct StoredSample {
 
 class SampleStore {
 public:
-  static constexpr std::size_t kMostFrames = 16;
+  static constexpr std::size_t kMostFrames = AccumulationSettings::kMostReprojectFrames;
 
   // Room for `capacity` samples of frames of width x height pixels. Nothing
   // is allocated after this.

@@ -264,6 +264,10 @@ TEST(BoardLive, EveryMistakeInTheLiveSectionsIsNamed) {
          "its own rays and keeps no history); choose one");
   expect(live(R"({"type": "sim"})", R"(, "render": {"accumulate_max_samples": 0})"),
          "render.accumulate_max_samples: must be an integer within 1 .. 4096");
+  expect(live(R"({"type": "sim"})", R"(, "render": {"reproject_frames": 17})"),
+         "render.reproject_frames: must be an integer within 1 .. 16");
+  expect(live(R"({"type": "sim"})", R"(, "render": {"reproject_frames": 0})"),
+         "render.reproject_frames: must be an integer within 1 .. 16");
   expect(live(R"({"type": "sim"})", R"(, "render": {"accumulate_tolerance_px": -1})"),
          "render.accumulate_tolerance_px: must be within 0 .. 100");
   EXPECT_EQ(
@@ -304,6 +308,8 @@ TEST(BoardLive, AccumulationIsOnUnlessAdaptive) {
   EXPECT_FALSE(render(R"({"reconstruct": false})").accumulation.reconstruct);
   EXPECT_TRUE(render("{}").accumulation.reproject);
   EXPECT_FALSE(render(R"({"reproject": false})").accumulation.reproject);
+  EXPECT_EQ(render("{}").accumulation.reproject_frames, 12u);
+  EXPECT_EQ(render(R"({"reproject_frames": 8})").accumulation.reproject_frames, 8u);
   EXPECT_EQ(render(R"({"accumulate_max_samples": 64})").accumulation.max_samples, 64u);
   EXPECT_EQ(render(R"({"accumulate_tolerance_px": 0.2})").accumulation.tolerance_px, 0.2);
 }

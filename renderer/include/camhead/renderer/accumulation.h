@@ -48,6 +48,8 @@ struct AccumulationSettings {
   // 9 rpp's error to par with it (0.98-1.03x over five seeds), for about 1
   // ms a pull frame (bench/RESULTS.md).
   std::uint32_t reproject_frames = 12;
+  // The most reproject_frames means: the store keeps no more frames.
+  static constexpr std::uint32_t kMostReprojectFrames = 16;
 };
 
 } // namespace camhead::renderer
