@@ -106,6 +106,8 @@ struct Record {
   std::string kind; // composite, placeholder, repeat
   std::uint64_t sequence = 0, dropped_before = 0;
   std::int64_t exposure_mid_ns = 0;
+  std::int64_t render_start_ns = 0, render_end_ns = 0;
+  std::uint64_t reprojected_samples = 0; // a new history's, moved from the frames before
   bool lens_fresh = false;
 };
 
@@ -128,6 +130,12 @@ Record parse_record(std::string_view line) {
       std::strtoull(std::string(raw_field(line, "dropped_before")).c_str(), nullptr, 10);
   r.exposure_mid_ns =
       std::strtoll(std::string(raw_field(line, "exposure_mid_ns")).c_str(), nullptr, 10);
+  r.render_start_ns =
+      std::strtoll(std::string(raw_field(line, "render_start_ns")).c_str(), nullptr, 10);
+  r.render_end_ns =
+      std::strtoll(std::string(raw_field(line, "render_end_ns")).c_str(), nullptr, 10);
+  r.reprojected_samples =
+      std::strtoull(std::string(raw_field(line, "reprojected_samples")).c_str(), nullptr, 10);
   r.lens_fresh = raw_field(line, "lens_fresh") == "true";
   return r;
 }
@@ -248,6 +256,10 @@ int main(int argc, char **argv) {
   }
   std::string problem, missed = "not looked at";
   std::vector<double> fresh_ms;
+  // Each composite's render in the guest: how close a run came to the
+  // camera's interval, where a frame that takes longer drops the next.
+  std::vector<double> render_ms;
+  std::string slowest; // which composite that was
   std::size_t composites = 0;
   try {
     fs::remove_all(kDir);
@@ -278,6 +290,19 @@ int main(int argc, char **argv) {
       problem = "camhead did not end cleanly at SIGINT (wait status " + std::to_string(status) +
                 "; " + log + " in the guest)";
     missed = frames_missed(records.all(), composites);
+    double most_ms = 0.0;
+    for (const Record &r : records.all())
+      if (r.kind == "composite" && r.render_end_ns > r.render_start_ns) {
+        render_ms.push_back(double(r.render_end_ns - r.render_start_ns) * 1e-6);
+        if (render_ms.back() > most_ms) {
+          most_ms = render_ms.back();
+          slowest = "frame " + std::to_string(r.sequence) + ", " +
+                    (r.reprojected_samples > 0
+                         ? "a new history with " + std::to_string(r.reprojected_samples) +
+                               " samples moved from the frames before"
+                         : std::string("no samples moved"));
+        }
+      }
     if (kTimed && problem.empty() && !missed.empty())
       problem = missed;
   } catch (const std::exception &e) {
@@ -286,11 +311,17 @@ int main(int argc, char **argv) {
   std::string detail = problem;
   if (!fresh_ms.empty()) {
     const std::size_t back = fresh_ms.size();
-    const std::string text = std::to_string(back) + " of " + std::to_string(kReplugs) +
-                             " plugs back, " + std::to_string(composites) + " frames composited" +
-                             (missed.empty() ? ", none missed" : " (" + missed + ")") +
-                             "; enumerated to the first fresh frame's mid-exposure: " +
-                             camhead::vm::median_and_worst_ms(std::move(fresh_ms));
+    const std::string text =
+        std::to_string(back) + " of " + std::to_string(kReplugs) + " plugs back, " +
+        std::to_string(composites) + " frames composited" +
+        (missed.empty() ? ", none missed" : " (" + missed + ")") +
+        "; enumerated to the first fresh frame's mid-exposure: " +
+        camhead::vm::median_and_worst_ms(std::move(fresh_ms)) +
+        (render_ms.empty()
+             ? std::string()
+             : "; a composite's render: " + camhead::vm::median_and_worst_ms(std::move(render_ms)) +
+                   " (the worst: " + slowest + "; a camera frame every " +
+                   std::to_string(1000 / kFps) + " ms)");
     detail = problem.empty() ? text : problem + "; " + text;
   }
   camhead::vm::print_result("usb_replug_100", problem.empty(), detail);
