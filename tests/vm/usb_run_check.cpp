@@ -13,7 +13,13 @@
 //                   plug; after every plug a fresh frame, its mid-exposure
 //                   within 500 ms of the kernel having the board enumerated
 //                   again (its serial in /sys/bus/usb/devices): the median
-//                   and worst of that; and camhead ends cleanly at SIGINT
+//                   and worst of that; and camhead ends cleanly at SIGINT.
+//                   Reported, not held: each composite's render time (its
+//                   median and worst, and what the worst frame was), the
+//                   headroom left under the camera's interval. On an idle
+//                   2-core host the worst, a new history after a lens
+//                   change, took 98-119 ms of the 100; a loaded host's
+//                   stalls then drop a frame (bench/RESULTS.md).
 //
 // Under the sanitizers (CAMHEAD_LAB_SANITIZED) camhead renders a 64x48 frame
 // in 200-500 ms in the emulated guest, and the USB stack takes about as long
