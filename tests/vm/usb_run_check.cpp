@@ -17,9 +17,9 @@
 //                   Reported, not held: each composite's render time (its
 //                   median and worst, and what the worst frame was), the
 //                   headroom left under the camera's interval. On an idle
-//                   2-core host the worst, a new history after a lens
-//                   change, took 98-119 ms of the 100; a loaded host's
-//                   stalls then drop a frame (bench/RESULTS.md).
+//                   2-core host the worst took 98-119 ms of the 100 (once
+//                   named: a new history after a lens change); a loaded
+//                   host's stalls then drop a frame (bench/RESULTS.md).
 //
 // Under the sanitizers (CAMHEAD_LAB_SANITIZED) camhead renders a 64x48 frame
 // in 200-500 ms in the emulated guest, and the USB stack takes about as long
