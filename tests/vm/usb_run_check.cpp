@@ -17,8 +17,8 @@
 //                   Reported, not held: each composite's render time (its
 //                   median and worst, and what the worst frame was), the
 //                   headroom left under the camera's interval. On an idle
-//                   2-core host the worst took 98-119 ms of the 100 (once
-//                   named: a new history after a lens change); a loaded
+//                   2-core host the worst took 98-119 ms of the 100 (where
+//                   named, a new history after a lens change); a loaded
 //                   host's stalls then drop a frame (bench/RESULTS.md).
 //
 // Under the sanitizers (CAMHEAD_LAB_SANITIZED) camhead renders a 64x48 frame
