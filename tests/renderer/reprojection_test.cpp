@@ -239,6 +239,33 @@ TEST(Reprojection, KeepingAFramesSamplesChangesNothingInIt) {
   EXPECT_TRUE(a == b);
 }
 
+TEST(Reprojection, ANewHistoryTakesTheSamplesOfAtMostReprojectFramesFrames) {
+  // Four held frames of one ray a pixel, all kept; then a focus change that
+  // asks for k of them. Each frame more adds samples, and none adds more
+  // than its own: the region's pixels.
+  const Scene scene = ball_scene();
+  std::uint64_t moved[4] = {};
+  std::uint64_t held_pixels = 0;
+  for (std::uint32_t k = 1; k <= 3; ++k) {
+    Frames frames(scene);
+    for (std::uint32_t n = 0; n < 4; ++n)
+      held_pixels = frames.render(still_uniform(scene, 1, 70u + n)).traced_pixels;
+    FrameRequest pull = still_uniform(scene, 1, 80u);
+    pull.camera.focus_distance_m = 1.2f;
+    pull.accumulation.reproject_frames = k;
+    const FrameReport report = frames.render(pull);
+    ASSERT_TRUE(report.history_restarted);
+    moved[k] = report.reprojected_samples;
+  }
+  EXPECT_GT(moved[1], 0u);
+  for (std::uint32_t k = 1; k <= 3; ++k) {
+    EXPECT_LE(moved[k], k * held_pixels) << k << " frames";
+    if (k > 1) {
+      EXPECT_GT(moved[k], moved[k - 1]) << k << " frames";
+    }
+  }
+}
+
 TEST(Reprojection, TheSamplesMovedAreTheSameOnAnyNumberOfThreads) {
   // Each thread moves the samples that land in its own band of rows, in the
   // order stored: one, two or seven threads give the same sums, bit for bit.
