@@ -65,16 +65,17 @@ public:
   // work on 4 x 2 blocks); the caller checks. A plate without bytes is none.
   //
   // `samples` [first, end) of the frame's pattern of frame.sampling.z
-  // samples (CMJ or Sobol': any prefix is unbiased) add to those that the frames
-  // before left in the accumulators when first > 0, and the composite is the
-  // mean of samples [0, end): the frame before must have been render_video()
-  // of the same loaded scene, camera, pattern, region, outputs and
-  // `composite`, ending at `first`. Without it, samples [0, frame.sampling.z), afresh. Not with
-  // `adaptive`. A frame whose frame.reconstruct.x > 0 is reconstructed
-  // (layout.h; not with `adaptive`); one that adds no sample (first == end)
-  // takes the first passes of the frame before where that one ran them
-  // with the same frame.reconstruct. With `composite`, the float composite
-  // comes back too (RenderResult::composite), for measurement.
+  // samples (CMJ or Sobol': any prefix is unbiased) add to those that the
+  // frames before left in the accumulators when first > 0, and the
+  // composite is the mean of samples [0, end): the frame before must have
+  // been render_video() of the same loaded scene, camera, pattern, region,
+  // outputs and `composite`, ending at `first`. Without it, samples [0,
+  // frame.sampling.z), afresh. Not with `adaptive`. A frame whose
+  // frame.reconstruct.x > 0 is reconstructed (layout.h; not with
+  // `adaptive`); one that adds no sample (first == end) takes the first
+  // passes of the frame before where that one ran them with the same
+  // frame.reconstruct. With `composite`, the float composite comes back
+  // too (RenderResult::composite), for measurement.
   struct SampleRange {
     std::uint32_t first = 0, end = 0;
   };
