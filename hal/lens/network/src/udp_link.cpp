@@ -15,23 +15,14 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "receipt_time.h"
+
 namespace camhead::hal::lens::detail {
 namespace {
 
 // The largest UDP payload over IPv4 is 65507 bytes; one 64 KiB buffer holds
 // any datagram, so MSG_TRUNC can only mean something very odd.
 constexpr std::size_t kBufferSize = 65536;
-
-// How old a queued datagram may be made by its kernel stamp. Only a
-// CLOCK_REALTIME step while a datagram waits in the queue can produce more
-// (see receive_all); the clamp keeps such a step from moving a reading far.
-constexpr std::int64_t kMaxQueueAgeNs = 2'000'000'000;
-
-std::int64_t clock_ns(clockid_t clock) {
-  timespec ts{};
-  ::clock_gettime(clock, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
 
 void enable_option(int fd, int level, int option) {
   const int one = 1;
@@ -122,6 +113,7 @@ UdpLink::UdpLink(const UdpLinkOptions &options)
       throw_errno(label, "SO_REUSEADDR");
     }
   }
+  queue_empty_ns_ = monotonic_ns(); // nothing is queued before the bind
   if (::bind(fd_.get(), reinterpret_cast<const sockaddr *>(&local), sizeof local) != 0) {
     throw_errno(label, "bind");
   }
@@ -179,6 +171,8 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
     iovec io{buffer_.data(), buffer_.size()};
     alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t))];
     Datagram d;
+    // Should this read find the queue empty, it was empty after this instant.
+    const std::int64_t asked_ns = monotonic_ns();
     msghdr message{};
     message.msg_name = &d.from;
     message.msg_namelen = sizeof d.from;
@@ -191,18 +185,18 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
       if (errno == EINTR) {
         continue;
       }
-      if (errno != EAGAIN && errno != EWOULDBLOCK) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK) {
+        queue_empty_ns_ = asked_ns;
+      } else {
         status_.detail = name_ + ": recvmsg: " + std::strerror(errno);
       }
       return drained;
     }
 
-    // Receipt time: CLOCK_MONOTONIC now, minus how long the datagram waited
-    // in the socket's queue. The kernel stamps only in CLOCK_REALTIME, so the
-    // wait is measured on that clock and only the short difference is used:
-    // a realtime step matters only if it falls inside that wait.
-    const std::int64_t now = monotonic_ns();
-    d.t_ns = now;
+    // Receipt time: the kernel's stamp, moved to CLOCK_MONOTONIC
+    // (receipt_time.h); now, for a datagram without one.
+    const ClockPair now = read_clock_pair();
+    d.t_ns = now.monotonic_ns;
     for (cmsghdr *c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c)) {
       if (c->cmsg_level != SOL_SOCKET) {
         continue;
@@ -210,9 +204,8 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
       if (c->cmsg_type == SCM_TIMESTAMPNS) {
         timespec stamp{};
         std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
-        const std::int64_t age =
-            clock_ns(CLOCK_REALTIME) - (std::int64_t{stamp.tv_sec} * 1'000'000'000 + stamp.tv_nsec);
-        d.t_ns = now - std::clamp<std::int64_t>(age, 0, kMaxQueueAgeNs);
+        d.t_ns = receipt_ns(std::int64_t{stamp.tv_sec} * 1'000'000'000 + stamp.tv_nsec, now,
+                            queue_empty_ns_);
       } else if (c->cmsg_type == SO_RXQ_OVFL) {
         std::uint32_t counter = 0;
         std::memcpy(&counter, CMSG_DATA(c), sizeof counter);

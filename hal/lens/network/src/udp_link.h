@@ -138,6 +138,9 @@ private:
   std::string name_;
   std::uint16_t port_ = 0;
   std::int64_t window_ns_ = 0;
+  // When the socket's queue was last seen empty: every datagram in it now
+  // was stamped after this (CLOCK_MONOTONIC).
+  std::int64_t queue_empty_ns_ = 0;
   std::vector<std::uint8_t> buffer_;
 
   EncoderStatus status_;

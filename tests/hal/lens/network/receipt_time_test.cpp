@@ -1,0 +1,102 @@
+// A datagram's receipt on CLOCK_MONOTONIC from the kernel's CLOCK_REALTIME
+// stamp (receipt_time.h), with clocks the test drives: a thread preempted
+// between two clock reads, and a realtime clock stepped while a datagram
+// waits in the queue, must not put a receipt before the datagram was sent.
+#include <cstdint>
+#include <ctime>
+#include <vector>
+
+#include "receipt_time.h"
+
+#include <gtest/gtest.h>
+
+namespace camhead::hal::lens::detail {
+namespace {
+
+// Realtime runs this far ahead of monotonic; each read advances time by
+// 25 ns, plus the pauses queued for particular reads (a preemption there).
+constexpr std::int64_t kRealtimeAheadNs = 1'700'000'000'000'000'000;
+
+struct Clocks {
+  std::int64_t monotonic_ns = 5'000'000'000;
+  std::vector<std::int64_t> pause_before_read_ns = {}; // by read, from the first
+  int reads = 0;
+
+  std::int64_t operator()(clockid_t clock) {
+    if (reads < int(pause_before_read_ns.size()))
+      monotonic_ns += pause_before_read_ns[std::size_t(reads)];
+    ++reads;
+    monotonic_ns += 25;
+    return clock == CLOCK_REALTIME ? monotonic_ns + kRealtimeAheadNs : monotonic_ns;
+  }
+};
+
+TEST(ReceiptTime, AnUntroubledReadingGivesTheOffsetToWithinItsBracket) {
+  Clocks clocks;
+  const ClockPair now = read_clock_pair(clocks);
+  EXPECT_EQ(clocks.reads, 3) << "a tight first bracket is kept";
+  EXPECT_LE(now.spread_ns, 50);
+  EXPECT_NEAR(double(now.realtime_ns - now.monotonic_ns), double(kRealtimeAheadNs),
+              now.spread_ns / 2.0);
+}
+
+TEST(ReceiptTime, APreemptionBetweenTwoReadsDoesNotMoveTheOffset) {
+  // 5 ms away between the monotonic read and the second realtime read of the
+  // first bracket: read naively (monotonic, then realtime), the offset would
+  // be 5 ms off, and a datagram's receipt 5 ms early.
+  Clocks clocks{.pause_before_read_ns = {0, 0, 5'000'000}};
+  const ClockPair now = read_clock_pair(clocks);
+  EXPECT_EQ(clocks.reads, 6) << "the wide bracket is read again";
+  EXPECT_LE(now.spread_ns, 50);
+  EXPECT_NEAR(double(now.realtime_ns - now.monotonic_ns), double(kRealtimeAheadNs),
+              now.spread_ns / 2.0);
+}
+
+TEST(ReceiptTime, ThreePreemptedBracketsKeepTheTightest) {
+  Clocks clocks{.pause_before_read_ns = {0, 0, 3'000'000, 0, 1'000'000, 0, 0, 0, 2'000'000}};
+  const ClockPair now = read_clock_pair(clocks);
+  EXPECT_EQ(clocks.reads, 9);
+  EXPECT_EQ(now.spread_ns, 1'000'050) << "the second bracket";
+}
+
+TEST(ReceiptTime, AStampMovesToTheMonotonicInstantItDescribes) {
+  Clocks clocks;
+  const std::int64_t queue_empty = clocks.monotonic_ns;
+  const std::int64_t sent = queue_empty + 1'000'000;
+  const std::int64_t stamp = sent + 2'000 + kRealtimeAheadNs; // the kernel, 2 us on
+  clocks.monotonic_ns = sent + 3'000'000;                     // read 3 ms after
+  const std::int64_t receipt = receipt_ns(stamp, read_clock_pair(clocks), queue_empty);
+  EXPECT_NEAR(double(receipt), double(sent + 2'000), 50.0);
+}
+
+TEST(ReceiptTime, ARealtimeStepWhileADatagramWaitsKeepsItsReceiptWhereItCanHaveBeen) {
+  const std::int64_t queue_empty = 5'000'000'000, sent = queue_empty + 1'000'000;
+  const std::int64_t stamp = sent + kRealtimeAheadNs;
+  for (const std::int64_t step_ns :
+       {std::int64_t{3'600'000'000'000}, -std::int64_t{60'000'000'000}}) {
+    // NTP steps the realtime clock after the kernel stamped the datagram.
+    Clocks clocks{.monotonic_ns = sent + 2'000'000};
+    const ClockPair now = read_clock_pair([&](clockid_t clock) {
+      const std::int64_t t = clocks(clock);
+      return clock == CLOCK_REALTIME ? t + step_ns : t;
+    });
+    const std::int64_t receipt = receipt_ns(stamp, now, queue_empty);
+    EXPECT_GE(receipt, queue_empty) << "step " << step_ns << " ns: not before the queue was empty";
+    EXPECT_LE(receipt, now.monotonic_ns) << "step " << step_ns << " ns: not after it was read";
+  }
+}
+
+TEST(ReceiptTime, ARealtimeStepInsideTheBracketIsNotAnOffset) {
+  // The clock ran backwards between a bracket's two reads in every try: no
+  // offset can be read, and the receipt is when the datagram was read.
+  std::int64_t t = 1'000'000'000;
+  int reads = 0;
+  const ClockPair now = read_clock_pair([&](clockid_t clock) {
+    t += 25;
+    return clock == CLOCK_REALTIME && reads++ % 2 == 1 ? t - 1'000'000'000 : t;
+  });
+  EXPECT_EQ(receipt_ns(t + 12345, now, 0), now.monotonic_ns);
+}
+
+} // namespace
+} // namespace camhead::hal::lens::detail
