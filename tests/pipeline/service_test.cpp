@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <thread>
@@ -23,6 +24,7 @@
 #include <unistd.h>
 
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/base/realtime_stamp.h"
 #include "camhead/renderer/gpu_tracer.h"
 #include "run/run_loop.h"
 #include "run_test_support.h"
@@ -85,15 +87,15 @@ public:
     const ssize_t n = ::recvmsg(fd_, &message, 0);
     if (n < 0)
       return std::nullopt;
-    // Sent this long before now, on the realtime clock the stamp is in.
-    std::int64_t sent_ns = base::monotonic_ns();
+    // When it was sent: the kernel's realtime stamp, on the monotonic clock.
+    const base::ClockPair now = base::read_clock_pair();
+    std::int64_t sent_ns = now.monotonic_ns;
     for (cmsghdr *c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c))
       if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
-        timespec stamp{}, now{};
+        timespec stamp{};
         std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
-        ::clock_gettime(CLOCK_REALTIME, &now);
-        sent_ns -= (std::int64_t(now.tv_sec) - stamp.tv_sec) * 1'000'000'000 +
-                   (now.tv_nsec - stamp.tv_nsec);
+        sent_ns = base::receipt_ns(std::int64_t(stamp.tv_sec) * 1'000'000'000 + stamp.tv_nsec, now,
+                                   std::numeric_limits<std::int64_t>::min());
       }
     return std::pair(std::string(buffer, std::size_t(n)), sent_ns);
   }

@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <ctime>
+#include <limits>
 #include <system_error>
 #include <utility>
+
+#include "camhead/base/realtime_stamp.h"
 
 namespace camhead::hal::lens::gpio::detail {
 namespace {
@@ -229,12 +232,8 @@ std::int64_t GpiodEdgeSource::to_monotonic_ns(const timespec &ts, std::int64_t n
     return stamp;
   }
   // Ahead of the monotonic clock: a kernel before 5.7 stamped CLOCK_REALTIME.
-  timespec real{}, mono{};
-  clock_gettime(CLOCK_REALTIME, &real);
-  clock_gettime(CLOCK_MONOTONIC, &mono);
-  const std::int64_t offset =
-      (real.tv_sec - mono.tv_sec) * kNanosPerSecond + (real.tv_nsec - mono.tv_nsec);
-  return stamp - offset;
+  // The edge came before it was read; how long before, only the stamp says.
+  return base::receipt_ns(stamp, base::read_clock_pair(), std::numeric_limits<std::int64_t>::min());
 }
 
 } // namespace camhead::hal::lens::gpio::detail

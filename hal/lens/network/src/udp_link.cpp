@@ -15,7 +15,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "receipt_time.h"
+#include "camhead/base/realtime_stamp.h"
 
 namespace camhead::hal::lens::detail {
 namespace {
@@ -194,8 +194,8 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
     }
 
     // Receipt time: the kernel's stamp, moved to CLOCK_MONOTONIC
-    // (receipt_time.h); now, for a datagram without one.
-    const ClockPair now = read_clock_pair();
+    // (realtime_stamp.h); now, for a datagram without one.
+    const base::ClockPair now = base::read_clock_pair();
     d.t_ns = now.monotonic_ns;
     for (cmsghdr *c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c)) {
       if (c->cmsg_level != SOL_SOCKET) {
@@ -204,8 +204,8 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
       if (c->cmsg_type == SCM_TIMESTAMPNS) {
         timespec stamp{};
         std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
-        d.t_ns = receipt_ns(std::int64_t{stamp.tv_sec} * 1'000'000'000 + stamp.tv_nsec, now,
-                            queue_empty_ns_);
+        d.t_ns = base::receipt_ns(std::int64_t{stamp.tv_sec} * 1'000'000'000 + stamp.tv_nsec, now,
+                                  queue_empty_ns_);
       } else if (c->cmsg_type == SO_RXQ_OVFL) {
         std::uint32_t counter = 0;
         std::memcpy(&counter, CMSG_DATA(c), sizeof counter);

@@ -1,21 +1,24 @@
-// When a datagram arrived, on CLOCK_MONOTONIC, from the kernel's receive
-// stamp, which a socket gives only on CLOCK_REALTIME (SO_TIMESTAMPNS).
+// A kernel stamp on CLOCK_REALTIME moved to CLOCK_MONOTONIC (monotonic_clock.h):
+// a socket stamps a datagram's receipt only on realtime (SO_TIMESTAMPNS), as
+// the GPIO character device did before Linux 5.7.
 //
 // The stamp is moved across by the two clocks' offset, read just after the
-// datagram was taken from the queue. Read naively, one clock then the other,
-// the offset is off by however long the thread was away between the two
-// reads. Under load on a 2-core VM that put 10 loopback datagrams in a
-// million up to 40 us before their own send, and once a tracker's first pose
-// before the tracker had started (a CI failure). So the offset is read
-// bracketed, realtime, monotonic, realtime, up to three times, and the
-// tightest bracket is kept: none of 800,000 datagrams came before its send.
+// stamp was taken (for a datagram: from the queue). Read naively, one clock
+// then the other, the offset is off by however long the thread was away
+// between the two reads. Under load on a 2-core VM that put 10 loopback
+// datagrams in a million up to 40 us before their own send, and once a
+// tracker's first pose before the tracker had started (a CI failure). So the
+// offset is read bracketed, realtime, monotonic, realtime, up to three
+// times, and the tightest bracket is kept: none of 800,000 datagrams came
+// before its send.
 //
 // And whatever the clocks do (a realtime step from NTP at a board's boot, a
-// bracket preempted three times), a receipt is kept where it can have been:
-// no earlier than the last time the queue was seen empty, no later than now.
+// bracket preempted three times), a datagram's receipt is kept where it can
+// have been: no earlier than the last time the queue was seen empty, no
+// later than now.
 //
-// Header-only and free of sockets, so that tests can drive it with their own
-// clocks.
+// Header-only; read_clock_pair takes the clock to read, so that tests can
+// drive it with their own. Any thread.
 #pragma once
 
 #include <algorithm>
@@ -23,7 +26,7 @@
 #include <ctime>
 #include <limits>
 
-namespace camhead::hal::lens::detail {
+namespace camhead::base {
 
 // One instant on both clocks: realtime_ns is good to within spread_ns / 2.
 struct ClockPair {
@@ -37,7 +40,7 @@ inline constexpr std::int64_t kTightBracketNs = 2'000;
 inline constexpr int kBracketTries = 3;
 
 // `read(clock)` reads a clock in nanoseconds (clock_gettime).
-template <typename ReadClock> ClockPair read_clock_pair(ReadClock &&read) {
+template <typename ReadClock> [[nodiscard]] ClockPair read_clock_pair(ReadClock &&read) {
   ClockPair best;
   for (int attempt = 0; attempt < kBracketTries && best.spread_ns > kTightBracketNs; ++attempt) {
     const std::int64_t before = read(CLOCK_REALTIME);
@@ -54,13 +57,13 @@ template <typename ReadClock> ClockPair read_clock_pair(ReadClock &&read) {
   return best;
 }
 
-inline std::int64_t read_clock_ns(clockid_t clock) {
+[[nodiscard]] inline std::int64_t read_clock_ns(clockid_t clock) {
   timespec ts{};
   ::clock_gettime(clock, &ts);
   return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
 }
 
-inline ClockPair read_clock_pair() {
+[[nodiscard]] inline ClockPair read_clock_pair() {
   return read_clock_pair(read_clock_ns);
 }
 
@@ -68,8 +71,8 @@ inline ClockPair read_clock_pair() {
 // kernel and taken from the queue just before `now` was read, when the queue
 // was last seen empty at `queue_empty_ns`: at `now` itself when no offset
 // could be read.
-inline std::int64_t receipt_ns(std::int64_t stamp_realtime_ns, const ClockPair &now,
-                               std::int64_t queue_empty_ns) {
+[[nodiscard]] inline std::int64_t receipt_ns(std::int64_t stamp_realtime_ns, const ClockPair &now,
+                                             std::int64_t queue_empty_ns) {
   if (now.spread_ns == std::numeric_limits<std::int64_t>::max()) {
     return now.monotonic_ns;
   }
@@ -77,4 +80,4 @@ inline std::int64_t receipt_ns(std::int64_t stamp_realtime_ns, const ClockPair &
   return std::clamp(moved, std::min(queue_empty_ns, now.monotonic_ns), now.monotonic_ns);
 }
 
-} // namespace camhead::hal::lens::detail
+} // namespace camhead::base

@@ -1,16 +1,16 @@
 // A datagram's receipt on CLOCK_MONOTONIC from the kernel's CLOCK_REALTIME
-// stamp (receipt_time.h), with clocks the test drives: a thread preempted
+// stamp (realtime_stamp.h), with clocks the test drives: a thread preempted
 // between two clock reads, and a realtime clock stepped while a datagram
 // waits in the queue, must not put a receipt before the datagram was sent.
 #include <cstdint>
 #include <ctime>
 #include <vector>
 
-#include "receipt_time.h"
+#include "camhead/base/realtime_stamp.h"
 
 #include <gtest/gtest.h>
 
-namespace camhead::hal::lens::detail {
+namespace camhead::base {
 namespace {
 
 // Realtime runs this far ahead of monotonic; each read advances time by
@@ -31,7 +31,7 @@ struct Clocks {
   }
 };
 
-TEST(ReceiptTime, AnUntroubledReadingGivesTheOffsetToWithinItsBracket) {
+TEST(RealtimeStamp, AnUntroubledReadingGivesTheOffsetToWithinItsBracket) {
   Clocks clocks;
   const ClockPair now = read_clock_pair(clocks);
   EXPECT_EQ(clocks.reads, 3) << "a tight first bracket is kept";
@@ -40,7 +40,7 @@ TEST(ReceiptTime, AnUntroubledReadingGivesTheOffsetToWithinItsBracket) {
               now.spread_ns / 2.0);
 }
 
-TEST(ReceiptTime, APreemptionBetweenTwoReadsDoesNotMoveTheOffset) {
+TEST(RealtimeStamp, APreemptionBetweenTwoReadsDoesNotMoveTheOffset) {
   // 5 ms away between the monotonic read and the second realtime read of the
   // first bracket: read naively (monotonic, then realtime), the offset would
   // be 5 ms off, and a datagram's receipt 5 ms early.
@@ -52,14 +52,14 @@ TEST(ReceiptTime, APreemptionBetweenTwoReadsDoesNotMoveTheOffset) {
               now.spread_ns / 2.0);
 }
 
-TEST(ReceiptTime, ThreePreemptedBracketsKeepTheTightest) {
+TEST(RealtimeStamp, ThreePreemptedBracketsKeepTheTightest) {
   Clocks clocks{.pause_before_read_ns = {0, 0, 3'000'000, 0, 1'000'000, 0, 0, 0, 2'000'000}};
   const ClockPair now = read_clock_pair(clocks);
   EXPECT_EQ(clocks.reads, 9);
   EXPECT_EQ(now.spread_ns, 1'000'050) << "the second bracket";
 }
 
-TEST(ReceiptTime, AStampMovesToTheMonotonicInstantItDescribes) {
+TEST(RealtimeStamp, AStampMovesToTheMonotonicInstantItDescribes) {
   Clocks clocks;
   const std::int64_t queue_empty = clocks.monotonic_ns;
   const std::int64_t sent = queue_empty + 1'000'000;
@@ -69,7 +69,7 @@ TEST(ReceiptTime, AStampMovesToTheMonotonicInstantItDescribes) {
   EXPECT_NEAR(double(receipt), double(sent + 2'000), 50.0);
 }
 
-TEST(ReceiptTime, ARealtimeStepWhileADatagramWaitsKeepsItsReceiptWhereItCanHaveBeen) {
+TEST(RealtimeStamp, ARealtimeStepWhileADatagramWaitsKeepsItsReceiptWhereItCanHaveBeen) {
   const std::int64_t queue_empty = 5'000'000'000, sent = queue_empty + 1'000'000;
   const std::int64_t stamp = sent + kRealtimeAheadNs;
   for (const std::int64_t step_ns :
@@ -86,7 +86,7 @@ TEST(ReceiptTime, ARealtimeStepWhileADatagramWaitsKeepsItsReceiptWhereItCanHaveB
   }
 }
 
-TEST(ReceiptTime, ARealtimeStepInsideTheBracketIsNotAnOffset) {
+TEST(RealtimeStamp, ARealtimeStepInsideTheBracketIsNotAnOffset) {
   // The clock ran backwards between a bracket's two reads in every try: no
   // offset can be read, and the receipt is when the datagram was read.
   std::int64_t t = 1'000'000'000;
@@ -99,4 +99,4 @@ TEST(ReceiptTime, ARealtimeStepInsideTheBracketIsNotAnOffset) {
 }
 
 } // namespace
-} // namespace camhead::hal::lens::detail
+} // namespace camhead::base
