@@ -114,7 +114,9 @@ TEST(FileCameraTiming, RealtimeKeepsTheRateAndNeverBlocksPastTheTimeout) {
 
   ASSERT_EQ(camera->wait_frame(milliseconds(1000), second), CaptureResult::frame);
   EXPECT_EQ(second.sequence, 1u);
-  EXPECT_GE(second.timestamp_ns - first.timestamp_ns, 90'000'000);
+  // Stamped on the schedule, however late this thread woke: one interval
+  // apart, or more only where the schedule restarted (a frame behind).
+  EXPECT_GE(second.timestamp_ns - first.timestamp_ns, 100'000'000);
   EXPECT_LT(second.timestamp_ns - first.timestamp_ns, 250'000'000);
   camera->release(first);
   camera->release(second);

@@ -89,7 +89,7 @@ private:
   std::optional<std::int64_t> retry_at_ns_;
   bool started_ = false;         // a frame was delivered
   bool scheduled_ = false;       // realtime: next_due_ns_ is set
-  std::int64_t first_ns_ = 0;    // the first frame's stamp
+  std::int64_t first_ns_ = 0;    // offline: the first frame's stamp
   std::int64_t next_due_ns_ = 0; // realtime: when the next frame goes out
   std::uint64_t sequence_ = 0;
   std::uint64_t frames_in_pass_ = 0;
@@ -143,18 +143,18 @@ CaptureResult FileCamera::next_frame(std::chrono::milliseconds timeout, Captured
   // Read first, then wait: the frame leaves when it is due, not a decode later.
   if (realtime_)
     sleep_until(next_due_ns_);
-  const std::int64_t now = base::monotonic_ns();
   if (!started_) {
     started_ = true;
-    first_ns_ = now;
+    first_ns_ = base::monotonic_ns();
   }
   out.format = format_;
   out.bytes = ring_.bytes(index);
   out.sequence = sequence_;
-  // In real time a frame is delivered as its exposure ends, as a camera's;
-  // offline, on an exact clock from the first.
+  // In real time a frame is delivered as its exposure ends, as a camera's,
+  // stamped when that was due (a late wake-up is delivery latency, not a
+  // later exposure); offline, on an exact clock from the first.
   out.timestamp_ns =
-      realtime_ ? now : first_ns_ + static_cast<std::int64_t>(sequence_) * interval_ns_;
+      realtime_ ? next_due_ns_ : first_ns_ + static_cast<std::int64_t>(sequence_) * interval_ns_;
   out.mark = realtime_ ? TimestampMark::end_of_frame : TimestampMark::start_of_exposure;
   out.exposure_ns = interval_ns_;
   out.buffer = index;

@@ -28,9 +28,10 @@
 // for PNGs. With `realtime`, frame 0 is delivered one interval after the
 // first wait_frame() (and after a retry), frame i+1 one interval after frame
 // i was due, as a camera delivers a frame once its exposure is over: stamped
-// with CLOCK_MONOTONIC when it is delivered, as the end of an exposure of a
-// whole interval (mark end_of_frame), so that its mid-exposure is half a
-// frame in the past, as the lens chain has it. A consumer more than a frame
+// with CLOCK_MONOTONIC when it was due, as the end of an exposure of a whole
+// interval (mark end_of_frame), so that its mid-exposure is half a frame in
+// the past, as the lens chain has it. The stamps keep the schedule, as a
+// sensor's clock does, however late the capture thread wakes to deliver. A consumer more than a frame
 // behind restarts the schedule rather than getting a burst (a file never
 // drops frames). Without `realtime`, frames come as fast as they are asked
 // for and stamps are the first delivery's time plus exactly sequence *
