@@ -67,17 +67,17 @@ template <typename ReadClock> [[nodiscard]] ClockPair read_clock_pair(ReadClock 
   return read_clock_pair(read_clock_ns);
 }
 
-// The monotonic instant of a datagram stamped `stamp_realtime_ns` by the
-// kernel and taken from the queue just before `now` was read, when the queue
-// was last seen empty at `queue_empty_ns`: at `now` itself when no offset
-// could be read.
+// The monotonic instant of a kernel stamp `stamp_realtime_ns` taken before
+// `now` was read and no earlier than `earliest_ns` (for a datagram: when its
+// socket's queue was last seen empty); `now` itself when no offset could be
+// read.
 [[nodiscard]] inline std::int64_t receipt_ns(std::int64_t stamp_realtime_ns, const ClockPair &now,
-                                             std::int64_t queue_empty_ns) {
+                                             std::int64_t earliest_ns) {
   if (now.spread_ns == std::numeric_limits<std::int64_t>::max()) {
     return now.monotonic_ns;
   }
   const std::int64_t moved = stamp_realtime_ns + (now.monotonic_ns - now.realtime_ns);
-  return std::clamp(moved, std::min(queue_empty_ns, now.monotonic_ns), now.monotonic_ns);
+  return std::clamp(moved, std::min(earliest_ns, now.monotonic_ns), now.monotonic_ns);
 }
 
 } // namespace camhead::base
