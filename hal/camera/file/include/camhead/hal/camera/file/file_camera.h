@@ -33,9 +33,10 @@
 // the past, as the lens chain has it. The stamps keep the schedule, as a
 // sensor's clock does, however late the capture thread wakes to deliver. A
 // consumer more than a frame behind restarts the schedule rather than
-// getting a burst (a file never drops frames). Without `realtime`, frames come as fast as they are asked
-// for and stamps are the first delivery's time plus exactly sequence *
-// interval (mark start_of_exposure), so that offline runs are reproducible.
+// getting a burst (a file never drops frames). Without `realtime`, frames
+// come as fast as they are asked for and stamps are the first delivery's
+// time plus exactly sequence * interval (mark start_of_exposure), so that
+// offline runs are reproducible.
 // sequence counts every delivered frame from 0, across loops.
 //
 // Buffers: three, allocated at open. A caller holding all three gets
