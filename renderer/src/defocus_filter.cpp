@@ -10,8 +10,14 @@
 namespace camhead::renderer::cpu {
 namespace rules {
 namespace {
-using namespace glm; // GLSL's built-ins, unqualified
-using std::abs;      // fabs, as GLSL's; found before glm's x >= 0 ? x : -x
+// GLSL's types and built-ins, unqualified and named one by one, so that no
+// function of these namespaces can hide them.
+using glm::ceil;
+using glm::max;
+using glm::min;
+using glm::sqrt;
+using glm::vec4;
+using std::abs; // fabs, as GLSL's; found before glm's x >= 0 ? x : -x
 #define CUBE_ROOT(x) std::cbrt(x)
 #include "reconstruct_rules.glsl"
 #undef CUBE_ROOT

@@ -95,7 +95,7 @@ public:
         timespec stamp{};
         std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
         sent_ns = base::receipt_ns(std::int64_t(stamp.tv_sec) * 1'000'000'000 + stamp.tv_nsec, now,
-                                   std::numeric_limits<std::int64_t>::min());
+                                   std::numeric_limits<std::int64_t>::min(), now.monotonic_ns);
       }
     return std::pair(std::string(buffer, std::size_t(n)), sent_ns);
   }

@@ -116,11 +116,14 @@ TEST(FileCameraTiming, RealtimeKeepsTheRateAndNeverBlocksPastTheTimeout) {
   ASSERT_EQ(camera->wait_frame(milliseconds(1000), second), CaptureResult::frame);
   EXPECT_EQ(second.sequence, 1u);
   // Stamped on the schedule, however late the camera's thread woke: exactly
-  // one interval apart. Only a consumer over a frame behind restarts it.
-  if (asked < first.timestamp_ns + 200'000'000)
-    EXPECT_EQ(second.timestamp_ns - first.timestamp_ns, 100'000'000);
-  else
+  // one interval apart. Only a call over a frame behind restarts the
+  // schedule, from that call (the camera judges by its own clock, so the
+  // test by the outcome).
+  const std::int64_t apart = second.timestamp_ns - first.timestamp_ns;
+  if (apart != 100'000'000) {
+    EXPECT_GT(apart, 200'000'000) << "neither on the schedule nor restarted";
     EXPECT_GE(second.timestamp_ns, asked) << "the schedule restarts from the late call";
+  }
   camera->release(first);
   camera->release(second);
 }

@@ -2,20 +2,21 @@
 // a socket stamps a datagram's receipt only on realtime (SO_TIMESTAMPNS), as
 // the GPIO character device did before Linux 5.7.
 //
-// The stamp is moved across by the two clocks' offset, read just after the
-// stamp was taken (for a datagram: from the queue). Read naively, one clock
-// then the other, the offset is off by however long the thread was away
-// between the two reads. Under load on a 2-core VM that put 10 loopback
-// datagrams in a million up to 40 us before their own send, and once a
-// tracker's first pose before the tracker had started (a CI failure). So the
-// offset is read bracketed, realtime, monotonic, realtime, up to three
-// times, and the tightest bracket is kept: none of 800,000 datagrams came
-// before its send.
+// The stamp is moved across by the two clocks' offset, read after the stamp
+// was taken; one reading serves a batch of stamps (a drained socket queue,
+// a GPIO read), which keeps their order and costs a few clock reads a batch,
+// not a datagram. Read naively, one clock then the other, the offset is off
+// by however long the thread was away between the two reads. Under load on
+// a 2-core VM that put 10 loopback datagrams in a million up to 40 us
+// before their own send, and once a tracker's first pose before the tracker
+// had started (a CI failure). So the offset is read bracketed, realtime,
+// monotonic, realtime, up to three times, and the tightest bracket is kept:
+// none of 800,000 datagrams came before its send.
 //
 // And whatever the clocks do (a realtime step from NTP at a board's boot, a
-// bracket preempted three times), a datagram's receipt is kept where it can
-// have been: no earlier than the last time the queue was seen empty, no
-// later than now.
+// bracket preempted three times), receipt_ns keeps a stamp within the bounds
+// its caller knows (for a datagram: not before its socket's queue was last
+// seen empty, not after it was read).
 //
 // Header-only; read_clock_pair takes the clock to read, so that tests can
 // drive it with their own. Any thread.
@@ -33,6 +34,13 @@ struct ClockPair {
   std::int64_t monotonic_ns = 0;
   std::int64_t realtime_ns = 0;
   std::int64_t spread_ns = std::numeric_limits<std::int64_t>::max();
+
+  // Whether an offset was read (a realtime step inside every bracket: not).
+  [[nodiscard]] bool known() const { return spread_ns != std::numeric_limits<std::int64_t>::max(); }
+  // A realtime stamp moved by this pair's offset.
+  [[nodiscard]] std::int64_t monotonic_of(std::int64_t stamp_realtime_ns) const {
+    return stamp_realtime_ns + (monotonic_ns - realtime_ns);
+  }
 };
 
 // A bracket this tight was not preempted: two clock reads take about 50 ns.
@@ -51,8 +59,8 @@ template <typename ReadClock> [[nodiscard]] ClockPair read_clock_pair(ReadClock 
       best = {monotonic, before + (after - before) / 2, after - before};
     }
   }
-  if (best.spread_ns == std::numeric_limits<std::int64_t>::max()) {
-    best.monotonic_ns = read(CLOCK_MONOTONIC); // no offset known: see receipt_ns
+  if (!best.known()) {
+    best.monotonic_ns = read(CLOCK_MONOTONIC); // the instant, without an offset
   }
   return best;
 }
@@ -67,17 +75,17 @@ template <typename ReadClock> [[nodiscard]] ClockPair read_clock_pair(ReadClock 
   return read_clock_pair(read_clock_ns);
 }
 
-// The monotonic instant of a kernel stamp `stamp_realtime_ns` taken before
-// `now` was read and no earlier than `earliest_ns` (for a datagram: when its
-// socket's queue was last seen empty); `now` itself when no offset could be
-// read.
-[[nodiscard]] inline std::int64_t receipt_ns(std::int64_t stamp_realtime_ns, const ClockPair &now,
-                                             std::int64_t earliest_ns) {
-  if (now.spread_ns == std::numeric_limits<std::int64_t>::max()) {
-    return now.monotonic_ns;
+// The monotonic instant of a kernel stamp `stamp_realtime_ns` that was taken
+// in [earliest_ns, latest_ns], moved by `clocks` (read after it): kept in
+// those bounds, and `latest_ns` when no offset could be read.
+[[nodiscard]] inline std::int64_t receipt_ns(std::int64_t stamp_realtime_ns,
+                                             const ClockPair &clocks, std::int64_t earliest_ns,
+                                             std::int64_t latest_ns) {
+  if (!clocks.known()) {
+    return latest_ns;
   }
-  const std::int64_t moved = stamp_realtime_ns + (now.monotonic_ns - now.realtime_ns);
-  return std::clamp(moved, std::min(earliest_ns, now.monotonic_ns), now.monotonic_ns);
+  return std::clamp(clocks.monotonic_of(stamp_realtime_ns), std::min(earliest_ns, latest_ns),
+                    latest_ns);
 }
 
 } // namespace camhead::base

@@ -5,11 +5,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <ctime>
-#include <limits>
+#include <optional>
 #include <system_error>
 #include <utility>
-
-#include "camhead/base/realtime_stamp.h"
 
 namespace camhead::hal::lens::gpio::detail {
 namespace {
@@ -202,6 +200,7 @@ bool GpiodEdgeSource::wait_edges(std::chrono::milliseconds timeout, std::vector<
 bool GpiodEdgeSource::read_ready(gpiod_line_bulk &ready, std::vector<EdgeEvent> &out,
                                  std::string &error) {
   const std::int64_t now_ns = monotonic_ns();
+  std::optional<base::ClockPair> clocks;
   for (unsigned i = 0; i < gpiod_line_bulk_num_lines(&ready); ++i) {
     gpiod_line *line = gpiod_line_bulk_get_line(&ready, i);
     const auto it = std::find(lines_.begin(), lines_.end(), line);
@@ -219,21 +218,24 @@ bool GpiodEdgeSource::read_ready(gpiod_line_bulk &ready, std::vector<EdgeEvent> 
     }
     for (int k = 0; k < n; ++k) {
       const gpiod_line_event &e = buffer_[static_cast<std::size_t>(k)];
-      out.push_back(EdgeEvent{to_monotonic_ns(e.ts, now_ns), role.axis, role.line,
+      out.push_back(EdgeEvent{to_monotonic_ns(e.ts, now_ns, clocks), role.axis, role.line,
                               e.event_type == GPIOD_LINE_EVENT_RISING_EDGE});
     }
   }
   return true;
 }
 
-std::int64_t GpiodEdgeSource::to_monotonic_ns(const timespec &ts, std::int64_t now_ns) {
+std::int64_t GpiodEdgeSource::to_monotonic_ns(const timespec &ts, std::int64_t now_ns,
+                                              std::optional<base::ClockPair> &clocks) {
   const std::int64_t stamp = static_cast<std::int64_t>(ts.tv_sec) * kNanosPerSecond + ts.tv_nsec;
   if (stamp <= now_ns + kNanosPerSecond) {
     return stamp;
   }
   // Ahead of the monotonic clock: a kernel before 5.7 stamped CLOCK_REALTIME.
-  // The edge came before it was read; how long before, only the stamp says.
-  return base::receipt_ns(stamp, base::read_clock_pair(), std::numeric_limits<std::int64_t>::min());
+  if (!clocks) {
+    clocks = base::read_clock_pair();
+  }
+  return clocks->known() ? clocks->monotonic_of(stamp) : clocks->monotonic_ns;
 }
 
 } // namespace camhead::hal::lens::gpio::detail

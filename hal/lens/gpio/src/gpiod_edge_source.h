@@ -13,9 +13,11 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "camhead/base/realtime_stamp.h"
 #include "camhead/hal/lens/gpio/edge_source.h"
 #include "camhead/hal/lens/gpio/gpio_quadrature.h"
 #include "gpiod_library.h"
@@ -57,7 +59,11 @@ private:
   [[nodiscard]] bool read_ready(gpiod_line_bulk &ready, std::vector<EdgeEvent> &out,
                                 std::string &error);
   // The kernel's stamp in CLOCK_MONOTONIC ns; `now_ns` is that clock now.
-  [[nodiscard]] static std::int64_t to_monotonic_ns(const timespec &ts, std::int64_t now_ns);
+  // A realtime stamp (kernels before 5.7) is moved by `clocks`, read at the
+  // batch's first such stamp and kept for the rest, so that one offset
+  // moves them all and their order holds.
+  [[nodiscard]] static std::int64_t to_monotonic_ns(const timespec &ts, std::int64_t now_ns,
+                                                    std::optional<base::ClockPair> &clocks);
 
   std::string chip_descr_;
   std::string consumer_;

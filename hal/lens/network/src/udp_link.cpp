@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <ctime>
+#include <optional>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -167,6 +168,8 @@ void UdpLink::poll(std::chrono::milliseconds timeout, const DatagramHandler &han
 UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
   Drained drained;
   std::string why;
+  // The clocks' offset for this burst's stamps, read after the first.
+  std::optional<base::ClockPair> clocks;
   for (int n = 0; n < kMaxBurst; ++n) {
     iovec io{buffer_.data(), buffer_.size()};
     alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t))];
@@ -195,8 +198,8 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
 
     // Receipt time: the kernel's stamp, moved to CLOCK_MONOTONIC
     // (realtime_stamp.h); now, for a datagram without one.
-    const base::ClockPair now = base::read_clock_pair();
-    d.t_ns = now.monotonic_ns;
+    const std::int64_t now = monotonic_ns();
+    d.t_ns = now;
     for (cmsghdr *c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c)) {
       if (c->cmsg_level != SOL_SOCKET) {
         continue;
@@ -204,8 +207,11 @@ UdpLink::Drained UdpLink::receive_all(const DatagramHandler &handle) {
       if (c->cmsg_type == SCM_TIMESTAMPNS) {
         timespec stamp{};
         std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
-        d.t_ns = base::receipt_ns(std::int64_t{stamp.tv_sec} * 1'000'000'000 + stamp.tv_nsec, now,
-                                  queue_empty_ns_);
+        if (!clocks) {
+          clocks = base::read_clock_pair();
+        }
+        d.t_ns = base::receipt_ns(std::int64_t{stamp.tv_sec} * 1'000'000'000 + stamp.tv_nsec,
+                                  *clocks, queue_empty_ns_, now);
       } else if (c->cmsg_type == SO_RXQ_OVFL) {
         std::uint32_t counter = 0;
         std::memcpy(&counter, CMSG_DATA(c), sizeof counter);

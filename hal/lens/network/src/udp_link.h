@@ -138,8 +138,10 @@ private:
   std::string name_;
   std::uint16_t port_ = 0;
   std::int64_t window_ns_ = 0;
-  // When the socket's queue was last seen empty: every datagram in it now
-  // was stamped after this (CLOCK_MONOTONIC).
+  // When the socket's queue was last seen empty (CLOCK_MONOTONIC): every
+  // datagram in it now was queued after this. The kernel stamps a datagram
+  // as it arrives, a softirq's backlog (microseconds) before it is queued,
+  // so a receipt kept no earlier than this is at most that late, never early.
   std::int64_t queue_empty_ns_ = 0;
   std::vector<std::uint8_t> buffer_;
 

@@ -31,9 +31,9 @@
 // with CLOCK_MONOTONIC when it was due, as the end of an exposure of a whole
 // interval (mark end_of_frame), so that its mid-exposure is half a frame in
 // the past, as the lens chain has it. The stamps keep the schedule, as a
-// sensor's clock does, however late the capture thread wakes to deliver. A
-// consumer more than a frame behind restarts the schedule rather than
-// getting a burst (a file never drops frames). Without `realtime`, frames
+// sensor's clock does, when the capture thread wakes late to deliver; a
+// consumer more than a frame behind restarts the schedule from its call
+// rather than getting a burst (a file never drops frames). Without `realtime`, frames
 // come as fast as they are asked for and stamps are the first delivery's
 // time plus exactly sequence * interval (mark start_of_exposure), so that
 // offline runs are reproducible.
