@@ -35,7 +35,10 @@ def write_board(scratch, source, name="web", width=192, height=144, http=None):
 
 
 class Run:
-    """`camhead run` with its page; stopped (SIGINT) on exit."""
+    """`camhead run` with its page; stopped (SIGINT) on exit.
+
+    Give it no --duration: a run that ended on the clock while a loaded
+    machine was still working through the steps would fail them."""
 
     def __init__(self, camhead, board, *extra, stats=None):
         args = [camhead, "run", "--board", board, "--threads", "1", *extra]

@@ -103,7 +103,7 @@ board = web_rig.write_board(scratch, source)
 y4m = os.path.join(scratch, "web.y4m")
 stats = os.path.join(scratch, "web_stats.jsonl")
 with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--output", "file:" + y4m,
-                 "--duration", "40", stats=stats) as run:
+                 stats=stats) as run:
     run.wait_frames(10)
     state = run.state()
     seen_frame = state["frame"]
@@ -322,8 +322,7 @@ check(readable.returncode == 2 and "chmod 600" in readable.stderr,
 
 good = web_rig.basic("operator", "correct horse")
 bad = web_rig.basic("operator", "wrong horse")
-with web_rig.Run(camhead, board, "--http", "0.0.0.0:0", "--http-password", password_file,
-                 "--duration", "60") as run:
+with web_rig.Run(camhead, board, "--http", "0.0.0.0:0", "--http-password", password_file) as run:
     run.host = "127.0.0.1"
     endpoints = ["/", "/app.js", "/api/state", "/api/history", "/api/events", "/metrics",
                  "/stream.mjpeg", "/snapshot.jpg", "/nothing"]
@@ -382,7 +381,7 @@ with web_rig.Run(camhead, board, "--http", "0.0.0.0:0", "--http-password", passw
 
 # -- 6: calibration views ------------------------------------------------------
 # The loopback rig has no marker board: a view is saved unchecked.
-with web_rig.Run(camhead, board, "--http", "127.0.0.1:0", "--duration", "30") as run:
+with web_rig.Run(camhead, board, "--http", "127.0.0.1:0") as run:
     run.wait_frames(3)
     status, _, body = run.get("/api/view", {"Content-Type": "application/json"}, method="POST",
                               body="{}")
@@ -422,7 +421,7 @@ if markers:
         json.dump(moving, f)
     shutil.rmtree(os.path.join(scratch, "recordings", "camera-views"), ignore_errors=True)
     views = []
-    with web_rig.Run(camhead, moving_board, "--http", "127.0.0.1:0", "--duration", "60") as run:
+    with web_rig.Run(camhead, moving_board, "--http", "127.0.0.1:0") as run:
         run.wait_frames(2)
         for _ in range(6):
             # 503: no camera frame came within its wait (a sanitizer build
