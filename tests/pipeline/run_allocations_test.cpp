@@ -57,13 +57,28 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The lines of `file` that contain `text` (all of them for "").
-std::size_t lines_in(const fs::path &file, const std::string &text = "") {
+std::size_t lines_in(const fs::path &file) {
   std::ifstream in(file);
   std::size_t n = 0;
   for (std::string line; std::getline(in, line);)
-    n += line.find(text) != std::string::npos ? 1 : 0;
+    ++n;
   return n;
+}
+
+// What a run's record holds so far: its records, those with the pose
+// fresh, and those of a reload's setup.
+struct RecordSoFar {
+  std::size_t records = 0, pose_fresh = 0, reloaded = 0;
+};
+RecordSoFar record_so_far(const fs::path &file) {
+  std::ifstream in(file);
+  RecordSoFar so_far;
+  for (std::string line; std::getline(in, line);) {
+    ++so_far.records;
+    so_far.pose_fresh += line.find("\"pose_fresh\":true") != std::string::npos ? 1 : 0;
+    so_far.reloaded += line.find("\"setup\":1,") != std::string::npos ? 1 : 0;
+  }
+  return so_far;
 }
 
 class RunAllocations : public RunLoop {
@@ -144,9 +159,9 @@ protected:
         const fs::path record = dir_ / "stats.jsonl";
         while (!ended && !stop_now) {
           std::this_thread::sleep_for(std::chrono::milliseconds(10));
-          stop_now = lines_in(record) >= 40 &&
-                     (!tracked || lines_in(record, "\"pose_fresh\":true") >= 31) &&
-                     (!reload || lines_in(record, "\"setup\":1,") >= 10);
+          const RecordSoFar so_far = record_so_far(record);
+          stop_now = so_far.records >= 40 && (!tracked || so_far.pose_fresh >= 31) &&
+                     (!reload || so_far.reloaded >= 10);
         }
       });
     std::atomic<std::uint64_t> preview_parts{0};
@@ -171,16 +186,12 @@ protected:
       reprojected += record.reprojected_samples;
       tracked_frames += record.pose_fresh ? 1 : 0;
     }
-    std::uint64_t reloaded_frames = 0;
-    std::ifstream stats(dir_ / "stats.jsonl");
-    for (std::string line; std::getline(stats, line);)
-      reloaded_frames += line.find("\"setup\":1,") != std::string::npos ? 1 : 0;
     return {test::counting_new::count(kRender),
             test::counting_new::count(kOutput),
             summary.frames_out,
             reprojected,
             tracked_frames,
-            reloaded_frames,
+            record_so_far(dir_ / "stats.jsonl").reloaded,
             preview_parts};
   }
 

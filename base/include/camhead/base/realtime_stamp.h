@@ -1,6 +1,7 @@
 // A kernel stamp on CLOCK_REALTIME moved to CLOCK_MONOTONIC (monotonic_clock.h):
 // a socket stamps a datagram's receipt only on realtime (SO_TIMESTAMPNS), as
-// the GPIO character device did before Linux 5.7.
+// the GPIO character device did before Linux 5.7 and as some V4L2 drivers
+// stamp their buffers.
 //
 // The stamp is moved across by the two clocks' offset, read after the stamp
 // was taken; one reading serves a batch of stamps (a drained socket queue,

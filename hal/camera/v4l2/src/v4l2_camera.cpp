@@ -20,6 +20,7 @@
 
 #include "buffer_timestamp.h"
 #include "camhead/base/monotonic_clock.h"
+#include "camhead/base/realtime_stamp.h"
 #include "camhead/hal/camera/frame_sequence.h"
 #include "camhead/hal/v4l2/reconnect_schedule.h"
 #include "capture_stream.h"
@@ -34,12 +35,6 @@ using v4l2::errno_text;
 constexpr int kIndexBits = 5;
 constexpr std::uint32_t kGenerations = 1u << 20;
 constexpr std::int64_t kExposureReadIntervalNs = 500'000'000;
-
-std::int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
 
 void sleep_until(std::int64_t t_ns) {
   const timespec until{static_cast<time_t>(t_ns / 1'000'000'000),
@@ -174,11 +169,15 @@ CaptureResult V4l2Camera::wait_frame(std::chrono::milliseconds timeout, Captured
       }
       continue;
     }
-    const std::int64_t now = base::monotonic_ns();
+    // Both clocks at one instant (realtime_stamp.h): a driver's wall-clock
+    // stamp is moved by their offset. Without one (a realtime step in every
+    // bracket), realtime_ns is 0, and such a stamp is judged on no clock.
+    const base::ClockPair clocks = base::read_clock_pair();
+    const std::int64_t now = clocks.monotonic_ns;
     const BufferStamp stamp = buffer_stamp(buffer.flags,
                                            std::int64_t{buffer.timestamp.tv_sec} * 1'000'000'000 +
                                                std::int64_t{buffer.timestamp.tv_usec} * 1'000,
-                                           now, realtime_ns());
+                                           now, clocks.realtime_ns);
     const FrameSequence::Step step = sequence_.next(buffer.sequence);
     stream.hold(index, step.sequence);
     status_.dropped += step.dropped;
