@@ -12,7 +12,10 @@
 // before their own send, and once a tracker's first pose before the tracker
 // had started (a CI failure). So the offset is read bracketed, realtime,
 // monotonic, realtime, up to three times, and the tightest bracket is kept:
-// none of 800,000 datagrams came before its send.
+// none of 800,000 datagrams came before its send. The realtime of the
+// monotonic read is taken as the bracket's first read, the earliest it can
+// have been, so that a moved stamp is never early, and late by no more
+// than the bracket (a midpoint could be early by half of it).
 //
 // And whatever the clocks do (a realtime step from NTP at a board's boot, a
 // bracket preempted three times), receipt_ns keeps a stamp within the bounds
@@ -30,7 +33,8 @@
 
 namespace camhead::base {
 
-// One instant on both clocks: realtime_ns is good to within spread_ns / 2.
+// One instant on both clocks: realtime_ns is the earliest the realtime clock
+// can have read at monotonic_ns; the truth is within spread_ns after it.
 struct ClockPair {
   std::int64_t monotonic_ns = 0;
   std::int64_t realtime_ns = 0;
@@ -38,7 +42,8 @@ struct ClockPair {
 
   // Whether an offset was read (a realtime step inside every bracket: not).
   [[nodiscard]] bool known() const { return spread_ns != std::numeric_limits<std::int64_t>::max(); }
-  // A realtime stamp moved by this pair's offset.
+  // A realtime stamp moved by this pair's offset: never before the instant
+  // it describes, and at most spread_ns after.
   [[nodiscard]] std::int64_t monotonic_of(std::int64_t stamp_realtime_ns) const {
     return stamp_realtime_ns + (monotonic_ns - realtime_ns);
   }
@@ -57,7 +62,7 @@ template <typename ReadClock> [[nodiscard]] ClockPair read_clock_pair(ReadClock 
     const std::int64_t after = read(CLOCK_REALTIME);
     // A realtime clock that ran backwards was stepped: no offset to read there.
     if (after >= before && after - before < best.spread_ns) {
-      best = {monotonic, before + (after - before) / 2, after - before};
+      best = {monotonic, before, after - before};
     }
   }
   if (!best.known()) {
