@@ -179,8 +179,12 @@ bool GpiodEdgeSource::wait_edges(std::chrono::milliseconds timeout, std::vector<
   gpiod_line_bulk ready;
   int rv = gpiod().line_event_wait_bulk(&all, &wait, &ready);
   bool ok = true;
+  // One offset for every round's realtime stamps (kernels before 5.7): they
+  // are sorted together below, and two offsets could swap an A edge and a B
+  // edge read in different rounds.
+  std::optional<base::ClockPair> clocks;
   for (int round = 0; rv > 0 && ok && round < kMaxDrainRounds; ++round) {
-    ok = read_ready(ready, out, error);
+    ok = read_ready(ready, clocks, out, error);
     if (ok) {
       const timespec zero{};
       rv = gpiod().line_event_wait_bulk(&all, &zero, &ready);
@@ -197,10 +201,9 @@ bool GpiodEdgeSource::wait_edges(std::chrono::milliseconds timeout, std::vector<
   return ok;
 }
 
-bool GpiodEdgeSource::read_ready(gpiod_line_bulk &ready, std::vector<EdgeEvent> &out,
-                                 std::string &error) {
+bool GpiodEdgeSource::read_ready(gpiod_line_bulk &ready, std::optional<base::ClockPair> &clocks,
+                                 std::vector<EdgeEvent> &out, std::string &error) {
   const std::int64_t now_ns = monotonic_ns();
-  std::optional<base::ClockPair> clocks;
   for (unsigned i = 0; i < gpiod_line_bulk_num_lines(&ready); ++i) {
     gpiod_line *line = gpiod_line_bulk_get_line(&ready, i);
     const auto it = std::find(lines_.begin(), lines_.end(), line);

@@ -56,12 +56,14 @@ private:
   // "gpio gpiochip0 line 17 (focus A)"; with a label as descriptor,
   // "gpio my-label (gpiochip3) line 17 (focus A)".
   [[nodiscard]] std::string line_name(const LineRole &role) const;
-  [[nodiscard]] bool read_ready(gpiod_line_bulk &ready, std::vector<EdgeEvent> &out,
-                                std::string &error);
+  // The events of the lines `ready`, their realtime stamps moved by
+  // `clocks` (read at the first such stamp of the wait_edges() call).
+  [[nodiscard]] bool read_ready(gpiod_line_bulk &ready, std::optional<base::ClockPair> &clocks,
+                                std::vector<EdgeEvent> &out, std::string &error);
   // The kernel's stamp in CLOCK_MONOTONIC ns; `now_ns` is that clock now.
   // A realtime stamp (kernels before 5.7) is moved by `clocks`, read at the
-  // batch's first such stamp and kept for the rest, so that one offset
-  // moves them all and their order holds.
+  // first such stamp of a wait_edges() call and kept for the rest of it, so
+  // that one offset moves them all and their order holds.
   [[nodiscard]] static std::int64_t to_monotonic_ns(const timespec &ts, std::int64_t now_ns,
                                                     std::optional<base::ClockPair> &clocks);
 
