@@ -42,6 +42,19 @@ TEST(BufferTimestamp, WallClockValuesAreConverted) {
   EXPECT_EQ(stamp.clock, StampClock::converted_realtime);
 }
 
+// Where no offset between the clocks could be read (a realtime step inside
+// every bracket), a wall-clock stamp cannot be moved, nor may a stamp near 0
+// (a writer counting from its start) pass for one: it was converted by an
+// offset of "now", into the future.
+TEST(BufferTimestamp, WithoutAnOffsetNoStampIsTakenForAWallClockOne) {
+  for (const std::int64_t stamp_ns : {kRealNow - 40'000'000, std::int64_t{500'000'000}}) {
+    const BufferStamp stamp =
+        buffer_stamp(V4L2_BUF_FLAG_TIMESTAMP_COPY, stamp_ns, kMonoNow, std::nullopt);
+    EXPECT_EQ(stamp.ns, kMonoNow) << stamp_ns;
+    EXPECT_EQ(stamp.clock, StampClock::dequeue_time) << stamp_ns;
+  }
+}
+
 TEST(BufferTimestamp, UnusableStampsBecomeTheDequeueTime) {
   for (const std::int64_t bad :
        {std::int64_t{0}, std::int64_t{-5}, kMonoNow - 100 * kS, kMonoNow + 60 * kS}) {

@@ -24,14 +24,14 @@ bool near(std::int64_t stamp, std::int64_t now) {
 } // namespace
 
 BufferStamp buffer_stamp(std::uint32_t flags, std::int64_t stamp_ns, std::int64_t monotonic_now_ns,
-                         std::int64_t realtime_now_ns) {
+                         std::optional<std::int64_t> realtime_now_ns) {
   const std::uint32_t type = flags & V4L2_BUF_FLAG_TIMESTAMP_MASK;
   if (stamp_ns > 0 && type == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC)
     return {stamp_ns, mark_of(flags), StampClock::monotonic};
   if (stamp_ns > 0 && near(stamp_ns, monotonic_now_ns))
     return {stamp_ns, mark_of(flags), StampClock::judged_monotonic};
-  if (stamp_ns > 0 && near(stamp_ns, realtime_now_ns))
-    return {stamp_ns - realtime_now_ns + monotonic_now_ns, mark_of(flags),
+  if (stamp_ns > 0 && realtime_now_ns && near(stamp_ns, *realtime_now_ns))
+    return {stamp_ns - *realtime_now_ns + monotonic_now_ns, mark_of(flags),
             StampClock::converted_realtime};
   return {monotonic_now_ns, TimestampMark::end_of_frame, StampClock::dequeue_time};
 }
