@@ -57,24 +57,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::size_t lines_in(const fs::path &file) {
-  std::ifstream in(file);
-  std::size_t n = 0;
-  for (std::string line; std::getline(in, line);)
-    ++n;
-  return n;
-}
-
-// What a run's record holds so far: its records, those with the pose
-// fresh, and those of a reload's setup.
+// What a run's record holds so far: its composites (not the repeats and
+// placeholders a slow start may add), those with the pose fresh, and those
+// of a reload's setup.
 struct RecordSoFar {
-  std::size_t records = 0, pose_fresh = 0, reloaded = 0;
+  std::size_t composites = 0, pose_fresh = 0, reloaded = 0;
 };
 RecordSoFar record_so_far(const fs::path &file) {
   std::ifstream in(file);
   RecordSoFar so_far;
   for (std::string line; std::getline(in, line);) {
-    ++so_far.records;
+    if (line.find("\"kind\":\"composite\"") == std::string::npos)
+      continue;
+    ++so_far.composites;
     so_far.pose_fresh += line.find("\"pose_fresh\":true") != std::string::npos ? 1 : 0;
     so_far.reloaded += line.find("\"setup\":1,") != std::string::npos ? 1 : 0;
   }
@@ -147,7 +142,7 @@ protected:
     if (reload) {
       options.reload = &reload_now;
       reloader = std::thread([&] {
-        for (int i = 0; i < 6000 && lines_in(dir_ / "stats.jsonl") < 10; ++i)
+        for (int i = 0; i < 6000 && record_so_far(dir_ / "stats.jsonl").composites < 10; ++i)
           std::this_thread::sleep_for(std::chrono::milliseconds(10));
         reload_now = true;
       });
@@ -160,7 +155,7 @@ protected:
         while (!ended && !stop_now) {
           std::this_thread::sleep_for(std::chrono::milliseconds(10));
           const RecordSoFar so_far = record_so_far(record);
-          stop_now = so_far.records >= 40 && (!tracked || so_far.pose_fresh >= 31) &&
+          stop_now = so_far.composites >= 40 && (!tracked || so_far.pose_fresh >= 31) &&
                      (!reload || so_far.reloaded >= 10);
         }
       });
