@@ -24,6 +24,52 @@ using std::abs; // fabs, as GLSL's; found before glm's x >= 0 ? x : -x
 } // namespace
 } // namespace rules
 
+namespace {
+
+// What one pass adds to a pixel: the neighbours at +-1 .. +-reach steps of
+// `step` elements (at most `before` steps back and `after` on), those with
+// samples and with alike blur circles, with Gaussian weights, three
+// exponentials a pixel for all of them: exp(f (k+1)^2) = exp(f k^2) exp(f (2k
+// + 1)). The neighbours go in the order -1, +1, -2, +2, ..., as the GPU's
+// pass takes them. A function of plain pointers and local sums: as a lambda
+// over captured spans, writing its sums through references, it reloaded
+// every pointer and stored every sum at each neighbour, and took a third
+// longer (bench/RESULTS.md).
+template <typename Weight>
+void gather(std::size_t i, float sigma, int reach, int before, int after, std::ptrdiff_t step,
+            const float *blur, const std::uint32_t *counts, const glm::vec4 *m_in,
+            const glm::vec4 *r_in, const Weight *n_in, glm::vec4 &m, glm::vec4 &r, float &n) {
+  const float falloff = -0.5f / (sigma * sigma);
+  float w = std::exp(falloff);
+  float ratio = std::exp(3.0f * falloff);
+  const float ratio_step = std::exp(2.0f * falloff);
+  const float own_blur = blur[i];
+  // In locals, not through the references: the compiler keeps them in
+  // registers.
+  glm::vec4 sum_m = m, sum_r = r;
+  float sum_n = n;
+  for (int k = 1; k <= reach; ++k) {
+    const std::ptrdiff_t offsets[2] = {-k * step, k * step};
+    const bool inside[2] = {k <= before, k <= after};
+    const glm::vec4 w4(w);
+    for (int side = 0; side < 2; ++side) {
+      const std::size_t j = std::size_t(std::ptrdiff_t(i) + offsets[side]);
+      if (!inside[side] || counts[j] == 0 || !rules::reconstruct_blurs_alike(own_blur, blur[j]))
+        continue;
+      sum_m += w4 * m_in[j];
+      sum_r += w4 * r_in[j];
+      sum_n += w * float(n_in[j]);
+    }
+    w *= ratio;
+    ratio *= ratio_step;
+  }
+  m = sum_m;
+  r = sum_r;
+  n = sum_n;
+}
+
+} // namespace
+
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
                     std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,
                     std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,
@@ -37,70 +83,40 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   const float max_reach = float(settings.max_radius_px);
   const auto at = [width](std::uint32_t y, int x) { return std::size_t(y) * width + x; };
 
-  // Each pixel's signed blur radius at its mean depth (a miss: at infinity).
+  // Each pixel's signed blur radius at its mean depth (a miss: at infinity),
+  // and its Gaussian's sigma. A sigma of NaN, which no comparison passes,
+  // leaves the pixel its own samples.
   auto blur_of = [&](int k) {
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
       buffers.blur[i] = rules::reconstruct_blur(aux[i], lens, inverse_focus);
+      buffers.sigma[i] =
+          rules::reconstruct_sigma_of(buffers.blur[i], float(counts[i]), strength, max_reach);
     }
   };
   pool.run(int(spans.size()), blur_of);
 
-  // A sigma of NaN, which no comparison passes, leaves the pixel its own
-  // samples.
-  const auto sigma_of = [&](std::size_t i) {
-    return rules::reconstruct_sigma_of(buffers.blur[i], float(counts[i]), strength, max_reach);
-  };
-  // Neighbours whose blur circles are alike, which keeps a sharp surface's
-  // samples from a far more blurred one's and lets a blurred silhouette's
-  // pixels share theirs with the background they spill over. A tighter rule
-  // (within half the pixel's own radius) left a 1-rpp frame of the rig
-  // focused far twice as noisy (bench/RESULTS.md).
-  const auto alike = [&](std::size_t i, std::size_t j) {
-    return rules::reconstruct_blurs_alike(buffers.blur[i], buffers.blur[j]);
-  };
-
-  // Adds the neighbours at +-1 .. +-reach steps of `step` (whose offsets
-  // `valid` allows) with Gaussian weights, three exponentials a pixel for
-  // all of them: exp(f (k+1)^2) = exp(f k^2) exp(f (2k + 1)).
-  const auto gather = [&](std::size_t i, float sigma, int reach, std::ptrdiff_t step,
-                          const auto &valid, const glm::vec4 *m_in, const glm::vec4 *r_in,
-                          const auto &n_in, glm::vec4 &m, glm::vec4 &r, float &n) {
-    const float falloff = -0.5f / (sigma * sigma);
-    float w = std::exp(falloff);
-    float ratio = std::exp(3.0f * falloff);
-    const float ratio_step = std::exp(2.0f * falloff);
-    for (int k = 1; k <= reach; ++k) {
-      for (const int side : {-k, k}) {
-        if (!valid(side))
-          continue;
-        const std::size_t j = std::size_t(std::ptrdiff_t(i) + side * step);
-        if (counts[j] == 0 || !alike(i, j))
-          continue;
-        m += w * m_in[j];
-        r += w * r_in[j];
-        n += w * n_in(j);
-      }
-      w *= ratio;
-      ratio *= ratio_step;
-    }
-  };
-  const auto reach_of = [&](float sigma) { return rules::reconstruct_reach_of(sigma, max_reach); };
+  // Neighbours whose blur circles are alike (reconstruct_blurs_alike) keep a
+  // sharp surface's samples from a far more blurred one's and let a blurred
+  // silhouette's pixels share theirs with the background they spill over. A
+  // tighter rule (within half the pixel's own radius) left a 1-rpp frame of
+  // the rig focused far twice as noisy (bench/RESULTS.md).
+  const float *blur = buffers.blur.data();
+  const float *sigmas = buffers.sigma.data();
+  const std::uint32_t *count = counts.data();
 
   // Rows: weighted sums of the sums, and of the counts.
   auto rows = [&](int k) {
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const float sigma = sigma_of(i);
+      const float sigma = sigmas[i];
       glm::vec4 m = mixed[i], r = real[i];
-      float n = float(counts[i]);
+      float n = float(count[i]);
       if (sigma >= settings.min_sigma_px)
-        gather(
-            i, sigma, reach_of(sigma), 1,
-            [&](int dx) { return int(x) + dx >= 0 && int(x) + dx < width; }, mixed.data(),
-            real.data(), [&](std::size_t j) { return float(counts[j]); }, m, r, n);
+        gather(i, sigma, rules::reconstruct_reach_of(sigma, max_reach), int(x), width - 1 - int(x),
+               1, blur, count, mixed.data(), real.data(), count, m, r, n);
       buffers.scratch_mixed[i] = m;
       buffers.scratch_real[i] = r;
       buffers.scratch_weight[i] = n;
@@ -113,15 +129,13 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const float sigma = sigma_of(i);
+      const float sigma = sigmas[i];
       glm::vec4 m = buffers.scratch_mixed[i], r = buffers.scratch_real[i];
       float n = buffers.scratch_weight[i];
       if (sigma >= settings.min_sigma_px)
-        gather(
-            i, sigma, reach_of(sigma), width,
-            [&](int dy) { return int(s.y) + dy >= 0 && int(s.y) + dy < height; },
-            buffers.scratch_mixed.data(), buffers.scratch_real.data(),
-            [&](std::size_t j) { return buffers.scratch_weight[j]; }, m, r, n);
+        gather(i, sigma, rules::reconstruct_reach_of(sigma, max_reach), int(s.y),
+               height - 1 - int(s.y), width, blur, count, buffers.scratch_mixed.data(),
+               buffers.scratch_real.data(), buffers.scratch_weight.data(), m, r, n);
       buffers.out_mixed[i] = m / n;
       buffers.out_real[i] = r / n;
     }
