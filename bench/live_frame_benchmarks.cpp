@@ -61,8 +61,20 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
 // still, reconstructed and not (still_raw: what the reconstruction costs),
 // and held so long that the history has all it may take (still_capped: 8
 // samples a pixel at most, as a locked-off shot's 256 after about 10 s;
-// from about the 8th frame on, few rays or none a frame).
-enum class Method { fresh, pull, pull_afresh, still, still_raw, still_capped };
+// from about the 8th frame on, few rays or none a frame); and a new history
+// every frame at the near end of the pull, as a moving camera's frames are,
+// reconstructed and not (near_fresh, near_fresh_raw: where the
+// reconstruction costs the most, its blur circles 20 pixels wide).
+enum class Method {
+  fresh,
+  pull,
+  pull_afresh,
+  still,
+  still_raw,
+  still_capped,
+  near_fresh,
+  near_fresh_raw
+};
 
 void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   const renderer::Scene scene = sim_rig_scene();
@@ -86,9 +98,11 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   request.camera = renderer::scene_camera(scene);
   request.rays_per_pixel = 1;
   request.influence_region = region;
+  const bool near = method == Method::near_fresh || method == Method::near_fresh_raw;
   request.accumulation.enabled = method != Method::fresh;
-  request.accumulation.reproject = method != Method::pull_afresh;
-  request.accumulation.reconstruct = method != Method::still_raw;
+  request.accumulation.reproject = method != Method::pull_afresh && !near;
+  request.accumulation.reconstruct =
+      method != Method::still_raw && method != Method::near_fresh_raw;
   if (method == Method::still_capped)
     request.accumulation.max_samples = 8;
   request.camera.f_number = 2.8f;
@@ -102,6 +116,8 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
     const double t =
         double(step < kLensStates ? step : 2 * kLensStates - 2 - step) / double(kLensStates - 1);
     request.camera.focus_distance_m = float(1.0 / (1.0 / 14.0 + t * (1.0 / 0.4 - 1.0 / 14.0)));
+    if (near) // 0.40 and 0.41 m in turn: a blur change far past the tolerance
+      request.camera.focus_distance_m = frame % 2 == 0 ? 0.40f : 0.41f;
     request.seed = std::uint32_t(++frame * 2654435761u) | 1u;
     const renderer::FrameReport report = frames->render(request, {format, plate}, outputs);
     if (report.status != renderer::FrameStatus::ok) {
@@ -121,18 +137,21 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
 void register_live_frame_benchmarks() {
   for (const bool gpu : {false, true})
     for (const bool region : {true, false})
-      for (const Method method : {Method::fresh, Method::pull, Method::pull_afresh, Method::still,
-                                  Method::still_raw, Method::still_capped}) {
+      for (const Method method :
+           {Method::fresh, Method::pull, Method::pull_afresh, Method::still, Method::still_raw,
+            Method::still_capped, Method::near_fresh, Method::near_fresh_raw}) {
         if (method != Method::fresh && !region)
           continue; // a history is kept over the region
         if (method == Method::pull_afresh && gpu)
           continue; // the GPU executor does not reproject
-        const char *name = method == Method::fresh         ? "fresh"
-                           : method == Method::pull        ? "live_pull"
-                           : method == Method::pull_afresh ? "live_pull_afresh"
-                           : method == Method::still       ? "live_still"
-                           : method == Method::still_raw   ? "live_still_raw"
-                                                           : "live_still_capped";
+        const char *name = method == Method::fresh          ? "fresh"
+                           : method == Method::pull         ? "live_pull"
+                           : method == Method::pull_afresh  ? "live_pull_afresh"
+                           : method == Method::still        ? "live_still"
+                           : method == Method::still_raw    ? "live_still_raw"
+                           : method == Method::still_capped ? "live_still_capped"
+                           : method == Method::near_fresh   ? "live_near_fresh"
+                                                            : "live_near_fresh_raw";
         benchmark::RegisterBenchmark((std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
                                       "/sim_rig/720x576/rpp:1/" +
                                       (region ? "region" : "every_pixel") + "/" + name)
