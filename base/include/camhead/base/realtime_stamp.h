@@ -3,10 +3,10 @@
 // the GPIO character device did before Linux 5.7 and as some V4L2 drivers
 // stamp their buffers.
 //
-// The stamp is moved across by the two clocks' offset, read after the stamp
-// was taken; one reading serves a batch of stamps (a drained socket queue,
-// a GPIO read), which keeps their order and costs a few clock reads a batch,
-// not a datagram. Read naively, one clock then the other, the offset is off
+// The stamp is moved across by the two clocks' offset, read once a batch of
+// stamps (a drained socket queue, a GPIO wait's reads), after the first of
+// them was taken: one offset keeps their order, and costs a few clock reads
+// a batch, not a datagram. Read naively, one clock then the other, the offset is off
 // by however long the thread was away between the two reads. Under load on
 // a 2-core VM that put 10 loopback datagrams in a million up to 40 us
 // before their own send, and once a tracker's first pose before the tracker

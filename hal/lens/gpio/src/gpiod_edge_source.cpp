@@ -238,7 +238,9 @@ std::int64_t GpiodEdgeSource::to_monotonic_ns(const timespec &ts, std::int64_t n
   if (!clocks) {
     clocks = base::read_clock_pair();
   }
-  return clocks->known() ? clocks->monotonic_of(stamp) : clocks->monotonic_ns;
+  // Without an offset (a realtime step inside every bracket), the latest the
+  // edge can have been: now, after its line was read.
+  return clocks->known() ? clocks->monotonic_of(stamp) : monotonic_ns();
 }
 
 } // namespace camhead::hal::lens::gpio::detail
