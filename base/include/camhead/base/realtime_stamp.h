@@ -6,16 +6,16 @@
 // The stamp is moved across by the two clocks' offset, read once a batch of
 // stamps (a drained socket queue, a GPIO wait's reads), after the first of
 // them was taken: one offset keeps their order, and costs a few clock reads
-// a batch, not a datagram. Read naively, one clock then the other, the offset is off
-// by however long the thread was away between the two reads. Under load on
-// a 2-core VM that put 10 loopback datagrams in a million up to 40 us
-// before their own send, and once a tracker's first pose before the tracker
-// had started (a CI failure). So the offset is read bracketed, realtime,
-// monotonic, realtime, up to three times, and the tightest bracket is kept:
-// none of 800,000 datagrams came before its send. The realtime of the
-// monotonic read is taken as the bracket's first read, the earliest it can
-// have been, so that a moved stamp is never early, and late by no more
-// than the bracket (a midpoint could be early by half of it).
+// a batch, not a datagram. Read naively, one clock then the other, the
+// offset is off by however long the thread was away between the two reads.
+// Under load on a 2-core VM that put 10 loopback datagrams in a million up
+// to 40 us before their own send, and once a tracker's first pose before
+// the tracker had started (a CI failure). So the offset is read bracketed,
+// realtime, monotonic, realtime, up to three times, and the tightest
+// bracket is kept: none of 800,000 datagrams came before its send. The
+// realtime of the monotonic read is taken as the bracket's first read, the
+// earliest it can have been, so that a moved stamp is never early, and late
+// by no more than the bracket (a midpoint could be early by half of it).
 //
 // And whatever the clocks do (a realtime step from NTP at a board's boot, a
 // bracket preempted three times), receipt_ns keeps a stamp within the bounds
