@@ -67,8 +67,7 @@ std::span<StoredSample> SampleStore::add_frame(const gpu::FrameParams &camera,
       region.rects.size() > frames_[0].rects.capacity())
     return {};
   // After the newest frame's samples, or from the start where they would
-  // not fit; the frames these overwrite are the oldest (each frame starts
-  // where the one before it ended, or at 0).
+  // not fit (each frame starts where the one before it ended, or at 0).
   std::size_t first = 0;
   if (stored_ > 0) {
     const Frame &newest = frames_[newest_];
@@ -76,13 +75,19 @@ std::span<StoredSample> SampleStore::add_frame(const gpu::FrameParams &camera,
     if (first + count > samples_.size())
       first = 0;
   }
-  while (stored_ > 0) {
-    const Frame &oldest = frames_[(newest_ + kMostFrames - (stored_ - 1)) % kMostFrames];
-    const bool overlaps = oldest.first < first + count && first < oldest.first + oldest.count;
-    if (!overlaps && stored_ < kMostFrames)
+  // The newest frame these samples overwrite goes, and every frame older
+  // than it (the list runs from the newest back). Not only the oldest: after
+  // a wrap to 0 the frames there are the newest, and the oldest may lie past
+  // the new samples, in the end that a frame too large for it left.
+  std::size_t keep = stored_;
+  for (std::size_t k = 0; k < stored_; ++k) {
+    const Frame &frame = frames_[(newest_ + kMostFrames - k) % kMostFrames];
+    if (frame.first < first + count && first < frame.first + frame.count) {
+      keep = k;
       break;
-    --stored_;
+    }
   }
+  stored_ = std::min(keep, kMostFrames - 1);
   newest_ = stored_ == 0 ? 0 : (newest_ + 1) % kMostFrames;
   ++stored_;
   Frame &frame = frames_[newest_];
@@ -154,12 +159,14 @@ void SampleStore::begin_reprojection(const gpu::FrameParams &to, const Influence
     if (has_lens_model(to)) {
       source.preimage.move = double(to.lens.x) * dw + 1e-6;
       source.preimage.per_px = 1.1 / (double(to.lens.z) * extent.least_stretch);
-      source.preimage.stretch = stretch;
       const double from_axis =
           std::max(double(to.projection.y), double(height_) - double(to.projection.y));
       const double ideal_move = double(frame.camera.lens.x) * dw;
       const double moved_stretch =
           ideal_move <= kStretchMargin ? stretch : lens_extent(to, ideal_move).stretch;
+      // Out to the move beyond the view (at least A_to |dw|), where a lens
+      // whose stretch grows outward (pincushion) stretches more.
+      source.preimage.stretch = moved_stretch;
       source.reach = std::uint32_t(std::ceil(std::abs(1.0 / source.preimage.s - 1.0) * from_axis +
                                              moved_stretch * double(to.lens.z) * ideal_move + 2.0));
     } else {
