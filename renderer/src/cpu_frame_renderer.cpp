@@ -373,9 +373,9 @@ private:
       uniform_share_ = k;
       return region_->pixels() * k;
     }
-    return cpu::share_rays_by_noise(spans_, scene_.render.width, scene_.render.height, aux_,
-                                    history_counts_, rpp, most, history_frames_,
-                                    {sigma_, noise_, shares_}, pool_);
+    return cpu::share_rays_by_noise(
+        spans_, scene_.render.width, scene_.render.height, aux_, history_counts_, own_counts_, rpp,
+        request.accumulation.max_samples, most, history_frames_, {sigma_, noise_, shares_}, pool_);
   }
 
   std::size_t index(std::uint32_t y, std::uint32_t x) const {

@@ -26,9 +26,11 @@ float luminance_sigma(std::span<const glm::vec4> aux, std::span<const std::uint3
 
 std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
                                   std::span<const glm::vec4> aux,
-                                  std::span<const std::uint32_t> counts, std::uint32_t rpp,
-                                  std::uint32_t most, std::uint32_t frame_index,
-                                  const RayShareBuffers &buffers, WorkerPool &pool) {
+                                  std::span<const std::uint32_t> counts,
+                                  std::span<const std::uint32_t> own, std::uint32_t rpp,
+                                  std::uint32_t most, std::uint32_t pattern_room,
+                                  std::uint32_t frame_index, const RayShareBuffers &buffers,
+                                  WorkerPool &pool) {
   const auto at = [width](std::uint32_t y, std::uint32_t x) {
     return std::size_t(y) * std::size_t(width) + x;
   };
@@ -76,16 +78,22 @@ std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, i
       lack_sum += lack;
     }
   const double scale = lack_sum > 0.0 ? double(pixels) * rpp / lack_sum : 0.0;
+  // A pixel's most rays a frame; in 64 bits, as a budget of 2^28 rays a
+  // pixel would wrap 32.
+  const double most_a_frame = double(kMostRaysAPixel) * double(rpp);
+  const auto room = [](std::uint32_t limit, std::uint32_t used) {
+    return limit > used ? limit - used : 0u; // moved samples may pass a limit
+  };
   for (const PixelSpan &span : spans)
     for (std::size_t i = at(span.y, span.x0); i < at(span.y, span.x1); ++i) {
       // Rounded up or down at random (a hash of the pixel and the frame),
       // so that the shares add up to the budget on average.
-      const double want = std::min(double(buffers.noise[i]) * scale, double(kMostRaysAPixel * rpp));
+      const double want = std::min(double(buffers.noise[i]) * scale, most_a_frame);
       const double whole = std::floor(want);
       const double u = double(hasher.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ frame_index)) *
                        (1.0 / 4294967296.0);
       const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
-      buffers.shares[i] = std::min({k, kMostRaysAPixel * rpp, most - counts[i]});
+      buffers.shares[i] = std::min({k, room(most, counts[i]), room(pattern_room, own[i])});
       rays += buffers.shares[i];
     }
   return rays;

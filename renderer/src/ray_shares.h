@@ -31,13 +31,15 @@ struct RayShareBuffers {
 
 // Shares rpp rays for each pixel of `spans` among them by their noise, from
 // the accumulators' `aux` (luminance sum and sum of squares in z, w) and
-// `counts` (samples so far, at least one, 0 outside the spans), none past
-// `most` samples; returns the rays given.
-[[nodiscard]] std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width,
-                                                int height, std::span<const glm::vec4> aux,
-                                                std::span<const std::uint32_t> counts,
-                                                std::uint32_t rpp, std::uint32_t most,
-                                                std::uint32_t frame_index,
-                                                const RayShareBuffers &buffers, WorkerPool &pool);
+// `counts` (samples so far, moved ones included: at least one, 0 outside
+// the spans); returns the rays given. No pixel goes past `most` samples in
+// all, nor past `pattern_room` samples of its own pattern (`own`: those it
+// traced so far).
+[[nodiscard]] std::uint64_t
+share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
+                    std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,
+                    std::span<const std::uint32_t> own, std::uint32_t rpp, std::uint32_t most,
+                    std::uint32_t pattern_room, std::uint32_t frame_index,
+                    const RayShareBuffers &buffers, WorkerPool &pool);
 
 } // namespace camhead::renderer::cpu

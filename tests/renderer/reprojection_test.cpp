@@ -266,6 +266,43 @@ TEST(Reprojection, ANewHistoryTakesTheSamplesOfAtMostReprojectFramesFrames) {
   }
 }
 
+// A history stops growing at max_samples (accumulation.h), the samples
+// moved into it counted. After a pull of a new history a frame (0.1 D
+// each), whose moved samples and first rays alike fill more than 8 samples
+// a pixel, the still frames' shares by noise give out. (The cap took the
+// samples so far from the pattern's room, unsigned: moved samples past it
+// wrapped the difference, and the history grew to 23 samples a pixel,
+// still tracing 76-99 rays a frame 40 frames on.)
+TEST(Reprojection, MovedSamplesCountTowardsTheMostAHistoryTakes) {
+  const Scene scene = ball_scene();
+  Frames frames(scene);
+  const auto at = [&](int step, std::uint32_t seed) {
+    FrameRequest request = still(scene, 1, seed);
+    request.accumulation.max_samples = 8;
+    request.camera.focus_distance_m = 1.0f / (0.5f + 0.1f * float(step));
+    return request;
+  };
+  std::uint64_t moved = 0;
+  for (int k = 0; k < 12; ++k)
+    moved += frames.render(at(k, 90u + std::uint32_t(k))).reprojected_samples;
+  EXPECT_GT(moved, 0u);
+  FrameReport report;
+  std::uint32_t after_ten = 0;
+  std::uint64_t rays_late = 0;
+  for (int k = 0; k < 40; ++k) { // held where the pull ended
+    report = frames.render(at(11, 200u + std::uint32_t(k)));
+    if (k == 9)
+      after_ten = report.history_samples;
+    if (k >= 10)
+      rays_late += report.camera_rays;
+  }
+  EXPECT_GE(after_ten, 8u) << "moved samples and the first rays fill the history";
+  EXPECT_EQ(report.history_samples, after_ten) << "and it grows no more";
+  // Only the few pixels that the moved samples left short of 8 take a ray
+  // now and then (a share by noise rounded up at random).
+  EXPECT_LT(rays_late, report.traced_pixels / 10) << "30 frames, a tenth of one frame's rays";
+}
+
 TEST(Reprojection, TheSamplesMovedAreTheSameOnAnyNumberOfThreads) {
   // Each thread moves the samples that land in its own band of rows, in the
   // order stored: one, two or seven threads give the same sums, bit for bit.
