@@ -23,17 +23,15 @@ bool near(std::int64_t stamp, std::int64_t now) {
 
 } // namespace
 
-BufferStamp buffer_stamp(std::uint32_t flags, std::int64_t stamp_ns, std::int64_t monotonic_now_ns,
-                         std::optional<std::int64_t> realtime_now_ns) {
+BufferStamp buffer_stamp(std::uint32_t flags, std::int64_t stamp_ns, const base::ClockPair &now) {
   const std::uint32_t type = flags & V4L2_BUF_FLAG_TIMESTAMP_MASK;
   if (stamp_ns > 0 && type == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC)
     return {stamp_ns, mark_of(flags), StampClock::monotonic};
-  if (stamp_ns > 0 && near(stamp_ns, monotonic_now_ns))
+  if (stamp_ns > 0 && near(stamp_ns, now.monotonic_ns))
     return {stamp_ns, mark_of(flags), StampClock::judged_monotonic};
-  if (stamp_ns > 0 && realtime_now_ns && near(stamp_ns, *realtime_now_ns))
-    return {stamp_ns - *realtime_now_ns + monotonic_now_ns, mark_of(flags),
-            StampClock::converted_realtime};
-  return {monotonic_now_ns, TimestampMark::end_of_frame, StampClock::dequeue_time};
+  if (stamp_ns > 0 && now.known() && near(stamp_ns, now.realtime_ns))
+    return {now.monotonic_of(stamp_ns), mark_of(flags), StampClock::converted_realtime};
+  return {now.monotonic_ns, TimestampMark::end_of_frame, StampClock::dequeue_time};
 }
 
 std::string clock_text(StampClock clock) {

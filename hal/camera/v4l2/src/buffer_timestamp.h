@@ -10,9 +10,9 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 
+#include "camhead/base/realtime_stamp.h"
 #include "camhead/hal/camera/camera_source.h"
 
 namespace camhead::hal::camera {
@@ -30,13 +30,11 @@ struct BufferStamp {
   StampClock clock = StampClock::monotonic;
 };
 
-// `flags` of the v4l2_buffer and its timestamp in ns; `monotonic_now_ns`
-// and `realtime_now_ns` read just after the dequeue (realtime_stamp.h's
-// pair; none where no offset could be read, and then no stamp is taken for
-// a wall-clock one).
+// `flags` of the v4l2_buffer and its timestamp in ns; `now`, both clocks
+// read just after the dequeue (realtime_stamp.h). Where `now` knows no
+// offset between them, no stamp is taken for a wall-clock one.
 [[nodiscard]] BufferStamp buffer_stamp(std::uint32_t flags, std::int64_t stamp_ns,
-                                       std::int64_t monotonic_now_ns,
-                                       std::optional<std::int64_t> realtime_now_ns);
+                                       const base::ClockPair &now);
 
 // For status lines: "the driver's CLOCK_MONOTONIC", ...
 [[nodiscard]] std::string clock_text(StampClock clock);

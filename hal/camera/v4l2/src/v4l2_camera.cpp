@@ -174,11 +174,10 @@ CaptureResult V4l2Camera::wait_frame(std::chrono::milliseconds timeout, Captured
     // bracket) such a stamp is judged on no clock.
     const base::ClockPair clocks = base::read_clock_pair();
     const std::int64_t now = clocks.monotonic_ns;
-    const BufferStamp stamp =
-        buffer_stamp(buffer.flags,
-                     std::int64_t{buffer.timestamp.tv_sec} * 1'000'000'000 +
-                         std::int64_t{buffer.timestamp.tv_usec} * 1'000,
-                     now, clocks.known() ? std::optional(clocks.realtime_ns) : std::nullopt);
+    const BufferStamp stamp = buffer_stamp(buffer.flags,
+                                           std::int64_t{buffer.timestamp.tv_sec} * 1'000'000'000 +
+                                               std::int64_t{buffer.timestamp.tv_usec} * 1'000,
+                                           clocks);
     const FrameSequence::Step step = sequence_.next(buffer.sequence);
     stream.hold(index, step.sequence);
     status_.dropped += step.dropped;
