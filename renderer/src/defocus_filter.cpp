@@ -25,23 +25,32 @@ using std::abs; // fabs, as GLSL's; found before glm's x >= 0 ? x : -x
 
 namespace {
 
+// A pixel's Gaussian as both passes walk it (found once, in the first):
+// the weight of the nearest neighbours, the ratio of the next ones' to
+// theirs, that ratio's own ratio (exp(f (k+1)^2) = exp(f k^2) exp(f (2k +
+// 1)): three exponentials a pixel for every neighbour), and how many
+// pixels either side it reaches (0: the pixel keeps its own samples).
+struct Gaussian {
+  float weight = 0.0f, ratio = 0.0f, ratio_step = 0.0f;
+  int reach = 0;
+};
+
 // What one pass adds to a pixel: the neighbours at +-1 .. +-reach steps of
 // `step` elements (at most `before` steps back and `after` on), those with
-// samples and with alike blur circles, with Gaussian weights, three
-// exponentials a pixel for all of them: exp(f (k+1)^2) = exp(f k^2) exp(f (2k
-// + 1)). The neighbours go in the order -1, +1, -2, +2, ..., as the GPU's
-// pass takes them. A function of plain pointers and local sums: as a lambda
-// over captured spans, writing its sums through references, it reloaded
-// every pointer and stored every sum at each neighbour, and the filter took
-// 1.4 times as long (bench/RESULTS.md).
+// samples and with alike blur circles, with Gaussian weights. The
+// neighbours go in the order -1, +1, -2, +2, ..., as the GPU's pass takes
+// them. A function of plain pointers and local sums: as a lambda over
+// captured spans, writing its sums through references, it reloaded every
+// pointer and stored every sum at each neighbour, and the filter took 1.4
+// times as long (bench/RESULTS.md).
 template <typename Weight>
-void gather(std::size_t i, float sigma, int reach, int before, int after, std::ptrdiff_t step,
+void gather(std::size_t i, const Gaussian &g, int before, int after, std::ptrdiff_t step,
             const float *blur, const std::uint32_t *counts, const glm::vec4 *m_in,
             const glm::vec4 *r_in, const Weight *n_in, glm::vec4 &m, glm::vec4 &r, float &n) {
-  const float falloff = -0.5f / (sigma * sigma);
-  float w = std::exp(falloff);
-  float ratio = std::exp(3.0f * falloff);
-  const float ratio_step = std::exp(2.0f * falloff);
+  float w = g.weight;
+  float ratio = g.ratio;
+  const float ratio_step = g.ratio_step;
+  const int reach = g.reach;
   const float own_blur = blur[i];
   // In locals, not through the references: the compiler keeps them in
   // registers.
@@ -82,19 +91,27 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   const float max_reach = float(settings.max_radius_px);
   const auto at = [width](std::uint32_t y, int x) { return std::size_t(y) * width + x; };
 
-  // Each pixel's signed blur radius at its mean depth (a miss: at infinity),
-  // and its Gaussian's sigma. A sigma of NaN, which no comparison passes,
-  // leaves the pixel its own samples.
+  // Each pixel's signed blur radius at its mean depth (a miss: at infinity).
   auto blur_of = [&](int k) {
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
       buffers.blur[i] = rules::reconstruct_blur(aux[i], lens, inverse_focus);
-      buffers.sigma[i] =
-          rules::reconstruct_sigma_of(buffers.blur[i], float(counts[i]), strength, max_reach);
     }
   };
   pool.run(int(spans.size()), blur_of);
+
+  // Its Gaussian, from its sigma; a sigma below the least, or NaN, which no
+  // comparison passes, leaves the pixel its own samples.
+  const auto gaussian_of = [&](std::size_t i) {
+    const float sigma =
+        rules::reconstruct_sigma_of(buffers.blur[i], float(counts[i]), strength, max_reach);
+    if (!(sigma >= settings.min_sigma_px))
+      return Gaussian{};
+    const float falloff = -0.5f / (sigma * sigma);
+    return Gaussian{std::exp(falloff), std::exp(3.0f * falloff), std::exp(2.0f * falloff),
+                    rules::reconstruct_reach_of(sigma, max_reach)};
+  };
 
   // Neighbours whose blur circles are alike (reconstruct_blurs_alike) keep a
   // sharp surface's samples from a far more blurred one's and let a blurred
@@ -102,7 +119,6 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   // tighter rule (within half the pixel's own radius) left a 1-rpp frame of
   // the rig focused far twice as noisy (bench/RESULTS.md).
   const float *blur = buffers.blur.data();
-  const float *sigmas = buffers.sigma.data();
   const std::uint32_t *count = counts.data();
 
   // Rows: weighted sums of the sums, and of the counts.
@@ -110,12 +126,12 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const float sigma = sigmas[i];
+      const Gaussian g = gaussian_of(i);
+      buffers.gaussian[i] = glm::vec4(g.weight, g.ratio, g.ratio_step, float(g.reach));
       glm::vec4 m = mixed[i], r = real[i];
       float n = float(count[i]);
-      if (sigma >= settings.min_sigma_px)
-        gather(i, sigma, rules::reconstruct_reach_of(sigma, max_reach), int(x), width - 1 - int(x),
-               1, blur, count, mixed.data(), real.data(), count, m, r, n);
+      gather(i, g, int(x), width - 1 - int(x), 1, blur, count, mixed.data(), real.data(), count, m,
+             r, n);
       buffers.scratch_mixed[i] = m;
       buffers.scratch_real[i] = r;
       buffers.scratch_weight[i] = n;
@@ -128,13 +144,13 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const float sigma = sigmas[i];
+      const glm::vec4 &found = buffers.gaussian[i];
+      const Gaussian g{found.x, found.y, found.z, int(found.w)};
       glm::vec4 m = buffers.scratch_mixed[i], r = buffers.scratch_real[i];
       float n = buffers.scratch_weight[i];
-      if (sigma >= settings.min_sigma_px)
-        gather(i, sigma, rules::reconstruct_reach_of(sigma, max_reach), int(s.y),
-               height - 1 - int(s.y), width, blur, count, buffers.scratch_mixed.data(),
-               buffers.scratch_real.data(), buffers.scratch_weight.data(), m, r, n);
+      gather(i, g, int(s.y), height - 1 - int(s.y), width, blur, count,
+             buffers.scratch_mixed.data(), buffers.scratch_real.data(),
+             buffers.scratch_weight.data(), m, r, n);
       buffers.out_mixed[i] = m / n;
       buffers.out_real[i] = r / n;
     }

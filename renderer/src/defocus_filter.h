@@ -48,12 +48,12 @@ struct DefocusFilterSettings {
 // Sums in, means out: `mixed`, `real` are the accumulators (sums of
 // `counts` samples, layout.h), `aux` holds the depth sum and hit count;
 // writes each span pixel's filtered means to `out_mixed`, `out_real`, with
-// `scratch_*`, `blur` and `sigma` (the frame's size each) for the passes
-// between.
+// `scratch_*`, `blur` and `gaussian` (the frame's size each) for the
+// passes between.
 struct DefocusFilterBuffers {
   std::span<glm::vec4> out_mixed, out_real;
-  std::span<glm::vec4> scratch_mixed, scratch_real;
-  std::span<float> scratch_weight, blur, sigma;
+  std::span<glm::vec4> scratch_mixed, scratch_real, gaussian;
+  std::span<float> scratch_weight, blur;
 };
 
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
