@@ -57,10 +57,12 @@ void make_block_rays(CpuKernel &kernel, int bx, int by, std::vector<RTCRayHit> &
         inside ? kernel.pixel_pattern_for(uint32_t(x), uint32_t(y), uint32_t(width),
                                           kernel.frame.sampling.w)
                : 0u;
+    const CpuKernel::SobolPixel sobol =
+        kernel.camera_sobol_pixel(uint32_t(x), uint32_t(y), kernel.frame.sampling.w);
     for (uint32_t s = 0; s < n; ++s) {
       RTCRayHit &rh = rays[s * kBlock * kBlock + lane];
       if (inside) {
-        set_ray(rh, kernel.camera_ray(uint32_t(x), uint32_t(y), s, n, pattern));
+        set_ray(rh, kernel.camera_ray(uint32_t(x), uint32_t(y), s, n, pattern, sobol));
       } else {
         set_ray(rh, CpuKernel::Ray{glm::vec3(0.0f), glm::vec3(0.0f, 0.0f, 1.0f)});
         rh.ray.tfar = -INFINITY;
@@ -192,8 +194,9 @@ double hit_agreement(RTCScene scene, CpuKernel &kernel, int step) {
   for (uint32_t y = 0; y < height; y += uint32_t(step)) {
     for (uint32_t x = 0; x < width; x += uint32_t(step)) {
       const uint32_t pattern = kernel.pixel_pattern_for(x, y, width, kernel.frame.sampling.w);
+      const CpuKernel::SobolPixel sobol = kernel.camera_sobol_pixel(x, y, kernel.frame.sampling.w);
       for (uint32_t s = 0; s < n; ++s) {
-        const CpuKernel::Ray ray = kernel.camera_ray(x, y, s, n, pattern);
+        const CpuKernel::Ray ray = kernel.camera_ray(x, y, s, n, pattern, sobol);
         RTCRayHit rh;
         set_ray(rh, ray);
         rtcIntersect1(scene, &context, &rh);

@@ -35,8 +35,28 @@ vec2 lens_preimage(float px, float py) {
       frame.distortion, frame.projection.w);
 }
 
-// One camera ray through pixel (x, y) for sample s of n (method.md section 1).
-Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
+// Whether camera rays take their pixel and aperture points from Sobol'
+// (sobol_owen_4d) rather than from CMJ patterns.
+bool camera_uses_sobol() {
+  return KERNEL_HAS(KERNEL_CAMERA_SOBOL) &&
+         (!KERNEL_HAS(KERNEL_CAMERA_CMJ) || frame.tracing.z == SAMPLER_SOBOL);
+}
+
+// Pixel (x, y)'s Sobol' keys in the pass of pattern seed `seed`, where
+// camera rays take them (a CMJ frame would make them for nothing).
+SobolPixel camera_sobol_pixel(uint x, uint y, uint seed) {
+  SobolPixel sobol;
+  sobol.seed = seed;
+  sobol.shift = uvec4(0u);
+  if (camera_uses_sobol()) {
+    sobol = sobol_pixel_for(x, y, seed);
+  }
+  return sobol;
+}
+
+// One camera ray through pixel (x, y) for sample s of n (method.md section
+// 1): CMJ pattern pixel_pattern, or the pixel's Sobol' points.
+Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern, SobolPixel sobol) {
   float width = float(frame.image.x);
   float height = float(frame.image.y);
   float filter_width = frame.lens.w;
@@ -44,9 +64,8 @@ Ray camera_ray(uint x, uint y, uint s, uint n, uint pixel_pattern) {
   //    and form the pinhole direction; row 0 is the top of the image.
   vec2 jitter;
   vec2 aperture;
-  if (KERNEL_HAS(KERNEL_CAMERA_SOBOL) &&
-      (!KERNEL_HAS(KERNEL_CAMERA_CMJ) || frame.tracing.z == SAMPLER_SOBOL)) {
-    vec4 q = sobol_owen_4d(s, pixel_pattern);
+  if (camera_uses_sobol()) {
+    vec4 q = sobol_owen_4d(s, sobol);
     jitter = vec2(q.x, q.y);
     aperture = vec2(q.z, q.w);
   } else {
@@ -432,6 +451,7 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
     seed = hash_u32(seed ^ 0xad5a3c1bu); // independent of the pilot's pattern
   }
   uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, seed);
+  SobolPixel sobol = camera_sobol_pixel(x, y, seed);
   uint first = frame.sampling.x;
   float weight = 1.0f;
   // One sample for all where none can differ. A shorter loop rather than a
@@ -449,7 +469,8 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
   }
   uint s = first;
   do {
-    SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern), s, count, pixel_pattern);
+    SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern, sobol), s, count,
+                                  pixel_pattern);
     accumulate_sample(r, weight, camera, has_plate, acc_mixed, acc_real, acc_aux);
   } while (++s < end);
 }

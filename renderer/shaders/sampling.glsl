@@ -111,11 +111,12 @@ vec2 sample_dimension(uint s, uint n, uint pixel_pattern, uint dimension) {
 
 // The low-discrepancy alternative for the camera ray (SAMPLER_SOBOL): the
 // first four dimensions of Sobol' (Joe and Kuo's direction numbers), Owen-
-// scrambled per pixel with a hash (Burley 2020, "Practical Hash-based Owen
-// Scrambling"), the pixel jitter in the first two and the aperture point in
-// the last two, so that pixel and lens are stratified jointly in 4-D rather
-// than each in 2-D. Progressive: a sample does not depend on n, and the
-// first 2^k samples of a pixel are a scrambled aligned block of the sequence.
+// scrambled with a hash (Burley 2020, "Practical Hash-based Owen
+// Scrambling") and shifted by a key of each pixel's (SobolPixel, below),
+// the pixel jitter in the first two and the aperture point in the last two,
+// so that pixel and lens are stratified jointly in 4-D rather than each in
+// 2-D. Progressive: a sample does not depend on n, and the first 2^k
+// samples of a pixel are a scrambled aligned block of the sequence.
 
 // Sobol' dimensions 1, 2 and 3 of sample i, as 32-bit fixed point
 // (dimension 0 is the bit reversal of i): the XOR of the direction numbers
@@ -205,19 +206,111 @@ uint nested_uniform_scramble(uint x, uint seed) {
   return bitfieldReverse(laine_karras_permutation(bitfieldReverse(x), seed));
 }
 
-// Sample s of the pixel pattern p as a point of [0, 1)^4: x, y the pixel
-// jitter, z, w the aperture. The index is scrambled too (Burley's shuffle),
-// which keeps aligned blocks aligned and decorrelates neighbouring pixels.
-vec4 sobol_owen_4d(uint s, uint p) {
-  uint i = nested_uniform_scramble(s, hash_u32(p ^ 0x3c6ef372u));
-  float scale = 1.0f / 4294967296.0f;
+// The pixel's index on a Z-order (Morton) curve: the bits of x and y
+// (each below 2^16) interleaved, so that every aligned run of 4^j indices
+// is an aligned 2^j x 2^j block of pixels.
+uint morton_index(uint x, uint y) {
+  uvec2 v = uvec2(x, y) & uvec2(0xffffu);
+  v = (v | (v << 8u)) & uvec2(0x00ff00ffu);
+  v = (v | (v << 4u)) & uvec2(0x0f0f0f0fu);
+  v = (v | (v << 2u)) & uvec2(0x33333333u);
+  v = (v | (v << 1u)) & uvec2(0x55555555u);
+  return v.x | (v.y << 1u);
+}
+
+// What one pixel's Sobol' samples are made of in one pass: the scramble
+// every pixel shares, and the pixel's own digital shift (an XOR of each
+// dimension's bits).
+//
+// A pixel's points are the pass's Owen-scrambled sequence shifted by its
+// own key: an XOR maps every dyadic box onto one of the same size, so each
+// pixel's first 2^k samples are as stratified as an Owen-scrambled net
+// (and, the scramble being random, distributed as one), and sample i is
+// still the same whatever the count (progressive). Across pixels, the keys
+// are themselves Sobol' points taken in Z order (Ahmed and Wonka 2020,
+// "Screen-Space Blue-Noise Diffusion of Monte Carlo Sampling Error via
+// Hierarchical Ordering of Pixels"), so that sample i of the pixels of any
+// aligned 2^j x 2^j block, the same sequence point shifted by each key, is
+// a stratified set of 4^j points: one ray a pixel lands on 4^j different
+// parts of the aperture, where independent pixels' rays clump. A blur
+// circle's pixels, which the reconstruction averages (defocus_filter.h),
+// take in parts of several such blocks: their rays are spread over the
+// aperture rather than stratified exactly, and only where the pixels are
+// at the same sample index (a fresh frame, or a history whose pixels took
+// alike shares). Like Heitz et al.'s (2019) per-pixel XOR keys, built here
+// rather than optimized.
+struct SobolPixel {
+  uint seed;   // the pass's: its index shuffle and Owen scrambles
+  uvec4 shift; // the pixel's key: jitter x, y, aperture u, v
+};
+
+// Sobol' dimension 1 of index i, bit-reversed: i through the Pascal matrix
+// mod 2, whose columns are the dimension's direction numbers. By Lucas'
+// theorem bit k of i reaches bit j of the value where j's bits are among
+// k's, so the product is a sum over bit supersets: five shifts, where
+// sobol_u32_123 loops over i's bits.
+uint sobol_reversed_dimension_1(uint i) {
+  i ^= (i >> 1u) & 0x55555555u;
+  i ^= (i >> 2u) & 0x33333333u;
+  i ^= (i >> 4u) & 0x0f0f0f0fu;
+  i ^= (i >> 8u) & 0x00ff00ffu;
+  i ^= (i >> 16u) & 0x0000ffffu;
+  return i;
+}
+
+// Sobol' dimensions 0 and 1 of index i as 32-bit fixed point, each Owen-
+// scrambled with its own seed: nested_uniform_scramble(), whose first step
+// is a reversal, of values found reversed (dimension 0 reversed is i).
+uvec2 sobol_owen_2d(uint i, uint seed) {
+  return uvec2(
+      bitfieldReverse(laine_karras_permutation(i, hash_u32(seed + 0x2545f491u))),
+      bitfieldReverse(
+          laine_karras_permutation(sobol_reversed_dimension_1(i), hash_u32(seed + 0x9e3779b9u))));
+}
+
+SobolPixel sobol_pixel_for(uint x, uint y, uint seed) {
+  uint z = morton_index(x, y);
+  SobolPixel pixel;
+  pixel.seed = seed;
+  // The Z order shuffled as a tree (Burley's index scramble keeps aligned
+  // runs aligned), once for the jitter's keys and once for the aperture's,
+  // so that which quarter of a block takes which pair of strata changes
+  // with the pass, and the pixel and aperture strata pair differently.
+  uvec2 jitter = sobol_owen_2d(nested_uniform_scramble(z, hash_u32(seed ^ 0x1b873593u)),
+                               hash_u32(seed ^ 0xcc9e2d51u));
+  uvec2 aperture = sobol_owen_2d(nested_uniform_scramble(z, hash_u32(seed ^ 0xe6546b64u)),
+                                 hash_u32(seed ^ 0x27d4eb2fu));
+  pixel.shift = uvec4(jitter, aperture);
+  return pixel;
+}
+
+// Sample s of a pass's sequence, before the pixels' keys, as 32-bit fixed
+// point. The index is shuffled (Burley's shuffle keeps aligned blocks
+// aligned), the same for every pixel, so that sample s of every pixel is
+// one point of the sequence under the pixels' keys.
+uvec4 sobol_scrambled_point(uint s, uint seed) {
+  uint i = nested_uniform_scramble(s, hash_u32(seed ^ 0x3c6ef372u));
   uvec3 d123 = sobol_u32_123(i);
-  float x = float(nested_uniform_scramble(bitfieldReverse(i), hash_u32(p + 0x9e3779b9u)) >> 8u);
-  float y = float(nested_uniform_scramble(d123.x, hash_u32(p + 0x7f4a7c15u)) >> 8u);
-  float z = float(nested_uniform_scramble(d123.y, hash_u32(p + 0xf39cc060u)) >> 8u);
-  float w = float(nested_uniform_scramble(d123.z, hash_u32(p + 0x5ced1fb7u)) >> 8u);
+  return uvec4(nested_uniform_scramble(bitfieldReverse(i), hash_u32(seed + 0x9e3779b9u)),
+               nested_uniform_scramble(d123.x, hash_u32(seed + 0x7f4a7c15u)),
+               nested_uniform_scramble(d123.y, hash_u32(seed + 0xf39cc060u)),
+               nested_uniform_scramble(d123.z, hash_u32(seed + 0x5ced1fb7u)));
+}
+
+#ifndef CAMHEAD_SOBOL_PASS_TABLE
+// The GPU makes each point where a pixel needs it; the CPU reference reads
+// a pass's points from a table made once (cpu_kernel.h defines the macro
+// and its own sobol_pass_point).
+uvec4 sobol_pass_point(uint s, uint seed) {
+  return sobol_scrambled_point(s, seed);
+}
+#endif
+
+// Sample s of a pixel as a point of [0, 1)^4: x, y the pixel jitter, z, w
+// the aperture.
+vec4 sobol_owen_4d(uint s, SobolPixel pixel) {
   // 24 bits each, so that the float is exact and below 1.
-  return vec4(x, y, z, w) * (256.0f * scale);
+  return vec4((sobol_pass_point(s, pixel.seed) ^ pixel.shift) >> 8u) * (1.0f / 16777216.0f);
 }
 
 // Shirley-Chiu concentric map: keeps the square's strata as disk strata.

@@ -49,6 +49,9 @@ constexpr std::uint32_t kPilotSamples = 4;
 constexpr std::size_t kStoredFrames = 2;
 // The most threads that move the kept samples at once (bands of rows).
 constexpr int kMostBands = 8;
+// The pass's Sobol' points made once (cpu_kernel.h): as many as a history
+// of the default 256 samples, four times over.
+constexpr std::size_t kSobolPoints = 1024;
 
 class CpuFrameRenderer final : public FrameRenderer {
 public:
@@ -61,7 +64,8 @@ public:
         row_pixels_(std::size_t(std::max(scene_.render.height, 0))), shares_(pixels_, 0u),
         sigma_(pixels_, 0.0f), noise_(pixels_, 0.0f), filtered_mixed_(pixels_),
         filtered_real_(pixels_), scratch_mixed_(pixels_), scratch_real_(pixels_),
-        filter_gaussian_(pixels_), scratch_weight_(pixels_), blur_(pixels_) {
+        filter_gaussian_(pixels_), scratch_weight_(pixels_), blur_(pixels_),
+        sobol_points_(kSobolPoints) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 2 != 0 || h % 2 != 0)
@@ -153,6 +157,7 @@ public:
     cpu::set_cpu_frame(kernel_, compiled_, frame);
     if (request.accumulation.enabled) // every sample traced on its own: see trace_pixel
       kernel_.frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
+    give_kernel_the_sobol_points(frame);
 
     Clock::time_point start = Clock::now();
     if (!continues) {
@@ -415,8 +420,9 @@ private:
     const gpu::FrameParams &f = kernel.frame;
     const glm::vec3 pupil(f.cam_position), right(f.cam_right), up(f.cam_up), forward(f.cam_forward);
     const std::uint32_t pattern = kernel.pixel_pattern_for(x, y, f.image.x, f.sampling.w);
+    const cpu::CpuKernel::SobolPixel sobol = kernel.camera_sobol_pixel(x, y, f.sampling.w);
     for (std::uint32_t s = f.sampling.x; s < f.sampling.y; ++s) {
-      const cpu::CpuKernel::Ray ray = kernel.camera_ray(x, y, s, f.sampling.z, pattern);
+      const cpu::CpuKernel::Ray ray = kernel.camera_ray(x, y, s, f.sampling.z, pattern, sobol);
       const cpu::CpuKernel::SampleResult r = kernel.trace_sample(ray, s, f.sampling.z, pattern);
       kernel.accumulate_sample(r, 1.0f, plate_[i], has_plate, mixed_[i], real_[i], aux_[i]);
       const float along = glm::dot(ray.dir, forward);
@@ -472,6 +478,25 @@ private:
     for (int b = 0; b < bands; ++b)
       total += given[std::size_t(b)];
     return total;
+  }
+
+  // The pass's Sobol' points for the kernel, made again only for a new
+  // seed or a longer pattern (a history's seed stays while it goes on).
+  void give_kernel_the_sobol_points(const gpu::FrameParams &frame) {
+    kernel_.sobol_points = nullptr;
+    kernel_.sobol_points_count = 0;
+    if (frame.tracing.z != SAMPLER_SOBOL)
+      return;
+    const auto count = std::uint32_t(std::min<std::size_t>(frame.sampling.z, kSobolPoints));
+    if (frame.sampling.w != sobol_points_seed_ || count > sobol_points_count_) {
+      for (std::uint32_t s = 0; s < count; ++s)
+        sobol_points_[s] = kernel_.sobol_scrambled_point(s, frame.sampling.w);
+      sobol_points_seed_ = frame.sampling.w;
+      sobol_points_count_ = count;
+    }
+    kernel_.sobol_points = sobol_points_.data();
+    kernel_.sobol_points_count = sobol_points_count_;
+    kernel_.sobol_points_seed = sobol_points_seed_;
   }
 
   // Samples [first, end) of the region's pixels into the accumulators.
@@ -531,7 +556,9 @@ private:
   // The strength whose means filtered_* hold, of the accumulators as the
   // last frame left them; none where it did not reconstruct.
   std::optional<double> filtered_strength_;
-  bool region_kind_ = true; // the region's: request.influence_region
+  bool region_kind_ = true;              // the region's: request.influence_region
+  std::vector<glm::uvec4> sobol_points_; // the pass's, for the kernel
+  std::uint32_t sobol_points_seed_ = 0, sobol_points_count_ = 0;
 };
 
 } // namespace

@@ -74,7 +74,24 @@ struct CpuKernel {
   // instruction (bsf or tzcnt). Found by class scope before glm's.
   static constexpr int findLSB(uint x) { return x == 0u ? -1 : std::countr_zero(x); }
 
+  // A pass's Sobol' points, before the pixels' keys (sampling.glsl): every
+  // pixel takes the same point at sample s, so the frame renderer makes
+  // them once for the pass of seed `sobol_points_seed` rather than once a
+  // pixel, which at one ray a pixel saves about what the keys cost
+  // (bench/RESULTS.md, "Sobol' keys in Z order"). Past the table, or in
+  // another pass (the adaptive second pass), the kernel makes its own.
+  const glm::uvec4 *sobol_points = nullptr;
+  uint sobol_points_count = 0;
+  uint sobol_points_seed = 0;
+  [[nodiscard]] glm::uvec4 sobol_pass_point(uint s, uint seed) {
+    if (s < sobol_points_count && seed == sobol_points_seed)
+      return sobol_points[s];
+    return sobol_scrambled_point(s, seed);
+  }
+
+#define CAMHEAD_SOBOL_PASS_TABLE
 #include "kernel.glsl"
+#undef CAMHEAD_SOBOL_PASS_TABLE
 };
 
 static_assert(CpuKernel::bitfieldReverse(0x00000001u) == 0x80000000u);
