@@ -58,7 +58,8 @@ void make_block_rays(CpuKernel &kernel, int bx, int by, std::vector<RTCRayHit> &
                                           kernel.frame.sampling.w)
                : 0u;
     const CpuKernel::SobolPixel sobol =
-        kernel.camera_sobol_pixel(uint32_t(x), uint32_t(y), kernel.frame.sampling.w);
+        inside ? kernel.camera_sobol_pixel(uint32_t(x), uint32_t(y), kernel.frame.sampling.w)
+               : CpuKernel::SobolPixel{};
     for (uint32_t s = 0; s < n; ++s) {
       RTCRayHit &rh = rays[s * kBlock * kBlock + lane];
       if (inside) {

@@ -451,7 +451,6 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
     seed = hash_u32(seed ^ 0xad5a3c1bu); // independent of the pilot's pattern
   }
   uint pixel_pattern = pixel_pattern_for(x, y, frame.image.x, seed);
-  SobolPixel sobol = camera_sobol_pixel(x, y, seed);
   uint first = frame.sampling.x;
   float weight = 1.0f;
   // One sample for all where none can differ. A shorter loop rather than a
@@ -467,6 +466,7 @@ void trace_pixel(uint x, uint y, vec4 camera, bool has_plate, INOUT(vec4) acc_mi
   if (first >= end) {
     return;
   }
+  SobolPixel sobol = camera_sobol_pixel(x, y, seed);
   uint s = first;
   do {
     SampleResult r = trace_sample(camera_ray(x, y, s, count, pixel_pattern, sobol), s, count,

@@ -298,9 +298,9 @@ uvec4 sobol_scrambled_point(uint s, uint seed) {
 }
 
 #ifndef CAMHEAD_SOBOL_PASS_TABLE
-// The GPU makes each point where a pixel needs it; the CPU reference reads
-// a pass's points from a table made once (cpu_kernel.h defines the macro
-// and its own sobol_pass_point).
+// The GPU makes each point where a pixel needs it; the CPU frame renderer
+// makes a pass's points once and the kernel reads them (cpu_kernel.h
+// defines the macro and its own sobol_pass_point).
 uvec4 sobol_pass_point(uint s, uint seed) {
   return sobol_scrambled_point(s, seed);
 }

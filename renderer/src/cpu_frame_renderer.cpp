@@ -480,20 +480,21 @@ private:
     return total;
   }
 
-  // The pass's Sobol' points for the kernel, made again only for a new
-  // seed or a longer pattern (a history's seed stays while it goes on).
+  // The pass's Sobol' points for the kernel: made for a new seed, and only
+  // the new ones for a longer pattern (a history's seed stays while it
+  // goes on).
   void give_kernel_the_sobol_points(const gpu::FrameParams &frame) {
     kernel_.sobol_points = nullptr;
     kernel_.sobol_points_count = 0;
     if (frame.tracing.z != SAMPLER_SOBOL)
       return;
     const auto count = std::uint32_t(std::min<std::size_t>(frame.sampling.z, kSobolPoints));
-    if (frame.sampling.w != sobol_points_seed_ || count > sobol_points_count_) {
-      for (std::uint32_t s = 0; s < count; ++s)
-        sobol_points_[s] = kernel_.sobol_scrambled_point(s, frame.sampling.w);
-      sobol_points_seed_ = frame.sampling.w;
-      sobol_points_count_ = count;
-    }
+    if (frame.sampling.w != sobol_points_seed_)
+      sobol_points_count_ = 0;
+    for (std::uint32_t s = sobol_points_count_; s < count; ++s)
+      sobol_points_[s] = kernel_.sobol_scrambled_point(s, frame.sampling.w);
+    sobol_points_seed_ = frame.sampling.w;
+    sobol_points_count_ = std::max(sobol_points_count_, count);
     kernel_.sobol_points = sobol_points_.data();
     kernel_.sobol_points_count = sobol_points_count_;
     kernel_.sobol_points_seed = sobol_points_seed_;

@@ -107,6 +107,31 @@ TEST(SobolKeys, EachPixelsFirstSamplesAreStratifiedWhateverTheirCount) {
     }
 }
 
+// The CPU frame renderer hands the kernel a pass's points made once
+// (cpu_kernel.h); read from the table or made where they are needed (past
+// it, or in a pass of another seed), a pixel's samples are the same.
+TEST(SobolKeys, APassesPointsFromTheTableAreThoseMadeWhereNeeded) {
+  constexpr std::uint32_t kSeed = 77, kTable = 16;
+  CpuKernel making;
+  std::vector<glm::uvec4> table(kTable);
+  for (std::uint32_t s = 0; s < kTable; ++s)
+    table[s] = making.sobol_scrambled_point(s, kSeed);
+  CpuKernel reading;
+  reading.sobol_points = table.data();
+  reading.sobol_points_count = kTable;
+  reading.sobol_points_seed = kSeed;
+  for (const std::uint32_t seed : {kSeed, kSeed + 1})
+    for (std::uint32_t s = 0; s < 2 * kTable; ++s) {
+      const CpuKernel::SobolPixel keys = making.sobol_pixel_for(5, 9, seed);
+      EXPECT_EQ(reading.sobol_owen_4d(s, keys), making.sobol_owen_4d(s, keys))
+          << "seed " << seed << ", sample " << s;
+    }
+  // A table that is not the pass's would show: one point altered is read.
+  table[3] = glm::uvec4(0u);
+  const CpuKernel::SobolPixel keys = making.sobol_pixel_for(5, 9, kSeed);
+  EXPECT_NE(reading.sobol_owen_4d(3, keys), making.sobol_owen_4d(3, keys));
+}
+
 // Unbiased: over passes (seeds), a pixel's first ray is uniform over the
 // aperture, whatever its place in the Z order; and the keys themselves,
 // which the shared scramble would hide, favour no part of it either. A
