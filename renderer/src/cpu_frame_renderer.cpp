@@ -64,7 +64,7 @@ public:
         row_pixels_(std::size_t(std::max(scene_.render.height, 0))), shares_(pixels_, 0u),
         sigma_(pixels_, 0.0f), noise_(pixels_, 0.0f), filtered_mixed_(pixels_),
         filtered_real_(pixels_), scratch_mixed_(pixels_), scratch_real_(pixels_),
-        filter_gaussian_(pixels_), scratch_weight_(pixels_), blur_(pixels_),
+        scratch_weight_(pixels_), blur_(pixels_), filter_gaussian_(pixels_),
         sobol_points_(kSobolPoints) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
@@ -251,7 +251,7 @@ public:
       settings.strength = request.accumulation.reconstruct_strength;
       cpu::filter_defocus(kernel_.frame, spans_, mixed_, real_, aux_, history_counts_, settings,
                           {filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_,
-                           filter_gaussian_, scratch_weight_, blur_},
+                           scratch_weight_, blur_, filter_gaussian_},
                           pool_);
     }
     filtered_strength_ =
@@ -551,9 +551,9 @@ private:
   std::vector<std::uint32_t> shares_;     // this frame's rays per pixel
   std::vector<float> sigma_, noise_;      // each pixel's noise, for the shares
   // The reconstruction's means and passes (defocus_filter.h).
-  std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_,
-      filter_gaussian_;
+  std::vector<glm::vec4> filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_;
   std::vector<float> scratch_weight_, blur_;
+  std::vector<cpu::DefocusGaussian> filter_gaussian_;
   // The strength whose means filtered_* hold, of the accumulators as the
   // last frame left them; none where it did not reconstruct.
   std::optional<double> filtered_strength_;

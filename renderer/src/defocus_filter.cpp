@@ -25,16 +25,6 @@ using std::abs; // fabs, as GLSL's; found before glm's x >= 0 ? x : -x
 
 namespace {
 
-// A pixel's Gaussian as both passes walk it (found once, in the first):
-// the weight of the nearest neighbours, the ratio of the next ones' to
-// theirs, that ratio's own ratio (exp(f (k+1)^2) = exp(f k^2) exp(f (2k +
-// 1)): three exponentials a pixel for every neighbour), and how many
-// pixels either side it reaches (0: the pixel keeps its own samples).
-struct Gaussian {
-  float weight = 0.0f, ratio = 0.0f, ratio_step = 0.0f;
-  int reach = 0;
-};
-
 // What one pass adds to a pixel: the neighbours at +-1 .. +-reach steps of
 // `step` elements (at most `before` steps back and `after` on), those with
 // samples and with alike blur circles, with Gaussian weights. The
@@ -44,7 +34,7 @@ struct Gaussian {
 // pointer and stored every sum at each neighbour, and the filter took 1.4
 // times as long (bench/RESULTS.md).
 template <typename Weight>
-void gather(std::size_t i, const Gaussian &g, int before, int after, std::ptrdiff_t step,
+void gather(std::size_t i, const DefocusGaussian &g, int before, int after, std::ptrdiff_t step,
             const float *blur, const std::uint32_t *counts, const glm::vec4 *m_in,
             const glm::vec4 *r_in, const Weight *n_in, glm::vec4 &m, glm::vec4 &r, float &n) {
   float w = g.weight;
@@ -107,10 +97,10 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const float sigma =
         rules::reconstruct_sigma_of(buffers.blur[i], float(counts[i]), strength, max_reach);
     if (!(sigma >= settings.min_sigma_px))
-      return Gaussian{};
+      return DefocusGaussian{};
     const float falloff = -0.5f / (sigma * sigma);
-    return Gaussian{std::exp(falloff), std::exp(3.0f * falloff), std::exp(2.0f * falloff),
-                    rules::reconstruct_reach_of(sigma, max_reach)};
+    return DefocusGaussian{std::exp(falloff), std::exp(3.0f * falloff), std::exp(2.0f * falloff),
+                           rules::reconstruct_reach_of(sigma, max_reach)};
   };
 
   // Neighbours whose blur circles are alike (reconstruct_blurs_alike) keep a
@@ -126,8 +116,8 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const Gaussian g = gaussian_of(i);
-      buffers.gaussian[i] = glm::vec4(g.weight, g.ratio, g.ratio_step, float(g.reach));
+      const DefocusGaussian g = gaussian_of(i);
+      buffers.gaussian[i] = g;
       glm::vec4 m = mixed[i], r = real[i];
       float n = float(count[i]);
       gather(i, g, int(x), width - 1 - int(x), 1, blur, count, mixed.data(), real.data(), count, m,
@@ -144,8 +134,7 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      const glm::vec4 &found = buffers.gaussian[i];
-      const Gaussian g{found.x, found.y, found.z, int(found.w)};
+      const DefocusGaussian g = buffers.gaussian[i];
       glm::vec4 m = buffers.scratch_mixed[i], r = buffers.scratch_real[i];
       float n = buffers.scratch_weight[i];
       gather(i, g, int(s.y), height - 1 - int(s.y), width, blur, count,

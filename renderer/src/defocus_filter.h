@@ -45,6 +45,16 @@ struct DefocusFilterSettings {
   int max_radius_px = 16;     // the widest reach of a pass: 2 sigma, at most
 };
 
+// A pixel's Gaussian as both passes walk it, found once in the first: the
+// weight of the nearest neighbours, the ratio of the next ones' to theirs,
+// that ratio's own ratio (exp(f (k+1)^2) = exp(f k^2) exp(f (2k + 1)):
+// three exponentials a pixel for every neighbour), and how many pixels
+// either side it reaches (0: the pixel keeps its own samples).
+struct DefocusGaussian {
+  float weight = 0.0f, ratio = 0.0f, ratio_step = 0.0f;
+  int reach = 0;
+};
+
 // Sums in, means out: `mixed`, `real` are the accumulators (sums of
 // `counts` samples, layout.h), `aux` holds the depth sum and hit count;
 // writes each span pixel's filtered means to `out_mixed`, `out_real`, with
@@ -52,8 +62,9 @@ struct DefocusFilterSettings {
 // passes between.
 struct DefocusFilterBuffers {
   std::span<glm::vec4> out_mixed, out_real;
-  std::span<glm::vec4> scratch_mixed, scratch_real, gaussian;
+  std::span<glm::vec4> scratch_mixed, scratch_real;
   std::span<float> scratch_weight, blur;
+  std::span<DefocusGaussian> gaussian;
 };
 
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
