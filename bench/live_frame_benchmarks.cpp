@@ -1,7 +1,7 @@
 // A live frame of the simulated rig as `camhead run` renders it: the
 // FrameRenderer of scenes/sim_rig.json at 720x576, a YUYV camera frame in and
 // a YUYV composite out, 1 ray per pixel (where the rig's frame budget sits on
-// two cores), the lens pulling focus from frame to frame. This is the work
+// two cores; far_fresh 2), the lens pulling focus from frame to frame. This is the work
 // the run loop's render thread does, without the simulated camera, the lens
 // thread and the outputs beside it, so that a change to the kernel, the
 // region or the conversions can be measured in seconds rather than in a
@@ -64,7 +64,10 @@ std::vector<std::uint8_t> camera_frame(const base::VideoFormat &format) {
 // from about the 8th frame on, few rays or none a frame); and a new history
 // every frame at the near end of the pull, as a moving camera's frames are,
 // reconstructed and not (near_fresh, near_fresh_raw: where the
-// reconstruction costs the most, its blur circles 20 pixels wide).
+// reconstruction costs the most, its blur circles 20 pixels wide); and a
+// new history every frame focused far, at the 2 rays a pixel that the rig's
+// budget gives such frames (far_fresh: where the first frame gives its
+// sharp pixels' rays by their neighbours' spread, ray_shares.h).
 enum class Method {
   fresh,
   pull,
@@ -73,8 +76,13 @@ enum class Method {
   still_raw,
   still_capped,
   near_fresh,
-  near_fresh_raw
+  near_fresh_raw,
+  far_fresh
 };
+
+std::uint32_t rays_per_pixel(Method method) {
+  return method == Method::far_fresh ? 2u : 1u;
+}
 
 void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
   const renderer::Scene scene = sim_rig_scene();
@@ -96,11 +104,12 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
 
   renderer::FrameRequest request;
   request.camera = renderer::scene_camera(scene);
-  request.rays_per_pixel = 1;
+  request.rays_per_pixel = rays_per_pixel(method);
   request.influence_region = region;
   const bool near = method == Method::near_fresh || method == Method::near_fresh_raw;
+  const bool far = method == Method::far_fresh;
   request.accumulation.enabled = method != Method::fresh;
-  request.accumulation.reproject = method != Method::pull_afresh && !near;
+  request.accumulation.reproject = method != Method::pull_afresh && !near && !far;
   request.accumulation.reconstruct =
       method != Method::still_raw && method != Method::near_fresh_raw;
   if (method == Method::still_capped)
@@ -118,6 +127,8 @@ void live_frame(benchmark::State &state, bool gpu, bool region, Method method) {
     request.camera.focus_distance_m = float(1.0 / (1.0 / 14.0 + t * (1.0 / 0.4 - 1.0 / 14.0)));
     if (near) // 0.40 and 0.41 m in turn: a blur change far past the tolerance
       request.camera.focus_distance_m = frame % 2 == 0 ? 0.40f : 0.41f;
+    if (far) // 14 and 10 m in turn: the same
+      request.camera.focus_distance_m = frame % 2 == 0 ? 14.0f : 10.0f;
     request.seed = std::uint32_t(++frame * 2654435761u) | 1u;
     const renderer::FrameReport report = frames->render(request, {format, plate}, outputs);
     if (report.status != renderer::FrameStatus::ok) {
@@ -139,7 +150,7 @@ void register_live_frame_benchmarks() {
     for (const bool region : {true, false})
       for (const Method method :
            {Method::fresh, Method::pull, Method::pull_afresh, Method::still, Method::still_raw,
-            Method::still_capped, Method::near_fresh, Method::near_fresh_raw}) {
+            Method::still_capped, Method::near_fresh, Method::near_fresh_raw, Method::far_fresh}) {
         if (method != Method::fresh && !region)
           continue; // a history is kept over the region
         if (method == Method::pull_afresh && gpu)
@@ -151,14 +162,16 @@ void register_live_frame_benchmarks() {
                            : method == Method::still_raw    ? "live_still_raw"
                            : method == Method::still_capped ? "live_still_capped"
                            : method == Method::near_fresh   ? "live_near_fresh"
+                           : method == Method::far_fresh    ? "live_far_fresh"
                                                             : "live_near_fresh_raw";
-        benchmark::RegisterBenchmark((std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
-                                      "/sim_rig/720x576/rpp:1/" +
-                                      (region ? "region" : "every_pixel") + "/" + name)
-                                         .c_str(),
-                                     [gpu, region, method](benchmark::State &state) {
-                                       live_frame(state, gpu, region, method);
-                                     })
+        benchmark::RegisterBenchmark(
+            (std::string("LiveFrame/") + (gpu ? "gpu" : "cpu") +
+             "/sim_rig/720x576/rpp:" + std::to_string(rays_per_pixel(method)) + "/" +
+             (region ? "region" : "every_pixel") + "/" + name)
+                .c_str(),
+            [gpu, region, method](benchmark::State &state) {
+              live_frame(state, gpu, region, method);
+            })
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime()
             ->MinTime(2.0);

@@ -145,6 +145,7 @@ public:
         history_ = frame;
         history_valid_ = true;
         history_by_noise_ = request.accumulation.share_by_noise;
+        history_first_rest_ = 0;
         history_uniform_ = 0;
         history_rays_ = 0;
         history_frames_ = 0;
@@ -217,6 +218,15 @@ public:
       if (reprojects && uniform_share_ > 0)
         kept = store_.add_frame(kernel_.frame, *region_, report.camera_rays);
       trace_shares(has_plate, kept);
+      if (first_frame_rest_ > 0) {
+        const cpu::FirstFrameShared rest = share_first_frame_rest(request, has_plate);
+        report.camera_rays += rest.rays;
+        trace_shares(has_plate, {});
+        if (rest.by_spread) {
+          history_all_uniform_ = false; // its pixels hold counts of their own
+          history_first_rest_ = first_frame_rest_;
+        }
+      }
       history_rays_ += report.camera_rays;
       report.history_samples =
           std::uint32_t(history_rays_ / std::max<std::uint64_t>(region_->pixels(), 1));
@@ -247,9 +257,8 @@ public:
                       *filtered_strength_ == request.accumulation.reconstruct_strength;
     filtered_strength_.reset(); // until the means are whole again
     if (filtered && !kept) {
-      cpu::DefocusFilterSettings settings;
-      settings.strength = request.accumulation.reconstruct_strength;
-      cpu::filter_defocus(kernel_.frame, spans_, mixed_, real_, aux_, history_counts_, settings,
+      cpu::filter_defocus(kernel_.frame, spans_, mixed_, real_, aux_, history_counts_,
+                          filter_settings(request),
                           {filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_,
                            scratch_weight_, blur_, filter_gaussian_},
                           pool_);
@@ -354,7 +363,8 @@ private:
 
   // An accumulating frame's rays, pixel by pixel (shares_), within the
   // frame's budget of rays_per_pixel for each pixel of the region; returns
-  // their sum. The first kPilotSamples of a history go to every pixel alike;
+  // their sum. The first kPilotSamples of a history go to every pixel alike
+  // (but a first frame's rays after the first: share_first_frame_rest);
   // from there, with share_by_noise, where the image still lacks them
   // (ray_shares.h).
   std::uint64_t share_rays(const FrameRequest &request) {
@@ -362,10 +372,17 @@ private:
     const std::uint32_t most = request.accumulation.max_samples - pattern_base_;
     const std::uint32_t rpp = request.rays_per_pixel;
     const bool by_noise = request.accumulation.share_by_noise && history_uniform_ >= kPilotSamples;
+    // A history's first frame with nothing moved into it and more than a
+    // ray a pixel to give: a ray each here, the rest after it is traced.
+    first_frame_rest_ = request.accumulation.share_by_noise && history_frames_ == 1 &&
+                                history_rays_ == 0 && rpp > 1 && most > 1
+                            ? rpp - 1
+                            : 0;
     uniform_share_ = 0;
     history_all_uniform_ = history_all_uniform_ && !by_noise;
     if (!by_noise) {
-      const std::uint32_t k = std::min(rpp, most - std::min(most, history_uniform_));
+      const std::uint32_t k =
+          std::min(rpp - first_frame_rest_, most - std::min(most, history_uniform_));
       span_firsts_.clear();
       std::size_t first = 0;
       for (const RowSpan &span : spans_) {
@@ -381,6 +398,30 @@ private:
     return cpu::share_rays_by_noise(
         spans_, scene_.render.width, scene_.render.height, aux_, history_counts_, own_counts_, rpp,
         request.accumulation.max_samples, most, history_frames_, {sigma_, noise_, shares_}, pool_);
+  }
+
+  // A first frame's rays after its first: alike where the lens blurs, by
+  // the neighbours' spread where it is sharp (ray_shares.h).
+  cpu::FirstFrameShared share_first_frame_rest(const FrameRequest &request, bool has_plate) {
+    cpu::FirstFrameShares settings;
+    settings.rays_per_pixel = request.rays_per_pixel;
+    settings.most = request.accumulation.max_samples;
+    settings.pattern_room = request.accumulation.max_samples - pattern_base_;
+    settings.rounding_key = kernel_.frame.sampling.w ^ 0x5bd1e995u; // the frame's seed
+    return cpu::share_first_frame_rays(spans_, kernel_.frame, aux_, plate_, has_plate,
+                                       history_counts_, own_counts_, settings,
+                                       {sigma_, noise_, shares_}, pool_);
+  }
+
+  cpu::DefocusFilterSettings filter_settings(const FrameRequest &request) const {
+    cpu::DefocusFilterSettings settings;
+    settings.strength = request.accumulation.reconstruct_strength;
+    // While the frames after a first frame that gave its rays by spread give
+    // theirs alike, the pixels holding more than the alike share are its
+    // edges' (defocus_filter.h).
+    if (history_first_rest_ > 0 && history_uniform_ < kPilotSamples)
+      settings.keep_above_samples = history_uniform_ + history_first_rest_;
+    return settings;
   }
 
   std::size_t index(std::uint32_t y, std::uint32_t x) const {
@@ -545,8 +586,12 @@ private:
   // whether all of its frames shared their rays alike.
   std::uint32_t pattern_base_ = 0;
   bool history_all_uniform_ = true;
+  // The rays a pixel its first frame gave after the first, where it gave
+  // the sharp pixels' by their spread; 0 where not.
+  std::uint32_t history_first_rest_ = 0;
   std::vector<std::uint32_t> row_pixels_; // the region's pixels in each row
   std::uint32_t uniform_share_ = 0;       // this frame's rays per pixel, if alike
+  std::uint32_t first_frame_rest_ = 0;    // ... and a pixel's more, shared after
   std::vector<std::size_t> span_firsts_;  // ... and where each span's go in store_
   std::vector<std::uint32_t> shares_;     // this frame's rays per pixel
   std::vector<float> sigma_, noise_;      // each pixel's noise, for the shares

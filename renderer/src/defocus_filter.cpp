@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
@@ -68,6 +69,10 @@ void gather(std::size_t i, const DefocusGaussian &g, int before, int after, std:
 
 } // namespace
 
+float defocus_blur_px(const gpu::FrameParams &frame, const glm::vec4 &aux) {
+  return rules::reconstruct_blur(aux, frame.lens.x * frame.lens.z, 1.0f / frame.lens.y);
+}
+
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
                     std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,
                     std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,
@@ -81,12 +86,16 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   const float max_reach = float(settings.max_radius_px);
   const auto at = [width](std::uint32_t y, int x) { return std::size_t(y) * width + x; };
 
-  // Each pixel's signed blur radius at its mean depth (a miss: at infinity).
+  // Each pixel's signed blur radius at its mean depth (a miss: at infinity);
+  // NaN for a pixel that keeps its samples, which then neither borrows nor
+  // lends (no comparison with NaN passes).
   auto blur_of = [&](int k) {
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      buffers.blur[i] = rules::reconstruct_blur(aux[i], lens, inverse_focus);
+      buffers.blur[i] = counts[i] > settings.keep_above_samples
+                            ? std::numeric_limits<float>::quiet_NaN()
+                            : rules::reconstruct_blur(aux[i], lens, inverse_focus);
     }
   };
   pool.run(int(spans.size()), blur_of);

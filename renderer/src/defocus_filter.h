@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <span>
 
 #include <glm/vec4.hpp>
@@ -43,6 +44,16 @@ struct DefocusFilterSettings {
   double strength = 1.0;
   double min_sigma_px = 0.25; // below it a pixel keeps its own samples
   int max_radius_px = 16;     // the widest reach of a pass: 2 sigma, at most
+  // Pixels holding more samples than this keep their own and lend none:
+  // the edges' pixels of a history whose first frame gave its sharp pixels'
+  // rays by their neighbours' spread (ray_shares.h). They hold up to ten
+  // times their neighbours' samples, and the mean of the samples would let
+  // them stand for their neighbours. First frames of 2 rpp, `camhead bench
+  // live`, relative error focused at 14 m and at the scene: 0.0208 and
+  // 0.0189 on the moving rig's scene with them reconstructed, 0.0159 and
+  // 0.0146 left alone; 0.0375 and 0.0443 against 0.0339 and 0.0253 on the
+  // locked-off rig's (bench/RESULTS.md).
+  std::uint32_t keep_above_samples = std::numeric_limits<std::uint32_t>::max();
 };
 
 // A pixel's Gaussian as both passes walk it, found once in the first: the
@@ -66,6 +77,11 @@ struct DefocusFilterBuffers {
   std::span<float> scratch_weight, blur;
   std::span<DefocusGaussian> gaussian;
 };
+
+// A pixel's signed blur radius in pixels at the mean depth of its samples,
+// from its accumulators `aux` (depth sum and hit count; a miss: at
+// infinity): the reconstruction's rule (reconstruct_rules.glsl).
+[[nodiscard]] float defocus_blur_px(const gpu::FrameParams &frame, const glm::vec4 &aux);
 
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
                     std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,

@@ -22,6 +22,51 @@ float luminance_sigma(std::span<const glm::vec4> aux, std::span<const std::uint3
   return std::sqrt(std::max(variance, 0.0f));
 }
 
+// A first frame's pixel taking its rays alike (not sharp).
+constexpr float kAlike = -1.0f;
+// The least want of a sharp pixel: its neighbours all alike, a pixel the
+// virtual objects may still reach on another ray.
+constexpr float kSharpFloor = 0.001f;
+
+float luminance(const glm::vec4 &rgb) {
+  return 0.2126f * rgb.x + 0.7152f * rgb.y + 0.0722f * rgb.z; // as kernel.glsl's composite
+}
+
+// How many more samples a pixel may take: below `most` in all and
+// `pattern_room` of its own pattern.
+struct SampleLimits {
+  std::span<const std::uint32_t> counts, own;
+  std::uint32_t most, pattern_room;
+};
+
+// Each span pixel's share, wanted(i) rays (a double: 16 times a budget of
+// 2^28 rays a pixel would wrap 32 bits) within `limits`, rounded up or down
+// at random (a hash of the pixel and `key`) so that the shares add up to the
+// budget on average; their sum.
+template <typename Wanted>
+std::uint64_t round_shares(std::span<const PixelSpan> spans, int width, const Wanted &wanted,
+                           const SampleLimits &limits, std::uint32_t key,
+                           std::span<std::uint32_t> shares) {
+  const auto room = [](std::uint32_t limit, std::uint32_t used) {
+    return limit > used ? limit - used : 0u; // moved samples may pass a limit
+  };
+  CpuKernel hasher; // for sampling.glsl's hash_u32
+  std::uint64_t rays = 0;
+  for (const PixelSpan &span : spans)
+    for (std::size_t i = std::size_t(span.y) * std::size_t(width) + span.x0;
+         i < std::size_t(span.y) * std::size_t(width) + span.x1; ++i) {
+      const double want = wanted(i);
+      const double whole = std::floor(want);
+      const double u =
+          double(hasher.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ key)) * (1.0 / 4294967296.0);
+      const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
+      shares[i] = std::min(
+          {k, room(limits.most, limits.counts[i]), room(limits.pattern_room, limits.own[i])});
+      rays += shares[i];
+    }
+  return rays;
+}
+
 } // namespace
 
 std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
@@ -37,8 +82,6 @@ std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, i
   std::uint64_t pixels = 0;
   for (const PixelSpan &span : spans)
     pixels += span.x1 - span.x0;
-  CpuKernel hasher; // for sampling.glsl's hash_u32
-  std::uint64_t rays = 0;
   auto own_sigma = [&](int k) {
     const PixelSpan &span = spans[std::size_t(k)];
     for (std::size_t i = at(span.y, span.x0); i < at(span.y, span.x1); ++i)
@@ -78,25 +121,83 @@ std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, i
       lack_sum += lack;
     }
   const double scale = lack_sum > 0.0 ? double(pixels) * rpp / lack_sum : 0.0;
-  // A pixel's most rays a frame; in 64 bits, as a budget of 2^28 rays a
-  // pixel would wrap 32.
   const double most_a_frame = double(kMostRaysAPixel) * double(rpp);
-  const auto room = [](std::uint32_t limit, std::uint32_t used) {
-    return limit > used ? limit - used : 0u; // moved samples may pass a limit
+  const auto wanted = [&](std::size_t i) {
+    return std::min(double(buffers.noise[i]) * scale, most_a_frame);
   };
-  for (const PixelSpan &span : spans)
-    for (std::size_t i = at(span.y, span.x0); i < at(span.y, span.x1); ++i) {
-      // Rounded up or down at random (a hash of the pixel and the frame),
-      // so that the shares add up to the budget on average.
-      const double want = std::min(double(buffers.noise[i]) * scale, most_a_frame);
-      const double whole = std::floor(want);
-      const double u = double(hasher.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ frame_index)) *
-                       (1.0 / 4294967296.0);
-      const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
-      buffers.shares[i] = std::min({k, room(most, counts[i]), room(pattern_room, own[i])});
-      rays += buffers.shares[i];
+  return round_shares(spans, width, wanted, {counts, own, most, pattern_room}, frame_index,
+                      buffers.shares);
+}
+
+FirstFrameShared
+share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams &frame,
+                       std::span<const glm::vec4> aux, std::span<const glm::vec4> plate,
+                       bool has_plate, std::span<const std::uint32_t> counts,
+                       std::span<const std::uint32_t> own, const FirstFrameShares &settings,
+                       const RayShareBuffers &buffers, WorkerPool &pool) {
+  const int width = int(frame.image.x);
+  const int height = int(frame.image.y);
+  const auto at = [width](int y, int x) { return std::size_t(y) * std::size_t(width) + x; };
+  // The virtual part of each pixel's sample, in `sigma`: its composite's
+  // luminance less the camera's (0 where the virtual objects change nothing).
+  const std::span<float> virtual_part = buffers.sigma;
+  auto virtual_part_of = [&](int k) {
+    const PixelSpan &span = spans[std::size_t(k)];
+    for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i)
+      virtual_part[i] =
+          aux[i].z / float(std::max(counts[i], 1u)) - (has_plate ? luminance(plate[i]) : 0.0f);
+  };
+  pool.run(int(spans.size()), virtual_part_of);
+  // A sharp pixel's want, in `noise`: the spread of the virtual part over
+  // the traced pixels of its 3x3 neighbourhood, and a floor; kAlike for the
+  // others.
+  auto want_of = [&](int k) {
+    const PixelSpan &span = spans[std::size_t(k)];
+    const int y = int(span.y);
+    for (int x = int(span.x0); x < int(span.x1); ++x) {
+      const std::size_t i = at(y, x);
+      if (!(std::abs(defocus_blur_px(frame, aux[i])) < kSharpBlurPx)) {
+        buffers.noise[i] = kAlike;
+        continue;
+      }
+      float sum = 0.0f, squares = 0.0f, n = 0.0f;
+      for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, height - 1); ++ny)
+        for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, width - 1); ++nx) {
+          const std::size_t j = at(ny, nx);
+          if (counts[j] == 0) // not traced this frame
+            continue;
+          sum += virtual_part[j];
+          squares += virtual_part[j] * virtual_part[j];
+          n += 1.0f;
+        }
+      const float mean = sum / n; // n >= 1: the pixel itself
+      const float spread =
+          n > 1.0f ? std::sqrt(std::max(squares - n * mean * mean, 0.0f) / (n - 1.0f)) : 0.0f;
+      const float want = spread + kNoiseFloor * std::abs(virtual_part[i]) + kSharpFloor;
+      // A sample of inf or NaN must not take every other pixel's rays.
+      buffers.noise[i] = std::isfinite(want) ? want : kSharpFloor;
     }
-  return rays;
+  };
+  pool.run(int(spans.size()), want_of);
+  // The sharp pixels' rays go where their spread is.
+  double want_sum = 0.0, sharp = 0.0;
+  for (const PixelSpan &span : spans)
+    for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i)
+      if (buffers.noise[i] != kAlike) {
+        want_sum += buffers.noise[i];
+        sharp += 1.0;
+      }
+  const double rest = double(settings.rays_per_pixel - 1);
+  const double scale = want_sum > 0.0 ? sharp * rest / want_sum : 0.0;
+  const double most_a_frame = double(kMostRaysAPixel) * double(settings.rays_per_pixel);
+  const auto wanted = [&](std::size_t i) {
+    return buffers.noise[i] == kAlike ? rest
+                                      : std::min(double(buffers.noise[i]) * scale, most_a_frame);
+  };
+  const std::uint64_t rays =
+      round_shares(spans, width, wanted, {counts, own, settings.most, settings.pattern_room},
+                   settings.rounding_key, buffers.shares);
+  return {rays, sharp > 0.0};
 }
 
 } // namespace camhead::renderer::cpu

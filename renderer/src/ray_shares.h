@@ -15,6 +15,8 @@
 
 #include <glm/vec4.hpp>
 
+#include "camhead/renderer/gpu_layout.h"
+#include "defocus_filter.h"
 #include "pixel_span.h"
 #include "worker_pool.h"
 
@@ -41,5 +43,49 @@ share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
                     std::span<const std::uint32_t> own, std::uint32_t rpp, std::uint32_t most,
                     std::uint32_t pattern_room, std::uint32_t frame_index,
                     const RayShareBuffers &buffers, WorkerPool &pool);
+
+// A history's first frame, nothing moved into it, has traced one ray a pixel
+// and has rays_per_pixel - 1 more a pixel to give (every frame of a moving
+// camera is one).
+//   - Where the lens blurs a pixel by kSharpBlurPx or more, the
+//     reconstruction (defocus_filter.h) averages it with its neighbours, and
+//     those pixels take the rays alike. Given by the spread of their one-ray
+//     neighbourhoods (noise, there) they came out noisier.
+//   - Where it is sharp, little smooths it, and one ray a pixel aliases an
+//     edge. The sharp pixels share their rays by how much the picture varies
+//     about them: the spread of the virtual part of the 3x3 neighbourhood's
+//     single samples (their composite less the camera's pixel, which the
+//     composite only passes through). It is large at an edge or a shadow's
+//     rim, small where the virtual objects change nothing.
+// The gain is the scene's: on the moving rig's scene, a first frame of 2 rpp
+// focused far has 0.6 times the error it had with every pixel alike; on the
+// locked-off rig's, 1.06-1.09 times (its nearly sharp surfaces gained more
+// from the reconstruction than from rays at their edges; bench/RESULTS.md).
+// At 0.5 px the moving rig's scene focused far came out as noisy as with
+// every pixel alike, at 0.75 px with a fifth of the gain that 1 px gives.
+inline constexpr float kSharpBlurPx = 1.0f;
+
+struct FirstFrameShares {
+  std::uint32_t rays_per_pixel = 2; // the frame's, its first ray included
+  std::uint32_t most = 0;           // samples a pixel, at most (max_samples)
+  std::uint32_t pattern_room = 0;   // samples of a pixel's own pattern, at most
+  std::uint32_t rounding_key = 0;   // a new one each frame
+};
+
+struct FirstFrameShared {
+  std::uint64_t rays = 0; // the rays given
+  bool by_spread = false; // whether any pixel was sharp (else every pixel took them alike)
+};
+
+// The shares of the rays after the first for each pixel of `spans` (the
+// frame's first ray traced in each: `counts` and `own` 1), from the
+// accumulators' `aux` and `plate`, the camera frame in linear RGB
+// (has_plate): (rays_per_pixel - 1) a pixel on average.
+[[nodiscard]] FirstFrameShared
+share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams &frame,
+                       std::span<const glm::vec4> aux, std::span<const glm::vec4> plate,
+                       bool has_plate, std::span<const std::uint32_t> counts,
+                       std::span<const std::uint32_t> own, const FirstFrameShares &settings,
+                       const RayShareBuffers &buffers, WorkerPool &pool);
 
 } // namespace camhead::renderer::cpu

@@ -18,9 +18,14 @@ struct AccumulationSettings {
   std::uint32_t max_samples = 256;
   // After a few samples everywhere, give each frame's rays to the pixels
   // whose samples disagree most (the blurred edges and shadows) rather than
-  // to every pixel alike. Off, N still frames of k rays are exactly one
-  // frame of N k rays (tests/renderer/frame_history_test.cpp); on, each
-  // pixel holds its own count of samples of its own pattern.
+  // to every pixel alike; and in a history's first frame of more than a ray
+  // a pixel (nothing moved into it: a moving camera's every frame), after a
+  // ray each, give the sharp pixels' rest to those whose neighbours' rays
+  // disagree, the edges that one ray a pixel aliases
+  // (renderer/src/ray_shares.h). Off, N still frames of k rays are exactly
+  // one frame of N k rays (tests/renderer/frame_history_test.cpp); on, each
+  // pixel holds its own count of samples of its own pattern. The CPU
+  // reference's only, so far.
   bool share_by_noise = true;
   // Let each pixel borrow its neighbours' samples within a Gaussian of
   // sigma = strength sqrt(blur radius) / samples^(1/3) pixels, among
