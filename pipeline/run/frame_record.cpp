@@ -46,7 +46,8 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
       ",\"camera_rays\":%" PRIu64 ",\"history_samples\":%u,\"reprojected_samples\":%" PRIu64
       ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
-      ",\"encode_ms\":%.3f,\"executor\":%s,\"pose_source\":%s,\"pose_known\":%s,\"pose_fresh\":%s"
+      ",\"rays_ms\":%.3f,\"encode_ms\":%.3f,\"executor\":%s,\"pose_source\":%s,\"pose_known\":%s,"
+      "\"pose_fresh\":%s"
       ",\"pose\":{\"position\":[%.7g,%.7g,%.7g],\"forward\":[%.6g,%.6g,%.6g]"
       ",\"up\":[%.6g,%.6g,%.6g]},\"markers_seen\":%d,\"pose_found_by\":%s%s%s"
       ",\"reprojection_px\":%s"
@@ -56,11 +57,12 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       std::isfinite(r.focus_m) ? std::to_string(r.focus_m).c_str() : "null", r.f_number,
       r.focal_length_mm, r.lens_fresh ? "true" : "false", 1e3 * r.lens_wait_s, r.rpp, r.camera_rays,
       r.history_samples, r.reprojected_samples, r.traced, r.dropped_before, 1e3 * r.decode_s,
-      1e3 * r.trace_s, 1e3 * r.encode_s, run.executor.c_str(), run.pose_source.c_str(),
-      r.pose_known ? "true" : "false", r.pose_fresh ? "true" : "false", r.position.x, r.position.y,
-      r.position.z, r.forward.x, r.forward.y, r.forward.z, r.up.x, r.up.y, r.up.z, r.markers_seen,
-      r.pose_found_by ? "\"" : "", r.pose_found_by ? r.pose_found_by : "null",
-      r.pose_found_by ? "\"" : "", reprojection, track_ms, 1e3 * r.pose_wait_s);
+      1e3 * r.trace_s, 1e3 * r.rays_s, 1e3 * r.encode_s, run.executor.c_str(),
+      run.pose_source.c_str(), r.pose_known ? "true" : "false", r.pose_fresh ? "true" : "false",
+      r.position.x, r.position.y, r.position.z, r.forward.x, r.forward.y, r.forward.z, r.up.x,
+      r.up.y, r.up.z, r.markers_seen, r.pose_found_by ? "\"" : "",
+      r.pose_found_by ? r.pose_found_by : "null", r.pose_found_by ? "\"" : "", reprojection,
+      track_ms, 1e3 * r.pose_wait_s);
   std::fflush(out);
 }
 

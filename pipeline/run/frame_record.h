@@ -47,6 +47,7 @@ struct FrameRecord {
   double traced = 1.0;                   // the fraction of the pixels traced (the influence region)
   std::uint64_t dropped_before = 0;      // camera, render-busy and output-busy drops since the last
   double decode_s = 0.0, trace_s = 0.0, encode_s = 0.0;
+  double rays_s = 0.0; // of trace_s, tracing the rays (0: not told apart)
 };
 
 // What every composite's line of a run says alike, as JSON string values

@@ -192,6 +192,7 @@ void Pipeline::render_loop() {
     counters_.traced_permille = std::uint32_t(std::lround(1000.0 * r.traced));
     r.decode_s = report.decode_s;
     r.trace_s = report.trace_s;
+    r.rays_s = report.rays_s;
     r.encode_s = report.encode_s;
     r.history_samples = report.history_samples;
     r.reprojected_samples = report.reprojected_samples;
@@ -199,7 +200,7 @@ void Pipeline::render_loop() {
     // accumulating frames share them unevenly; a full history traces none).
     budget.measured(report.traced_pixels > 0 ? double(report.camera_rays) / report.traced_pixels
                                              : 0.0,
-                    report.decode_s + report.trace_s + report.encode_s);
+                    report.decode_s + report.trace_s + report.encode_s, report.rays_s);
     counters_.rpp = request.rays_per_pixel;
     (void)ready_slots_.push(*slot_index);
   }

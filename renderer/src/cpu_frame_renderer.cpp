@@ -209,6 +209,7 @@ public:
       history_rays_ += report.reprojected_samples;
     }
     const std::uint32_t total = frame.sampling.z;
+    const Clock::time_point rays_start = Clock::now();
     if (request.accumulation.enabled) {
       report.camera_rays = share_rays(request);
       // A frame that traces every pixel alike is kept for the frames after
@@ -248,6 +249,7 @@ public:
       for (const std::uint32_t n : counts_)
         report.camera_rays += n;
     }
+    report.rays_s = seconds_since(rays_start);
     // Reconstructed layers are means already. A frame that added no ray to
     // the history (a whole one, or one whose shares by noise all came out
     // 0) has the means of the frame before, if that one reconstructed them

@@ -17,16 +17,20 @@ FrameBudget::FrameBudget(const FrameBudgetSettings &settings)
                                 std::to_string(settings.max_rpp) + " is empty or 0");
 }
 
-void FrameBudget::measured(double rpp, double seconds) {
+void FrameBudget::measured(double rpp, double seconds, double rays_seconds) {
   if (!(rpp > 0.0) || !std::isfinite(rpp) || !(seconds > 0.0) || !std::isfinite(seconds))
     return;
-  const double per_rpp = seconds / rpp;
-  seconds_per_rpp_ = seconds_per_rpp_ == 0.0 ? per_rpp
-                                             : settings_.smoothing * per_rpp +
-                                                   (1.0 - settings_.smoothing) * seconds_per_rpp_;
+  const bool apart = rays_seconds > 0.0 && rays_seconds <= seconds;
+  const double per_rpp = (apart ? rays_seconds : seconds) / rpp;
+  const double fixed = apart ? seconds - rays_seconds : 0.0;
+  const double a = settings_.smoothing;
+  seconds_per_rpp_ = measured_ ? a * per_rpp + (1.0 - a) * seconds_per_rpp_ : per_rpp;
+  fixed_seconds_ = measured_ ? a * fixed + (1.0 - a) * fixed_seconds_ : fixed;
+  measured_ = true;
   // A frame that came out dear counts at once, not averaged away.
   const double cost = std::max(seconds_per_rpp_, per_rpp);
-  const double fits = settings_.headroom * settings_.target_s / cost;
+  const double room = settings_.headroom * settings_.target_s - std::max(fixed_seconds_, fixed);
+  const double fits = room / cost;
   const double most = std::max(rpp + 1.0, rpp * settings_.max_growth);
   const double next = std::clamp(std::floor(std::min(fits, most)), double(settings_.min_rpp),
                                  double(settings_.max_rpp));

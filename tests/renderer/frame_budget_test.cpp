@@ -79,6 +79,29 @@ TEST(FrameBudget, FollowsTheSceneWhenItGetsDearerOrCheaper) {
   EXPECT_GT(budget.rpp(), 2 * settled);
 }
 
+TEST(FrameBudget, ScalesOnlyTheRaysTimeWithTheRays) {
+  // A frame whose fixed part (the camera frame in and out, the
+  // reconstruction) is 8 ms and whose rays take 12 ms a ray a pixel: 2 rpp
+  // take 32 ms and fit 36 ms (a 40-ms frame's 0.9). Told the rays' time,
+  // the budget gives them; taking the whole frame as the rays', it finds
+  // 20 ms a ray a pixel and keeps 1.
+  Device device{.overhead_s = 0.008, .per_rpp_s = 0.012};
+  FrameBudget apart(FrameBudgetSettings{.target_s = 0.040});
+  FrameBudget all(FrameBudgetSettings{.target_s = 0.040});
+  double largest = 0.0;
+  for (int i = 0; i < 30; ++i) {
+    const double rays = device.per_rpp_s * apart.rpp();
+    const double t = device.overhead_s + rays;
+    apart.measured(apart.rpp(), t, rays);
+    all.measured(all.rpp(), device.overhead_s + device.per_rpp_s * all.rpp());
+    if (i > 0)
+      largest = std::max(largest, t);
+  }
+  EXPECT_EQ(apart.rpp(), 2u);
+  EXPECT_LE(largest, 0.036);
+  EXPECT_EQ(all.rpp(), 1u);
+}
+
 TEST(FrameBudget, StaysWithinItsRange) {
   FrameBudget fast(FrameBudgetSettings{.target_s = 1.0, .max_rpp = 64});
   Device device;

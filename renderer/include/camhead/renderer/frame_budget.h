@@ -1,18 +1,24 @@
 // Rays per pixel for a frame-time target: the budget a live frame spends,
 // uniform or adaptive, for a frame-time target.
 //
-// The cost of a frame grows with its rays per pixel, and the rate changes
-// with the scene, the lens (a wide aperture spreads rays over more of the
-// scene) and the device. FrameBudget learns the cost of one ray per pixel
-// from the frames it is told about (device time, FrameTimings::device_s, so
-// that host latency does not count) and chooses the next frame's rays per
-// pixel to fill the target:
-//   - the cost per rpp is an exponential average of the measured ones, so
-//     one noisy frame moves the budget a little, a lasting change fully;
+// The cost of a frame is a part that its rays per pixel do not change (the
+// camera frame in and the composite out, the region, the reconstruction) and
+// the rays' part, which grows with them; and the rate changes with the scene,
+// the lens (a wide aperture spreads rays over more of the scene) and the
+// device. FrameBudget learns both parts from the frames it is told about
+// (device time, FrameTimings::device_s, so that host latency does not count)
+// and chooses the next frame's rays per pixel to fill the target:
+//   - each part is an exponential average of the measured ones, so one noisy
+//     frame moves the budget a little, a lasting change fully;
 //   - a dearer frame shrinks the budget at once (a frame over target is a
 //     dropped frame), a cheaper one lets it grow by at most `max_growth`
 //     (or one rpp) over the rpp measured (a fast outlier must not make the
 //     next frame late).
+// Where a renderer does not tell the rays' time apart, the whole frame
+// counts as its rays'. Taken so on the CPU reference, README command 1 gave
+// 2 rays a pixel to 72 of its 141 frames focused beyond a metre in one run
+// (27 of 94 in another); told apart, to 114 of 141, none of them over the
+// frame time (bench/RESULTS.md).
 // Pure arithmetic on the timings it is given: testable with a made-up clock.
 #pragma once
 
@@ -40,13 +46,16 @@ public:
   // Rays per pixel for the next frame.
   [[nodiscard]] std::uint32_t rpp() const { return rpp_; }
   // A frame of `rpp` rays per pixel (a mean: an accumulating frame shares
-  // its rays unevenly) took `seconds`; ignored unless both > 0.
-  void measured(double rpp, double seconds);
+  // its rays unevenly) took `seconds`, `rays_seconds` of them tracing its
+  // rays (0: not told apart, all of it); ignored unless rpp and seconds > 0.
+  void measured(double rpp, double seconds, double rays_seconds = 0.0);
 
 private:
   FrameBudgetSettings settings_;
   std::uint32_t rpp_;
   double seconds_per_rpp_ = 0.0;
+  double fixed_seconds_ = 0.0;
+  bool measured_ = false;
 };
 
 } // namespace camhead::renderer
