@@ -226,6 +226,9 @@ public:
         if (rest.by_spread) {
           history_all_uniform_ = false; // its pixels hold counts of their own
           history_first_rest_ = first_frame_rest_;
+        } else { // every pixel took the same share
+          history_uniform_ +=
+              std::uint32_t(rest.rays / std::max<std::uint64_t>(region_->pixels(), 1));
         }
       }
       history_rays_ += report.camera_rays;
@@ -385,17 +388,31 @@ private:
     if (!by_noise) {
       const std::uint32_t k =
           std::min(rpp - first_frame_rest_, most - std::min(most, history_uniform_));
+      // After a first frame that gave its sharp pixels' rays by spread, a
+      // pixel may hold more than the others: none goes past the most.
+      const std::uint32_t max_samples = request.accumulation.max_samples;
+      const auto room = [](std::uint32_t limit, std::uint32_t used) {
+        return limit > used ? limit - used : 0u;
+      };
+      bool alike = true;
+      std::uint64_t rays = 0;
       span_firsts_.clear();
       std::size_t first = 0;
       for (const RowSpan &span : spans_) {
-        for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i)
-          shares_[i] = k;
+        for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
+          shares_[i] = history_first_rest_ == 0
+                           ? k
+                           : std::min({k, room(max_samples, history_counts_[i]),
+                                       room(most, own_counts_[i])});
+          alike = alike && shares_[i] == k;
+          rays += shares_[i];
+        }
         span_firsts_.push_back(first);
         first += std::size_t(span.x1 - span.x0) * k;
       }
       history_uniform_ += k;
-      uniform_share_ = k;
-      return region_->pixels() * k;
+      uniform_share_ = alike ? k : 0; // a frame of uneven shares is not kept (sample_store.h)
+      return rays;
     }
     return cpu::share_rays_by_noise(
         spans_, scene_.render.width, scene_.render.height, aux_, history_counts_, own_counts_, rpp,

@@ -23,6 +23,9 @@ void FrameBudget::measured(double rpp, double seconds, double rays_seconds) {
   const bool apart = rays_seconds > 0.0 && rays_seconds <= seconds;
   const double per_rpp = (apart ? rays_seconds : seconds) / rpp;
   const double fixed = apart ? seconds - rays_seconds : 0.0;
+  if (apart != apart_)
+    measured_ = false;
+  apart_ = apart;
   const double a = settings_.smoothing;
   seconds_per_rpp_ = measured_ ? a * per_rpp + (1.0 - a) * seconds_per_rpp_ : per_rpp;
   fixed_seconds_ = measured_ ? a * fixed + (1.0 - a) * fixed_seconds_ : fixed;

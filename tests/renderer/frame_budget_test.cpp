@@ -100,6 +100,10 @@ TEST(FrameBudget, ScalesOnlyTheRaysTimeWithTheRays) {
   EXPECT_EQ(apart.rpp(), 2u);
   EXPECT_LE(largest, 0.036);
   EXPECT_EQ(all.rpp(), 1u);
+  // A frame not told apart after them counts whole, with no fixed part
+  // taken off it again: 16 ms a ray a pixel, 2 rpp still fit.
+  apart.measured(2.0, device.overhead_s + 2.0 * device.per_rpp_s);
+  EXPECT_EQ(apart.rpp(), 2u);
 }
 
 TEST(FrameBudget, StaysWithinItsRange) {

@@ -541,6 +541,28 @@ TEST(FrameHistory, AFirstFrameInFocusGivesItsRaysToTheEdges) {
   EXPECT_LT(spread8, 0.9 * alike8);
 }
 
+TEST(FrameHistory, AFirstFrameSharedKeepsTheHistoryWithinItsMostSamples) {
+  // At most 8 samples a pixel: a first frame's edges, which took many, and
+  // a first frame whose rays all went alike (every pixel blurred) both stop
+  // there, whatever the frames after them give alike.
+  for (const auto &[scene, rpp] :
+       {std::pair(ball_scene(), 3u), std::pair(defocused_ball_scene(), 5u)}) {
+    Frames frames(scene);
+    FrameRequest request = still(scene, rpp, 31);
+    request.accumulation.max_samples = 8;
+    std::uint64_t rays = 0, pixels = 0;
+    FrameReport report;
+    for (int n = 0; n < 12; ++n) {
+      report = frames.render(request);
+      rays += report.camera_rays;
+      pixels = report.traced_pixels;
+    }
+    EXPECT_EQ(report.camera_rays, 0u) << rpp;
+    EXPECT_LE(rays, pixels * 8) << rpp;
+    EXPECT_LE(report.history_samples, 8u) << rpp;
+  }
+}
+
 TEST(FrameHistory, AFirstFrameBlurredEverywhereTracesItsRaysAlike) {
   // Focused at 0.3 m, every pixel is blurred by 5 to 7: the reconstruction
   // smooths them all, and a first frame shared by noise is the frame alike.

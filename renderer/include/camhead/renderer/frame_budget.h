@@ -16,9 +16,10 @@
 //     next frame late).
 // Where a renderer does not tell the rays' time apart, the whole frame
 // counts as its rays'. Taken so on the CPU reference, README command 1 gave
-// 2 rays a pixel to 72 of its 141 frames focused beyond a metre in one run
-// (27 of 94 in another); told apart, to 114 of 141, none of them over the
-// frame time (bench/RESULTS.md).
+// 2 rays a pixel to 72 of its 141 frames focused beyond a metre; told
+// apart, to 114 of 141, none of them over the frame time (bench/RESULTS.md).
+// A frame told apart after one not (or the other way) starts the averages
+// again: a whole frame's time a ray is not the rays' alone.
 // Pure arithmetic on the timings it is given: testable with a made-up clock.
 #pragma once
 
@@ -56,6 +57,7 @@ private:
   double seconds_per_rpp_ = 0.0;
   double fixed_seconds_ = 0.0;
   bool measured_ = false;
+  bool apart_ = false; // whether the averages are of frames told apart
 };
 
 } // namespace camhead::renderer

@@ -103,9 +103,10 @@ struct FrameReport {
   double decode_s = 0.0;
   double trace_s = 0.0;
   double encode_s = 0.0;
-  // Of trace_s, tracing the camera rays alone: what grows with the rays per
-  // pixel (frame_budget.h). 0 where the renderer does not tell it apart
-  // (the GPU executor, whose device time is one figure).
+  // Of trace_s, the samples' pass (their shares and tracing them): what
+  // grows with the rays per pixel (frame_budget.h). 0 where the renderer
+  // does not tell it apart (the GPU executor, whose device time is one
+  // figure).
   double rays_s = 0.0;
 };
 
