@@ -419,6 +419,12 @@ bool pixel_misses_scene(uint x, uint y) {
   return true;
 }
 
+// The luminance (Rec. 709) by which a sample's composite is weighed for
+// sharing rays (adaptive.glsl; renderer/src/ray_shares.h).
+float composite_luminance(vec3 f) {
+  return dot(f, vec3(0.2126f, 0.7152f, 0.0722f));
+}
+
 // Adds `weight` copies of sample r to the accumulators (trace_pixel).
 void accumulate_sample(SampleResult r, float weight, vec4 camera, bool has_plate,
                        INOUT(vec4) acc_mixed, INOUT(vec4) acc_real, INOUT(vec4) acc_aux) {
@@ -430,7 +436,7 @@ void accumulate_sample(SampleResult r, float weight, vec4 camera, bool has_plate
   }
   // This sample's composite (equation 4, linear in the sample).
   vec3 f = has_plate ? r.mixed + (1.0f - m) * (vec3(camera) - r.real) : r.mixed;
-  float lum = dot(f, vec3(0.2126f, 0.7152f, 0.0722f));
+  float lum = composite_luminance(f);
   acc_aux += weight * vec4(0.0f, 0.0f, lum, lum * lum);
 }
 

@@ -388,22 +388,15 @@ private:
     if (!by_noise) {
       const std::uint32_t k =
           std::min(rpp - first_frame_rest_, most - std::min(most, history_uniform_));
-      // After a first frame that gave its sharp pixels' rays by spread, a
-      // pixel may hold more than the others: none goes past the most.
-      const std::uint32_t max_samples = request.accumulation.max_samples;
-      const auto room = [](std::uint32_t limit, std::uint32_t used) {
-        return limit > used ? limit - used : 0u;
-      };
+      // No pixel goes past its pattern's end: after a first frame that gave
+      // its sharp pixels' rays by spread, they hold more than the others.
       bool alike = true;
       std::uint64_t rays = 0;
       span_firsts_.clear();
       std::size_t first = 0;
       for (const RowSpan &span : spans_) {
         for (std::size_t i = index(span.y, span.x0); i < index(span.y, span.x1); ++i) {
-          shares_[i] = history_first_rest_ == 0
-                           ? k
-                           : std::min({k, room(max_samples, history_counts_[i]),
-                                       room(most, own_counts_[i])});
+          shares_[i] = std::min(k, cpu::sample_room(most, own_counts_[i]));
           alike = alike && shares_[i] == k;
           rays += shares_[i];
         }

@@ -28,10 +28,6 @@ constexpr float kAlike = -1.0f;
 // virtual objects may still reach on another ray.
 constexpr float kSharpFloor = 0.001f;
 
-float luminance(const glm::vec4 &rgb) {
-  return 0.2126f * rgb.x + 0.7152f * rgb.y + 0.0722f * rgb.z; // as kernel.glsl's composite
-}
-
 // How many more samples a pixel may take: below `most` in all and
 // `pattern_room` of its own pattern.
 struct SampleLimits {
@@ -47,9 +43,6 @@ template <typename Wanted>
 std::uint64_t round_shares(std::span<const PixelSpan> spans, int width, const Wanted &wanted,
                            const SampleLimits &limits, std::uint32_t key,
                            std::span<std::uint32_t> shares) {
-  const auto room = [](std::uint32_t limit, std::uint32_t used) {
-    return limit > used ? limit - used : 0u; // moved samples may pass a limit
-  };
   CpuKernel hasher; // for sampling.glsl's hash_u32
   std::uint64_t rays = 0;
   for (const PixelSpan &span : spans)
@@ -60,8 +53,8 @@ std::uint64_t round_shares(std::span<const PixelSpan> spans, int width, const Wa
       const double u =
           double(hasher.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ key)) * (1.0 / 4294967296.0);
       const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
-      shares[i] = std::min(
-          {k, room(limits.most, limits.counts[i]), room(limits.pattern_room, limits.own[i])});
+      shares[i] = std::min({k, sample_room(limits.most, limits.counts[i]),
+                            sample_room(limits.pattern_room, limits.own[i])});
       rays += shares[i];
     }
   return rays;
@@ -141,11 +134,12 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
   // The virtual part of each pixel's sample, in `sigma`: its composite's
   // luminance less the camera's (0 where the virtual objects change nothing).
   const std::span<float> virtual_part = buffers.sigma;
+  CpuKernel kernel; // for kernel.glsl's composite_luminance
   auto virtual_part_of = [&](int k) {
     const PixelSpan &span = spans[std::size_t(k)];
     for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i)
-      virtual_part[i] =
-          aux[i].z / float(std::max(counts[i], 1u)) - (has_plate ? luminance(plate[i]) : 0.0f);
+      virtual_part[i] = aux[i].z / float(std::max(counts[i], 1u)) -
+                        (has_plate ? kernel.composite_luminance(glm::vec3(plate[i])) : 0.0f);
   };
   pool.run(int(spans.size()), virtual_part_of);
   // A sharp pixel's want, in `noise`: the spread of the virtual part over

@@ -23,6 +23,12 @@
 namespace camhead::renderer::cpu {
 
 inline constexpr std::uint32_t kMostRaysAPixel = 16;
+
+// How many more samples a pixel holding `used` may take below `limit`; 0
+// past it (moved samples may pass a limit).
+[[nodiscard]] constexpr std::uint32_t sample_room(std::uint32_t limit, std::uint32_t used) {
+  return limit > used ? limit - used : 0u;
+}
 // The noise floor, relative to the pixel's luminance and absolute.
 inline constexpr float kNoiseFloor = 0.01f;
 
