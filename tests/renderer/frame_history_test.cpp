@@ -13,7 +13,6 @@
 #include <memory>
 #include <random>
 #include <span>
-#include <utility>
 #include <vector>
 
 #include "camhead/base/video_format.h"
@@ -501,81 +500,6 @@ TEST(FrameHistory, SharingByNoiseConvergesFasterThanEveryPixelAlike) {
   EXPECT_LT(e_by_noise, 0.8 * e_alike);
   // The budget holds: the shares round at random, so within a few percent.
   EXPECT_NEAR(double(rays_by_noise), double(rays_alike), 0.03 * double(rays_alike));
-}
-
-// The root mean square of the errors of eight first frames of `rpp` rays,
-// each pixel alike and shared by noise, reconstructed or not.
-std::pair<double, double> first_frame_errors(const Scene &scene, const Frames &reference,
-                                             std::uint32_t rpp, bool reconstruct) {
-  double alike = 0.0, by_spread = 0.0;
-  std::uint64_t rays_alike = 0, rays_by_spread = 0;
-  for (std::uint32_t n = 0; n < 8; ++n) {
-    Frames a(scene), b(scene);
-    FrameRequest uniform = still_uniform(scene, rpp, 900 + n), shared = still(scene, rpp, 900 + n);
-    uniform.accumulation.reconstruct = shared.accumulation.reconstruct = reconstruct;
-    rays_alike += a.render(uniform).camera_rays;
-    rays_by_spread += b.render(shared).camera_rays;
-    alike += std::pow(virtual_error(a, reference), 2);
-    by_spread += std::pow(virtual_error(b, reference), 2);
-  }
-  // The budget holds: the shares round at random, so within a few percent.
-  EXPECT_NEAR(double(rays_by_spread), double(rays_alike), 0.03 * double(rays_alike));
-  return {std::sqrt(alike / 8.0), std::sqrt(by_spread / 8.0)};
-}
-
-TEST(FrameHistory, AFirstFrameInFocusGivesItsRaysToTheEdges) {
-  // At 64x48 the ball scene is sharp (blur radii under half a pixel), so a
-  // first frame, after a ray in every pixel, gives the rest by the spread of
-  // its neighbours' rays: to the ball's rim and the shadows'. Against the
-  // same rays alike: alone (4 rpp), and with the reconstruction (8 rpp;
-  // at 2 and 4 rpp this small scene's nearly sharp surfaces gain as much
-  // from the reconstruction of rays alike, as the locked-off rig's do).
-  const Scene scene = ball_scene();
-  const Frames reference = converged(scene, 77);
-  const auto [alike4, spread4] = first_frame_errors(scene, reference, 4, false);
-  const auto [alike8, spread8] = first_frame_errors(scene, reference, 8, true);
-  std::printf("[ history ] first frames in focus: error %.4f alike, %.4f by spread at 4 rpp; "
-              "%.4f and %.4f reconstructed at 8 rpp\n",
-              alike4, spread4, alike8, spread8);
-  EXPECT_LT(spread4, 0.9 * alike4);
-  EXPECT_LT(spread8, 0.9 * alike8);
-}
-
-TEST(FrameHistory, AFirstFrameSharedKeepsTheHistoryWithinItsMostSamples) {
-  // A first frame's edges, which took many rays, and a first frame whose
-  // rays all went alike (every pixel blurred) both stop at the most samples
-  // a pixel, whatever the frames after them give alike: in all, no more
-  // rays than the region's pixels times the most.
-  struct Case {
-    Scene scene;
-    std::uint32_t rpp, most;
-  };
-  for (const Case &c : {Case{ball_scene(), 3, 4}, Case{defocused_ball_scene(), 5, 8}}) {
-    Frames frames(c.scene);
-    FrameRequest request = still(c.scene, c.rpp, 31);
-    request.accumulation.max_samples = c.most;
-    std::uint64_t rays = 0, pixels = 0;
-    FrameReport report;
-    for (int n = 0; n < 12; ++n) {
-      report = frames.render(request);
-      rays += report.camera_rays;
-      pixels = report.traced_pixels;
-    }
-    EXPECT_EQ(report.camera_rays, 0u) << c.rpp;
-    EXPECT_LE(rays, pixels * c.most) << c.rpp;
-    EXPECT_LE(report.history_samples, c.most) << c.rpp;
-  }
-}
-
-TEST(FrameHistory, AFirstFrameBlurredEverywhereTracesItsRaysAlike) {
-  // Focused at 0.3 m, every pixel is blurred by 5 to 7: the reconstruction
-  // smooths them all, and a first frame shared by noise is the frame alike.
-  const Scene scene = defocused_ball_scene();
-  Frames alike(scene), by_noise(scene);
-  const FrameReport a = alike.render(still_uniform(scene, 4, 41));
-  const FrameReport b = by_noise.render(still(scene, 4, 41));
-  EXPECT_EQ(a.camera_rays, b.camera_rays);
-  EXPECT_EQ(bytes_differing(alike.out(), by_noise.out()), 0u);
 }
 
 // A tracked pose jitters: a turn of the view that moves no point by the
