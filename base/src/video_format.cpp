@@ -41,11 +41,14 @@ std::size_t row_bytes(const VideoFormat &format) {
                            : packed_stride(format.pixel, format.width);
 }
 
-std::size_t frame_bytes(const VideoFormat &format) {
+std::size_t frame_rows(const VideoFormat &format) {
   const std::size_t rows = static_cast<std::size_t>(format.height > 0 ? format.height : 0);
-  const std::size_t luma = row_bytes(format) * rows;
   // NV12's chroma plane: half the rows at the same stride.
-  return format.pixel == PixelFormat::nv12 ? luma + row_bytes(format) * ((rows + 1) / 2) : luma;
+  return format.pixel == PixelFormat::nv12 ? rows + (rows + 1) / 2 : rows;
+}
+
+std::size_t frame_bytes(const VideoFormat &format) {
+  return row_bytes(format) * frame_rows(format);
 }
 
 std::string check_video_format(const VideoFormat &format) {

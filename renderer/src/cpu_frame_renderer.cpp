@@ -10,7 +10,6 @@
 #include <array>
 #include <chrono>
 #include <cstddef>
-#include <cstring>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -64,8 +63,7 @@ public:
         row_pixels_(std::size_t(std::max(scene_.render.height, 0))), shares_(pixels_, 0u),
         sigma_(pixels_, 0.0f), noise_(pixels_, 0.0f), filtered_mixed_(pixels_),
         filtered_real_(pixels_), scratch_mixed_(pixels_), scratch_real_(pixels_),
-        scratch_weight_(pixels_), blur_(pixels_), filter_gaussian_(pixels_),
-        sobol_points_(kSobolPoints) {
+        scratch_weight_(pixels_), blur_(pixels_), filter_gaussian_(pixels_) {
     const int w = scene_.render.width;
     const int h = scene_.render.height;
     if (w <= 0 || h <= 0 || w % 2 != 0 || h % 2 != 0)
@@ -158,7 +156,7 @@ public:
     cpu::set_cpu_frame(kernel_, compiled_, frame);
     if (request.accumulation.enabled) // every sample traced on its own: see trace_pixel
       kernel_.frame.tracing.w &= ~TRACING_SKIP_EMPTY_PIXELS;
-    give_kernel_the_sobol_points(frame);
+    sobol_points_.give(kernel_, frame);
 
     Clock::time_point start = Clock::now();
     if (!continues) {
@@ -298,9 +296,9 @@ public:
     if (camera_format_only) {
       auto copy = [&](int y) {
         for (const VideoBuffer &out : outputs)
-          copy_row(plate, out, y);
+          video::copy_row(plate.format, plate.bytes, out.format, out.bytes, y);
       };
-      pool_.run(copied_rows(plate.format), copy);
+      pool_.run(int(base::frame_rows(plate.format)), copy);
       auto resolve_region = [&](int k) {
         const RowSpan &b = blocks_[std::size_t(k)];
         resolve(int(b.y), std::min(int(b.y) + 2, height), int(b.x0), int(b.x1));
@@ -333,17 +331,6 @@ private:
       return false;
     const double change = frame_change_px(history_, frame, nearest_depth_m(compiled_, history_));
     return change <= request.accumulation.tolerance_px;
-  }
-
-  // Rows of every plane (nv12's chroma rows after the luma rows).
-  static int copied_rows(const base::VideoFormat &f) {
-    return f.height + (f.pixel == base::PixelFormat::nv12 ? f.height / 2 : 0);
-  }
-
-  static void copy_row(const VideoFrame &from, const VideoBuffer &to, int row) {
-    const std::size_t bytes = base::packed_stride(from.format.pixel, from.format.width);
-    std::memcpy(to.bytes.data() + base::row_bytes(to.format) * std::size_t(row),
-                from.bytes.data() + base::row_bytes(from.format) * std::size_t(row), bytes);
   }
 
   // A row's stretch of the region.
@@ -533,26 +520,6 @@ private:
     return total;
   }
 
-  // The pass's Sobol' points for the kernel: made for a new seed, and only
-  // the new ones for a longer pattern (a history's seed stays while it
-  // goes on).
-  void give_kernel_the_sobol_points(const gpu::FrameParams &frame) {
-    kernel_.sobol_points = nullptr;
-    kernel_.sobol_points_count = 0;
-    if (frame.tracing.z != SAMPLER_SOBOL)
-      return;
-    const auto count = std::uint32_t(std::min<std::size_t>(frame.sampling.z, kSobolPoints));
-    if (frame.sampling.w != sobol_points_seed_)
-      sobol_points_count_ = 0;
-    for (std::uint32_t s = sobol_points_count_; s < count; ++s)
-      sobol_points_[s] = kernel_.sobol_scrambled_point(s, frame.sampling.w);
-    sobol_points_seed_ = frame.sampling.w;
-    sobol_points_count_ = std::max(sobol_points_count_, count);
-    kernel_.sobol_points = sobol_points_.data();
-    kernel_.sobol_points_count = sobol_points_count_;
-    kernel_.sobol_points_seed = sobol_points_seed_;
-  }
-
   // Samples [first, end) of the region's pixels into the accumulators.
   void trace(std::uint32_t first, std::uint32_t end, bool has_plate) {
     kernel_.frame.sampling.x = first;
@@ -614,9 +581,8 @@ private:
   // The strength whose means filtered_* hold, of the accumulators as the
   // last frame left them; none where it did not reconstruct.
   std::optional<double> filtered_strength_;
-  bool region_kind_ = true;              // the region's: request.influence_region
-  std::vector<glm::uvec4> sobol_points_; // the pass's, for the kernel
-  std::uint32_t sobol_points_seed_ = 0, sobol_points_count_ = 0;
+  bool region_kind_ = true;                         // the region's: request.influence_region
+  cpu::SobolPointTable sobol_points_{kSobolPoints}; // the pass's, for the kernel
 };
 
 } // namespace

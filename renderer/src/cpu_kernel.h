@@ -6,7 +6,9 @@
 // rays the GPU traces.
 #pragma once
 
+#include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -104,6 +106,36 @@ static_assert(CpuKernel::findLSB(0x80000000u) == 31 && CpuKernel::findLSB(0x00f0
 #undef OUT
 #undef PRECISE
 #undef KERNEL_TABLE
+
+// A pass's Sobol' points for a kernel (CpuKernel::sobol_points), made once
+// for a seed, and only the new ones for a longer pattern (a history's seed
+// stays while it goes on); at most `capacity`.
+class SobolPointTable {
+public:
+  explicit SobolPointTable(std::size_t capacity) : points_(capacity) {}
+  // Gives `kernel` the points of `frame`'s pass, none unless it samples
+  // with Sobol'.
+  void give(CpuKernel &kernel, const FrameParams &frame) {
+    kernel.sobol_points = nullptr;
+    kernel.sobol_points_count = 0;
+    if (frame.tracing.z != SAMPLER_SOBOL)
+      return;
+    const auto count = std::uint32_t(std::min<std::size_t>(frame.sampling.z, points_.size()));
+    if (frame.sampling.w != seed_)
+      count_ = 0;
+    for (std::uint32_t s = count_; s < count; ++s)
+      points_[s] = kernel.sobol_scrambled_point(s, frame.sampling.w);
+    seed_ = frame.sampling.w;
+    count_ = std::max(count_, count);
+    kernel.sobol_points = points_.data();
+    kernel.sobol_points_count = count_;
+    kernel.sobol_points_seed = seed_;
+  }
+
+private:
+  std::vector<glm::uvec4> points_;
+  std::uint32_t seed_ = 0, count_ = 0;
+};
 
 // The kernel as the CPU reference runs it: `scene` with `frame` moved into
 // the compiled scene's frame, uniform sampling (tracing.y = 0), pixels no

@@ -37,9 +37,7 @@ gpu::VideoParams video_params(const base::VideoFormat &f, std::uint32_t first_wo
 void copy_rows(const std::uint8_t *from, std::size_t from_stride, std::uint8_t *to,
                std::size_t to_stride, const base::VideoFormat &f) {
   const std::size_t row = base::packed_stride(f.pixel, f.width);
-  const std::size_t rows =
-      std::size_t(f.height) + (f.pixel == base::PixelFormat::nv12 ? std::size_t(f.height) / 2 : 0);
-  for (std::size_t y = 0; y < rows; ++y)
+  for (std::size_t y = 0; y < base::frame_rows(f); ++y)
     std::memcpy(to + y * to_stride, from + y * from_stride, row);
 }
 

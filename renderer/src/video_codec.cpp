@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
@@ -226,6 +227,13 @@ void encode_rows(const base::VideoFormat &f, std::span<std::uint8_t> frame, cons
     }
     break;
   }
+}
+
+void copy_row(const base::VideoFormat &from_format, std::span<const std::uint8_t> from,
+              const base::VideoFormat &to_format, std::span<std::uint8_t> to, int row) {
+  std::memcpy(to.data() + base::row_bytes(to_format) * std::size_t(row),
+              from.data() + base::row_bytes(from_format) * std::size_t(row),
+              base::packed_stride(from_format.pixel, from_format.width));
 }
 
 } // namespace camhead::renderer::video

@@ -26,4 +26,9 @@ void decode_row(const base::VideoFormat &format, std::span<const std::uint8_t> f
 void encode_rows(const base::VideoFormat &format, std::span<std::uint8_t> frame,
                  const glm::vec4 *image, int y0, int y1, int x0 = 0, int x1 = -1);
 
+// Row `row` of every plane (base::frame_rows) of `from` into `to`, frames
+// of the same pixel format and width (their strides may differ).
+void copy_row(const base::VideoFormat &from_format, std::span<const std::uint8_t> from,
+              const base::VideoFormat &to_format, std::span<std::uint8_t> to, int row);
+
 } // namespace camhead::renderer::video

@@ -47,6 +47,9 @@ struct VideoFormat {
 // The stride in effect: `stride`, or the packed one when it is 0.
 [[nodiscard]] std::size_t row_bytes(const VideoFormat &format);
 // Bytes of a whole frame, every plane.
+// Rows of every plane, each row_bytes() long: the height, then NV12's
+// chroma rows.
+[[nodiscard]] std::size_t frame_rows(const VideoFormat &format);
 [[nodiscard]] std::size_t frame_bytes(const VideoFormat &format);
 
 // Why `format` cannot describe a frame (empty size, odd width for 4:2:2, odd
