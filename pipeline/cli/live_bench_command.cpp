@@ -51,7 +51,7 @@ struct LiveArgs {
   fs::path scene;
   fs::path out_dir = "bench";
   int ref_rpp = 1024;
-  std::uint32_t rpp = 1; // rays per live frame
+  double rpp = 1.0; // rays per pixel of a live frame, a mean
   int frames = 50;
   double fps = 25.0;
   int threads = 0;
@@ -60,6 +60,13 @@ struct LiveArgs {
   std::string executor = "cpu";
   std::string device; // the Vulkan device, for the GPU executor
 };
+
+// Rays per pixel as a person writes them: 2, 1.5.
+std::string rays_text(double rpp) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", rpp);
+  return text;
+}
 
 // The live frames' renderer; the camera image and the reference are the CPU
 // reference's whatever it is.
@@ -153,7 +160,7 @@ public:
   }
 
   // The live frame: `rpp` more rays while the camera holds still.
-  double live_error(std::uint32_t rpp, std::uint32_t seed, std::uint32_t *history) {
+  double live_error(double rpp, std::uint32_t seed, std::uint32_t *history) {
     *history = render(live_request(camera_, rpp, seed, true), "a live frame").history_samples;
     return error();
   }
@@ -161,7 +168,7 @@ public:
   // The live frame at the end of a pull through `focus_before` (metres, the
   // frames before it, in order), each frame `rpp` rays; with `reproject`,
   // each frame's history starts with the frames before it moved.
-  double pull_error(std::uint32_t rpp, std::uint32_t seed, std::span<const float> focus_before,
+  double pull_error(double rpp, std::uint32_t seed, std::span<const float> focus_before,
                     bool reproject, std::uint32_t *history) {
     for (std::size_t k = 0; k < focus_before.size(); ++k) {
       FrameCamera camera = camera_;
@@ -178,11 +185,12 @@ public:
   }
 
 private:
-  FrameRequest live_request(const FrameCamera &camera, std::uint32_t rpp, std::uint32_t seed,
+  FrameRequest live_request(const FrameCamera &camera, double rpp, std::uint32_t seed,
                             bool reproject) const {
     FrameRequest request;
     request.camera = camera;
-    request.rays_per_pixel = rpp;
+    request.rays_per_pixel = std::uint32_t(rpp);
+    request.extra_rays_per_pixel = float(rpp - std::floor(rpp));
     request.seed = seed;
     request.accumulation.enabled = true;
     request.accumulation.reconstruct = args_.reconstruct > 0.0;
@@ -289,7 +297,7 @@ void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
     panel.title = c.lens.name;
     panel.x_label = "seconds since the lens came to rest";
     panel.y_label = "rel. RMSE over the region";
-    chart::Series live{"live, " + std::to_string(args.rpp) + " rpp a frame, accumulated",
+    chart::Series live{"live, " + rays_text(args.rpp) + " rpp a frame, accumulated",
                        {30, 90, 200},
                        chart::Marker::circle,
                        c.seconds,
@@ -334,7 +342,7 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
   const std::array<std::array<std::string, 2>, 4> titles = {
       {{"1 RPP, FRESH", "(BEFORE)"},
        {"LIVE IN A PULL",
-        std::to_string(args.rpp) + " RPP" + (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : "")},
+        rays_text(args.rpp) + " RPP" + (args.reconstruct > 0.0 ? ", RECONSTRUCTED" : "")},
        {"9 RPP", ""},
        {std::to_string(args.ref_rpp) + " RPP", "(REFERENCE)"}}};
   const int gap = 6, left = 120, top = 28;
@@ -445,10 +453,10 @@ int run_live(const LiveArgs &args) {
         (is_still ? rest : pull).push_back(std::move(c));
       }
 
-    std::printf("\n%s, %dx%d, reference %d rpp; live on the %s executor: %u rpp a frame at %.0f "
+    std::printf("\n%s, %dx%d, reference %d rpp; live on the %s executor: %s rpp a frame at %.0f "
                 "fps\n\n",
                 scene_file.string().c_str(), scene.render.width, scene.render.height, args.ref_rpp,
-                args.executor.c_str(), args.rpp, args.fps);
+                args.executor.c_str(), rays_text(args.rpp).c_str(), args.fps);
     std::printf("| still shot | region | uniform 1 / 9 / 49 rpp | live after 1 / 5 / 12 / 25 / "
                 "%d frames | frames to 9 rpp's error | frames to 49 rpp's |\n|---|---|---|---|---|"
                 "---|\n",
@@ -513,9 +521,10 @@ void add_bench_live_command(CLI::App &bench) {
       ->capture_default_str()
       ->check(path_text());
   cmd->add_option("--rpp", args->rpp,
-                  "Rays per pixel of each live frame: what the frame budget holds at the\n"
-                  "camera's rate (camhead run's status line; 1 on 2 cores)")
-      ->check(CLI::Range(1, 4096))
+                  "Rays per pixel of each live frame, a mean: what the frame budget holds\n"
+                  "at the camera's rate (camhead run's status line). A fraction (1.5) goes\n"
+                  "where a frame shares its rays unevenly (a first frame's sharp edges)")
+      ->check(CLI::Range(1.0, 4096.0))
       ->capture_default_str();
   cmd->add_option("--frames", args->frames, "Still frames after rest")
       ->check(CLI::Range(1, 10000))

@@ -43,7 +43,7 @@ void write_composite_record(std::FILE *out, std::uint64_t output_frame, const Fr
       ",\"setup\":%" PRIu64 ",\"capture_ns\":%" PRId64 ",\"exposure_mid_ns\":%" PRId64
       ",\"delivered_ns\":%" PRId64 ",\"render_start_ns\":%" PRId64 ",\"render_end_ns\":%" PRId64
       ",\"output_ns\":%" PRId64 ",\"focus_m\":%s,\"f_number\":%.6g"
-      ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%u"
+      ",\"focal_length_mm\":%.6g,\"lens_fresh\":%s,\"lens_wait_ms\":%.3f,\"rpp\":%.6g"
       ",\"camera_rays\":%" PRIu64 ",\"history_samples\":%u,\"reprojected_samples\":%" PRIu64
       ",\"traced\":%.4f,\"dropped_before\":%" PRIu64 ",\"decode_ms\":%.3f,\"trace_ms\":%.3f"
       ",\"rays_ms\":%.3f,\"encode_ms\":%.3f,\"executor\":%s,\"pose_source\":%s,\"pose_known\":%s,"

@@ -40,7 +40,7 @@ struct FrameRecord {
   // out), and how long rendering it waited for the tracker (marker poses;
   // 0 otherwise).
   double track_s = 0.0, pose_wait_s = 0.0;
-  std::uint32_t rpp = 0;
+  double rpp = 0.0; // rays per pixel asked, a mean (frame_budget.h)
   std::uint64_t camera_rays = 0;
   std::uint32_t history_samples = 0;     // samples per pixel the image holds (accumulating; else 0)
   std::uint64_t reprojected_samples = 0; // of them moved from the frames before (a new history)

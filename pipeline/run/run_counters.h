@@ -10,7 +10,7 @@ namespace camhead::pipeline {
 struct RunCounters {
   std::atomic<std::uint64_t> frames_in{0}, frames_out{0}, render_busy{0}, output_busy{0},
       render_failed{0}, placeholders{0}, repeats{0}, sink_errors{0}, lens_late{0};
-  std::atomic<std::uint32_t> rpp{0};
+  std::atomic<double> rpp{0.0}; // rays per pixel asked of the last frame, a mean
   std::atomic<std::uint32_t> traced_permille{1000}; // of the last frame's pixels
   std::atomic<std::int64_t> latency_ns{0};          // capture to output, last frame
   std::atomic<bool> camera_lost{false};

@@ -152,14 +152,19 @@ void Pipeline::render_loop() {
     r.up = posed.up;
     renderer::FrameRequest request = setup_request(*setup_, options_.influence_region);
     request.camera = lens_camera(posed, lens.state);
-    request.rays_per_pixel = setup_->board.render.rays_per_pixel.value_or(budget.rpp());
+    if (setup_->board.render.rays_per_pixel) {
+      request.rays_per_pixel = *setup_->board.render.rays_per_pixel;
+    } else {
+      request.rays_per_pixel = budget.rpp();
+      request.extra_rays_per_pixel = float(budget.rays_per_pixel() - budget.rpp());
+    }
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     // Before the pose source's first pose, virtual objects drawn from the
     // stand-in (the scene's camera) would stand wherever that puts them (on
     // the moving rig, 1200 px off): the frame goes out as the camera image
     // alone.
     request.plate_only = !pose.known;
-    r.rpp = request.rays_per_pixel;
+    r.rpp = request.rays_per_pixel + double(request.extra_rays_per_pixel);
 
     for (std::size_t i = 0; i < sinks_.size(); ++i)
       targets_[i] = {sinks_[i]->format(), slot.images[i]};
@@ -201,7 +206,7 @@ void Pipeline::render_loop() {
     budget.measured(report.traced_pixels > 0 ? double(report.camera_rays) / report.traced_pixels
                                              : 0.0,
                     report.decode_s + report.trace_s + report.encode_s, report.rays_s);
-    counters_.rpp = request.rays_per_pixel;
+    counters_.rpp = r.rpp;
     (void)ready_slots_.push(*slot_index);
   }
   ready_slots_.close();

@@ -50,7 +50,7 @@ void RunStatus::second(std::int64_t now_ns, double dt, std::uint64_t in, std::ui
     std::snprintf(lens_late, sizeof lens_late, " (%" PRIu64 " frames without it)", late);
   char line[512];
   std::snprintf(line, sizeof line,
-                "in %5.1f fps  out %5.1f fps  rpp %u  traced %.0f%%  dropped %" PRIu64
+                "in %5.1f fps  out %5.1f fps  rpp %.4g  traced %.0f%%  dropped %" PRIu64
                 " (camera %" PRIu64 ", render busy %" PRIu64 ", output busy %" PRIu64
                 ")  focus %s f/%.1f %.0f mm%s%s%s  latency %.0f ms%s%s",
                 double(in) / dt, double(out) / dt, counters_.rpp.load(),

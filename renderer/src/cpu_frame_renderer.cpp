@@ -102,14 +102,8 @@ public:
     const bool has_plate = !plate.bytes.empty();
     if (std::string reason = check_frames(plate, outputs, width, height); !reason.empty())
       return bad_frame(std::move(reason));
-    if (asked.rays_per_pixel == 0)
-      return bad_frame("0 rays per pixel");
-    if (asked.accumulation.enabled && asked.adaptive)
-      return bad_frame("adaptive frames do not accumulate");
-    if (asked.accumulation.enabled && asked.accumulation.max_samples == 0)
-      return bad_frame("a history of at most 0 samples");
-    if (asked.plate_only && !has_plate)
-      return bad_frame("a plate-only frame without a camera frame");
+    if (std::string reason = check_request(asked, has_plate); !reason.empty())
+      return bad_frame(std::move(reason));
     const FrameRequest request = as_rendered(asked);
 
     gpu::FrameParams frame = make_frame_params(scene_, request.camera, int(request.rays_per_pixel));
@@ -143,9 +137,9 @@ public:
         history_ = frame;
         history_valid_ = true;
         history_by_noise_ = request.accumulation.share_by_noise;
-        history_first_rest_ = 0;
         history_uniform_ = 0;
         history_rays_ = 0;
+        history_moved_ = 0;
         history_frames_ = 0;
       }
       ++history_frames_;
@@ -205,6 +199,7 @@ public:
       report.reprojected_samples =
           reproject_into_history(has_plate, request.accumulation.reproject_frames);
       history_rays_ += report.reprojected_samples;
+      history_moved_ = report.reprojected_samples;
     }
     const std::uint32_t total = frame.sampling.z;
     const Clock::time_point rays_start = Clock::now();
@@ -217,14 +212,13 @@ public:
       if (reprojects && uniform_share_ > 0)
         kept = store_.add_frame(kernel_.frame, *region_, report.camera_rays);
       trace_shares(has_plate, kept);
-      if (first_frame_rest_ > 0) {
+      if (first_frame_rest_ > 0.0) {
         const cpu::FirstFrameShared rest = share_first_frame_rest(request, has_plate);
         report.camera_rays += rest.rays;
         trace_shares(has_plate, {});
-        if (rest.by_spread) {
+        if (rest.uneven) {
           history_all_uniform_ = false; // its pixels hold counts of their own
-          history_first_rest_ = first_frame_rest_;
-        } else { // every pixel took the same share
+        } else {                        // every pixel took the same share
           history_uniform_ +=
               std::uint32_t(rest.rays / std::max<std::uint64_t>(region_->pixels(), 1));
         }
@@ -261,7 +255,8 @@ public:
     filtered_strength_.reset(); // until the means are whole again
     if (filtered && !kept) {
       cpu::filter_defocus(kernel_.frame, spans_, mixed_, real_, aux_, history_counts_,
-                          filter_settings(request),
+                          {.strength = request.accumulation.reconstruct_strength,
+                           .lend_up_to_own = history_moved_ == 0},
                           {filtered_mixed_, filtered_real_, scratch_mixed_, scratch_real_,
                            scratch_weight_, blur_, filter_gaussian_},
                           pool_);
@@ -363,18 +358,21 @@ private:
     // Pattern indices from pattern_base_ on, below the pattern's size.
     const std::uint32_t most = request.accumulation.max_samples - pattern_base_;
     const std::uint32_t rpp = request.rays_per_pixel;
+    // The frames that share their rays unevenly spend the budget's fraction
+    // of a ray too (FrameRequest::extra_rays_per_pixel).
+    const double mean = rpp + double(request.extra_rays_per_pixel);
     const bool by_noise = request.accumulation.share_by_noise && history_uniform_ >= kPilotSamples;
     // A history's first frame with nothing moved into it and more than a
     // ray a pixel to give: a ray each here, the rest after it is traced.
     first_frame_rest_ = request.accumulation.share_by_noise && history_frames_ == 1 &&
-                                history_rays_ == 0 && rpp > 1 && most > 1
-                            ? rpp - 1
-                            : 0;
+                                history_rays_ == 0 && mean > 1.0 && most > 1
+                            ? mean - 1.0
+                            : 0.0;
     uniform_share_ = 0;
     history_all_uniform_ = history_all_uniform_ && !by_noise;
     if (!by_noise) {
       const std::uint32_t k =
-          std::min(rpp - first_frame_rest_, most - std::min(most, history_uniform_));
+          std::min(first_frame_rest_ > 0.0 ? 1u : rpp, most - std::min(most, history_uniform_));
       // No pixel goes past its pattern's end: after a first frame that gave
       // its sharp pixels' rays by spread, they hold more than the others.
       bool alike = true;
@@ -395,7 +393,7 @@ private:
       return rays;
     }
     return cpu::share_rays_by_noise(
-        spans_, scene_.render.width, scene_.render.height, aux_, history_counts_, own_counts_, rpp,
+        spans_, scene_.render.width, scene_.render.height, aux_, history_counts_, own_counts_, mean,
         request.accumulation.max_samples, most, history_frames_, {sigma_, noise_, shares_}, pool_);
   }
 
@@ -403,24 +401,13 @@ private:
   // the neighbours' spread where it is sharp (ray_shares.h).
   cpu::FirstFrameShared share_first_frame_rest(const FrameRequest &request, bool has_plate) {
     cpu::FirstFrameShares settings;
-    settings.rays_per_pixel = request.rays_per_pixel;
+    settings.rest = first_frame_rest_;
     settings.most = request.accumulation.max_samples;
     settings.pattern_room = request.accumulation.max_samples - pattern_base_;
     settings.rounding_key = kernel_.frame.sampling.w ^ 0x5bd1e995u; // the frame's seed
     return cpu::share_first_frame_rays(spans_, kernel_.frame, aux_, plate_, has_plate,
                                        history_counts_, own_counts_, settings,
                                        {sigma_, noise_, shares_}, pool_);
-  }
-
-  cpu::DefocusFilterSettings filter_settings(const FrameRequest &request) const {
-    cpu::DefocusFilterSettings settings;
-    settings.strength = request.accumulation.reconstruct_strength;
-    // While the frames after a first frame that gave its rays by spread give
-    // theirs alike, the pixels holding more than the alike share are its
-    // edges' (defocus_filter.h).
-    if (history_first_rest_ > 0 && history_uniform_ < kPilotSamples)
-      settings.keep_above_samples = history_uniform_ + history_first_rest_;
-    return settings;
   }
 
   std::size_t index(std::uint32_t y, std::uint32_t x) const {
@@ -555,6 +542,7 @@ private:
   bool history_by_noise_ = false;
   std::uint32_t history_uniform_ = 0; // samples every pixel has (the uniform frames')
   std::uint64_t history_rays_ = 0;
+  std::uint64_t history_moved_ = 0; // of them moved from the frames before
   std::uint32_t history_frames_ = 0;
   std::vector<std::uint32_t> history_counts_; // samples per pixel
   // ... of them traced for this history (its pattern's next index); the
@@ -565,12 +553,9 @@ private:
   // whether all of its frames shared their rays alike.
   std::uint32_t pattern_base_ = 0;
   bool history_all_uniform_ = true;
-  // The rays a pixel its first frame gave after the first, where it gave
-  // the sharp pixels' by their spread; 0 where not.
-  std::uint32_t history_first_rest_ = 0;
   std::vector<std::uint32_t> row_pixels_; // the region's pixels in each row
   std::uint32_t uniform_share_ = 0;       // this frame's rays per pixel, if alike
-  std::uint32_t first_frame_rest_ = 0;    // ... and a pixel's more, shared after
+  double first_frame_rest_ = 0.0;         // ... and a pixel's more, a mean, shared after
   std::vector<std::size_t> span_firsts_;  // ... and where each span's go in store_
   std::vector<std::uint32_t> shares_;     // this frame's rays per pixel
   std::vector<float> sigma_, noise_;      // each pixel's noise, for the shares

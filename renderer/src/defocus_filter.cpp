@@ -1,5 +1,6 @@
 #include "defocus_filter.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -28,7 +29,8 @@ namespace {
 
 // What one pass adds to a pixel: the neighbours at +-1 .. +-reach steps of
 // `step` elements (at most `before` steps back and `after` on), those with
-// samples and with alike blur circles, with Gaussian weights. The
+// samples and with alike blur circles, with Gaussian weights, each lending
+// up to the pixel's own count of samples where `lend_up_to_own`. The
 // neighbours go in the order -1, +1, -2, +2, ..., as the GPU's pass takes
 // them. A function of plain pointers and local sums: as a lambda over
 // captured spans, writing its sums through references, it reloaded every
@@ -37,12 +39,17 @@ namespace {
 template <typename Weight>
 void gather(std::size_t i, const DefocusGaussian &g, int before, int after, std::ptrdiff_t step,
             const float *blur, const std::uint32_t *counts, const glm::vec4 *m_in,
-            const glm::vec4 *r_in, const Weight *n_in, glm::vec4 &m, glm::vec4 &r, float &n) {
+            const glm::vec4 *r_in, const Weight *n_in, bool lend_up_to_own, glm::vec4 &m,
+            glm::vec4 &r, float &n) {
   float w = g.weight;
   float ratio = g.ratio;
   const float ratio_step = g.ratio_step;
   const int reach = g.reach;
   const float own_blur = blur[i];
+  // The most samples a neighbour lends: the pixel's own count
+  // (DefocusFilterSettings::lend_up_to_own), or all of them.
+  const float lend_most =
+      lend_up_to_own ? float(counts[i]) : std::numeric_limits<float>::infinity();
   // In locals, not through the references: the compiler keeps them in
   // registers.
   glm::vec4 sum_m = m, sum_r = r;
@@ -50,14 +57,14 @@ void gather(std::size_t i, const DefocusGaussian &g, int before, int after, std:
   for (int k = 1; k <= reach; ++k) {
     const std::ptrdiff_t offsets[2] = {-k * step, k * step};
     const bool inside[2] = {k <= before, k <= after};
-    const glm::vec4 w4(w);
     for (int side = 0; side < 2; ++side) {
       const std::size_t j = std::size_t(std::ptrdiff_t(i) + offsets[side]);
       if (!inside[side] || counts[j] == 0 || !rules::reconstruct_blurs_alike(own_blur, blur[j]))
         continue;
-      sum_m += w4 * m_in[j];
-      sum_r += w4 * r_in[j];
-      sum_n += w * float(n_in[j]);
+      const float lent = w * std::min(1.0f, lend_most / float(counts[j]));
+      sum_m += glm::vec4(lent) * m_in[j];
+      sum_r += glm::vec4(lent) * r_in[j];
+      sum_n += lent * float(n_in[j]);
     }
     w *= ratio;
     ratio *= ratio_step;
@@ -86,16 +93,12 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
   const float max_reach = float(settings.max_radius_px);
   const auto at = [width](std::uint32_t y, int x) { return std::size_t(y) * width + x; };
 
-  // Each pixel's signed blur radius at its mean depth (a miss: at infinity);
-  // NaN for a pixel that keeps its samples, which then neither borrows nor
-  // lends (no comparison with NaN passes).
+  // Each pixel's signed blur radius at its mean depth (a miss: at infinity).
   auto blur_of = [&](int k) {
     const PixelSpan &s = spans[std::size_t(k)];
     for (std::uint32_t x = s.x0; x < s.x1; ++x) {
       const std::size_t i = at(s.y, int(x));
-      buffers.blur[i] = counts[i] > settings.keep_above_samples
-                            ? std::numeric_limits<float>::quiet_NaN()
-                            : rules::reconstruct_blur(aux[i], lens, inverse_focus);
+      buffers.blur[i] = rules::reconstruct_blur(aux[i], lens, inverse_focus);
     }
   };
   pool.run(int(spans.size()), blur_of);
@@ -129,8 +132,8 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
       buffers.gaussian[i] = g;
       glm::vec4 m = mixed[i], r = real[i];
       float n = float(count[i]);
-      gather(i, g, int(x), width - 1 - int(x), 1, blur, count, mixed.data(), real.data(), count, m,
-             r, n);
+      gather(i, g, int(x), width - 1 - int(x), 1, blur, count, mixed.data(), real.data(), count,
+             settings.lend_up_to_own, m, r, n);
       buffers.scratch_mixed[i] = m;
       buffers.scratch_real[i] = r;
       buffers.scratch_weight[i] = n;
@@ -148,7 +151,7 @@ void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> sp
       float n = buffers.scratch_weight[i];
       gather(i, g, int(s.y), height - 1 - int(s.y), width, blur, count,
              buffers.scratch_mixed.data(), buffers.scratch_real.data(),
-             buffers.scratch_weight.data(), m, r, n);
+             buffers.scratch_weight.data(), settings.lend_up_to_own, m, r, n);
       buffers.out_mixed[i] = m / n;
       buffers.out_real[i] = r / n;
     }

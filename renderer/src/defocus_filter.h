@@ -29,7 +29,6 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
 #include <span>
 
 #include <glm/vec4.hpp>
@@ -44,16 +43,20 @@ struct DefocusFilterSettings {
   double strength = 1.0;
   double min_sigma_px = 0.25; // below it a pixel keeps its own samples
   int max_radius_px = 16;     // the widest reach of a pass: 2 sigma, at most
-  // Pixels holding more samples than this keep their own and lend none:
-  // the edges' pixels of a history whose first frame gave its sharp pixels'
-  // rays by their neighbours' spread (ray_shares.h). They hold many times
-  // their neighbours' samples, and the mean of the samples would let them
-  // stand for their neighbours. First frames of 2 rpp, `camhead bench
-  // live`, relative error focused at 14 m and at the scene: 0.0209 and
-  // 0.0189 on the moving rig's scene with them reconstructed, 0.0159 and
-  // 0.0146 left alone; 0.0375 and 0.0443 against 0.0339 and 0.0253 on the
-  // locked-off rig's (bench/RESULTS.md).
-  std::uint32_t keep_above_samples = std::numeric_limits<std::uint32_t>::max();
+  // A neighbour holding more samples than the pixel lends them with the
+  // weight of the pixel's own count: its mean, not its many samples. Where
+  // the renderer gave some pixels more rays than others (a first frame's
+  // sharp edges, a held shot's noisiest pixels: ray_shares.h), lent whole
+  // they stood for their neighbours. First frames of 2 rpp, `camhead bench
+  // live` on the locked-off rig's scene, focused at 14 m, at the scene, and
+  // the 14-m pull frame afresh: 0.0375, 0.0443 and 0.0370 lent whole;
+  // 0.0339, 0.0253 and 0.0351 with the pixels that took more left out (the
+  // rule before); 0.0265, 0.0249 and 0.0273 lent up to the pixel's own
+  // count. Not for a history of samples moved from the frames before
+  // (sample_store.h), whose counts differ by where the samples land: there
+  // it made the rig's pull frames up to 6 % noisier (bench/RESULTS.md). The
+  // GPU executor's pixels all hold the same samples, and lend whole.
+  bool lend_up_to_own = false;
 };
 
 // A pixel's Gaussian as both passes walk it, found once in the first: the

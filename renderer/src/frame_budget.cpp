@@ -8,7 +8,7 @@
 namespace camhead::renderer {
 
 FrameBudget::FrameBudget(const FrameBudgetSettings &settings)
-    : settings_(settings), rpp_(settings.min_rpp) {
+    : settings_(settings), rays_(settings.min_rpp) {
   if (!(settings.target_s > 0.0))
     throw std::invalid_argument("frame-time target must be > 0 s, not " +
                                 std::to_string(settings.target_s));
@@ -32,12 +32,19 @@ void FrameBudget::measured(double rpp, double seconds, double rays_seconds) {
   measured_ = true;
   // A frame that came out dear counts at once, not averaged away.
   const double cost = std::max(seconds_per_rpp_, per_rpp);
-  const double room = settings_.headroom * settings_.target_s - std::max(fixed_seconds_, fixed);
-  const double fits = room / cost;
+  const double fixed_part = std::max(fixed_seconds_, fixed);
+  const auto fits = [&](double headroom) {
+    return (headroom * settings_.target_s - fixed_part) / cost;
+  };
   const double most = std::max(rpp + 1.0, rpp * settings_.max_growth);
-  const double next = std::clamp(std::floor(std::min(fits, most)), double(settings_.min_rpp),
-                                 double(settings_.max_rpp));
-  rpp_ = static_cast<std::uint32_t>(next);
+  // Whole rays within the headroom, or a ray's sixteenths within the
+  // fraction's, whichever gives more.
+  constexpr double kSteps = 16.0;
+  const double whole = std::floor(std::min(fits(settings_.headroom), most));
+  const double sixteenths =
+      std::floor(std::min(fits(settings_.fraction_headroom), most) * kSteps) / kSteps;
+  rays_ =
+      std::clamp(std::max(whole, sixteenths), double(settings_.min_rpp), double(settings_.max_rpp));
 }
 
 } // namespace camhead::renderer

@@ -39,6 +39,23 @@ check_frames(const VideoFrame &plate, std::span<const VideoBuffer> outputs, int 
   return {};
 }
 
+// The first problem with what `request` asks of a frame with or without a
+// camera frame, or empty.
+[[nodiscard]] inline std::string check_request(const FrameRequest &request, bool has_plate) {
+  if (request.rays_per_pixel == 0)
+    return "0 rays per pixel";
+  if (!(request.extra_rays_per_pixel >= 0.0f && request.extra_rays_per_pixel < 1.0f))
+    return "a fraction of a ray a pixel of " + std::to_string(request.extra_rays_per_pixel) +
+           ", not in [0, 1)";
+  if (request.accumulation.enabled && request.adaptive)
+    return "adaptive frames do not accumulate";
+  if (request.accumulation.enabled && request.accumulation.max_samples == 0)
+    return "a history of at most 0 samples";
+  if (request.plate_only && !has_plate)
+    return "a plate-only frame without a camera frame";
+  return {};
+}
+
 // The same pixels in the same bytes, whatever the rows' padding: an output
 // in the camera frame's own format, which outside the influence region takes
 // the camera's bytes as they are.

@@ -70,14 +70,8 @@ public:
     if (outputs.size() > VIDEO_MAX_OUTPUTS)
       return bad_frame(std::to_string(outputs.size()) + " outputs; the GPU executor takes " +
                        std::to_string(VIDEO_MAX_OUTPUTS));
-    if (asked.rays_per_pixel == 0)
-      return bad_frame("0 rays per pixel");
-    if (asked.accumulation.enabled && asked.adaptive)
-      return bad_frame("adaptive frames do not accumulate");
-    if (asked.accumulation.enabled && asked.accumulation.max_samples == 0)
-      return bad_frame("a history of at most 0 samples");
-    if (asked.plate_only && plate.bytes.empty())
-      return bad_frame("a plate-only frame without a camera frame");
+    if (std::string reason = check_request(asked, !plate.bytes.empty()); !reason.empty())
+      return bad_frame(std::move(reason));
     const FrameRequest request = as_rendered(asked);
     gpu::FrameParams frame = frame_params(request, !plate.bytes.empty());
     const Shape shape = shape_of(plate, outputs, request);

@@ -65,7 +65,7 @@ std::uint64_t round_shares(std::span<const PixelSpan> spans, int width, const Wa
 std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
                                   std::span<const glm::vec4> aux,
                                   std::span<const std::uint32_t> counts,
-                                  std::span<const std::uint32_t> own, std::uint32_t rpp,
+                                  std::span<const std::uint32_t> own, double rpp,
                                   std::uint32_t most, std::uint32_t pattern_room,
                                   std::uint32_t frame_index, const RayShareBuffers &buffers,
                                   WorkerPool &pool) {
@@ -173,25 +173,34 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
     }
   };
   pool.run(int(spans.size()), want_of);
-  // The sharp pixels' rays go where their spread is.
-  double want_sum = 0.0, sharp = 0.0;
+  // The sharp pixels' rays go where their spread is, the blurred ones' alike.
+  // With a ray a pixel after the first or more, the sharp pixels take as
+  // many in all as alike; with less, theirs first, up to a ray each (one
+  // ray a pixel aliases a sharp edge, and the reconstruction smooths a
+  // blurred one), and the blurred ones share what is left, at random.
+  double want_sum = 0.0, sharp = 0.0, pixels = 0.0;
   for (const PixelSpan &span : spans)
-    for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i)
+    for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i) {
+      pixels += 1.0;
       if (buffers.noise[i] != kAlike) {
         want_sum += buffers.noise[i];
         sharp += 1.0;
       }
-  const double rest = double(settings.rays_per_pixel - 1);
-  const double scale = want_sum > 0.0 ? sharp * rest / want_sum : 0.0;
-  const double most_a_frame = double(kMostRaysAPixel) * double(settings.rays_per_pixel);
+    }
+  const double rest = settings.rest;
+  const double sharp_rays = std::min(rest * pixels, sharp * std::max(rest, 1.0));
+  const double blurred_each =
+      pixels > sharp ? (rest * pixels - sharp_rays) / (pixels - sharp) : 0.0;
+  const double scale = want_sum > 0.0 ? sharp_rays / want_sum : 0.0;
+  const double most_a_frame = double(kMostRaysAPixel) * (1.0 + rest);
   const auto wanted = [&](std::size_t i) {
-    return buffers.noise[i] == kAlike ? rest
+    return buffers.noise[i] == kAlike ? blurred_each
                                       : std::min(double(buffers.noise[i]) * scale, most_a_frame);
   };
   const std::uint64_t rays =
       round_shares(spans, width, wanted, {counts, own, settings.most, settings.pattern_room},
                    settings.rounding_key, buffers.shares);
-  return {rays, sharp > 0.0};
+  return {rays, sharp > 0.0 || blurred_each != std::floor(blurred_each)};
 }
 
 } // namespace camhead::renderer::cpu

@@ -37,22 +37,24 @@ struct RayShareBuffers {
   std::span<std::uint32_t> shares; // out: each span pixel's rays
 };
 
-// Shares rpp rays for each pixel of `spans` among them by their noise, from
+// Shares rpp rays a pixel (a mean) of `spans` among them by their noise, from
 // the accumulators' `aux` (luminance sum and sum of squares in z, w) and
 // `counts` (samples so far, moved ones included: at least one, 0 outside
 // the spans); returns the rays given. No pixel goes past `most` samples in
 // all, nor past `pattern_room` samples of its own pattern (`own`: those it
 // traced so far).
-[[nodiscard]] std::uint64_t
-share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
-                    std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,
-                    std::span<const std::uint32_t> own, std::uint32_t rpp, std::uint32_t most,
-                    std::uint32_t pattern_room, std::uint32_t frame_index,
-                    const RayShareBuffers &buffers, WorkerPool &pool);
+[[nodiscard]] std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width,
+                                                int height, std::span<const glm::vec4> aux,
+                                                std::span<const std::uint32_t> counts,
+                                                std::span<const std::uint32_t> own, double rpp,
+                                                std::uint32_t most, std::uint32_t pattern_room,
+                                                std::uint32_t frame_index,
+                                                const RayShareBuffers &buffers, WorkerPool &pool);
 
 // A history's first frame, nothing moved into it, has traced one ray a pixel
-// and has rays_per_pixel - 1 more a pixel to give (every frame of a moving
-// camera is one).
+// and has `rest` more a pixel to give, a mean (every frame of a moving
+// camera is one; a fraction where the frame budget lies between two whole
+// rays a pixel: FrameRequest::extra_rays_per_pixel).
 //   - Where the lens blurs a pixel by kSharpBlurPx or more, the
 //     reconstruction (defocus_filter.h) averages it with its neighbours, and
 //     those pixels take the rays alike. Given by the spread of their one-ray
@@ -63,30 +65,34 @@ share_rays_by_noise(std::span<const PixelSpan> spans, int width, int height,
 //     single samples (their composite less the camera's pixel, which the
 //     composite only passes through). It is large at an edge or a shadow's
 //     rim, small where the virtual objects change nothing.
-// The gain is the scene's: on the moving rig's scene, a first frame of 2 rpp
-// focused far has 0.6 times the error it had with every pixel alike; on the
-// locked-off rig's, 1.06-1.09 times (its nearly sharp surfaces gained more
-// from the reconstruction than from rays at their edges; bench/RESULTS.md).
+//   - With a ray a pixel or more to give, the sharp pixels take as many in
+//     all as they would alike. With less, they take theirs first, up to a
+//     ray each, and the blurred ones share what is left, at random.
+// First frames, `camhead bench live --frames 1`, relative error focused at
+// 14 m (bench/RESULTS.md): on the moving rig's scene 0.0348 at 1 rpp,
+// 0.0244, 0.0198 and 0.0169 at 1.25, 1.5 and 1.75, and 0.0149 at 2 (0.0264
+// with every pixel's rays alike, 9 rpp's 0.0170); on the locked-off rig's
+// 0.0419, 0.0370, 0.0349, 0.0302 and 0.0265 (alike 0.0312).
 // At 0.5 px the moving rig's scene focused far came out as noisy as with
 // every pixel alike, at 0.75 px with a fifth of the gain that 1 px gives.
 inline constexpr float kSharpBlurPx = 1.0f;
 
 struct FirstFrameShares {
-  std::uint32_t rays_per_pixel = 2; // the frame's, its first ray included
-  std::uint32_t most = 0;           // samples a pixel, at most (max_samples)
-  std::uint32_t pattern_room = 0;   // samples of a pixel's own pattern, at most
-  std::uint32_t rounding_key = 0;   // a new one each frame
+  double rest = 1.0;              // rays a pixel after the first, a mean (> 0)
+  std::uint32_t most = 0;         // samples a pixel, at most (max_samples)
+  std::uint32_t pattern_room = 0; // samples of a pixel's own pattern, at most
+  std::uint32_t rounding_key = 0; // a new one each frame
 };
 
 struct FirstFrameShared {
   std::uint64_t rays = 0; // the rays given
-  bool by_spread = false; // whether any pixel was sharp (else every pixel took them alike)
+  bool uneven = false;    // whether the pixels took different shares
 };
 
 // The shares of the rays after the first for each pixel of `spans` (the
 // frame's first ray traced in each: `counts` and `own` 1), from the
 // accumulators' `aux` and `plate`, the camera frame in linear RGB
-// (has_plate): (rays_per_pixel - 1) a pixel on average.
+// (has_plate): `rest` a pixel on average.
 [[nodiscard]] FirstFrameShared
 share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams &frame,
                        std::span<const glm::vec4> aux, std::span<const glm::vec4> plate,

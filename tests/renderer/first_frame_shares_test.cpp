@@ -2,17 +2,18 @@
 // (renderer/src/ray_shares.h, share_first_frame_rays), on its own: one
 // sample a pixel of a frame with a vertical edge of the virtual objects
 // down its middle, over a camera image of random texture. In focus the
-// rays go to the edge; blurred by a pixel or more they go alike. And the
-// reconstruction leaves the pixels that took more alone
-// (defocus_filter.h, keep_above_samples). Then the same through the CPU
-// reference's live frames (history_support.h): less error for the same rays
-// in focus, the history within its most samples, a blurred frame alike.
+// rays go to the edge; blurred by a pixel or more they go alike; a fraction
+// of a ray a pixel goes to the sharp pixels first. And the reconstruction
+// lends a pixel's many samples to its neighbours no more than their own
+// count (defocus_filter.h). Then the same through the CPU reference's live
+// frames (history_support.h): less error for the same rays in focus, a
+// fraction of a ray spent, the history within its most samples, a blurred
+// frame alike.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <limits>
 #include <random>
 #include <utility>
 #include <vector>
@@ -85,13 +86,13 @@ struct Shared {
   std::vector<std::uint32_t> shares;
 };
 
-Shared share(const OneRayFrame &f, std::uint32_t rpp) {
+Shared share(const OneRayFrame &f, double rest) {
   const std::size_t pixels = f.aux.size();
   std::vector<float> sigma(pixels), noise(pixels);
   Shared out;
   out.shares.assign(pixels, 0u);
   FirstFrameShares settings;
-  settings.rays_per_pixel = rpp;
+  settings.rest = rest;
   settings.most = 256;
   settings.pattern_room = 256;
   settings.rounding_key = 7;
@@ -126,8 +127,8 @@ TEST(FirstFrameShares, InFocusTheRaysGoToTheEdgeNotToTheCameraTexture) {
   const std::uint64_t budget = std::uint64_t(kWidth) * kHeight * (kRpp - 1);
   std::uint64_t at_edge[2] = {};
   for (const bool textured : {false, true}) {
-    const Shared s = share(one_ray_frame(kFocusM, textured, 0.5f), kRpp);
-    EXPECT_TRUE(s.result.by_spread);
+    const Shared s = share(one_ray_frame(kFocusM, textured, 0.5f), kRpp - 1.0);
+    EXPECT_TRUE(s.result.uneven);
     // The columns either side of the edge see it in their 3x3
     // neighbourhood: each takes more than any pixel two columns off it, up
     // to 16 times the frame's rays.
@@ -151,7 +152,7 @@ TEST(FirstFrameShares, InFocusTheRaysGoToTheEdgeNotToTheCameraTexture) {
 
 TEST(FirstFrameShares, WithNothingVirtualTheCameraTextureDrawsNoRays) {
   // No edge: every pixel's want is the floor, so each takes the frame's rays.
-  const Shared s = share(one_ray_frame(kFocusM, true, 0.0f), 3);
+  const Shared s = share(one_ray_frame(kFocusM, true, 0.0f), 2.0);
   for (const std::uint32_t n : s.shares)
     EXPECT_NEAR(double(n), 2.0, 1.0);
   EXPECT_NEAR(double(s.result.rays), 2.0 * kWidth * kHeight, 0.02 * 2.0 * kWidth * kHeight);
@@ -161,55 +162,94 @@ TEST(FirstFrameShares, BlurredByAPixelOrMoreEveryPixelTakesTheRaysAlike) {
   // Against a focus of 2 m (0.5 D), at 4 px a dioptre: 1 m blurs by 2 px,
   // 8 m by 1.5 px (behind the focus).
   for (const float depth : {1.0f, 8.0f}) {
-    const Shared s = share(one_ray_frame(depth, true, 0.5f), 4);
-    EXPECT_FALSE(s.result.by_spread) << depth;
+    const Shared s = share(one_ray_frame(depth, true, 0.5f), 3.0);
+    EXPECT_FALSE(s.result.uneven) << depth;
     for (const std::uint32_t n : s.shares)
       ASSERT_EQ(n, 3u) << depth;
   }
   // 1.8 m: 0.22 px, sharp.
-  const Shared sharp = share(one_ray_frame(1.8f, true, 0.5f), 4);
-  EXPECT_TRUE(sharp.result.by_spread);
+  const Shared sharp = share(one_ray_frame(1.8f, true, 0.5f), 3.0);
+  EXPECT_TRUE(sharp.result.uneven);
   EXPECT_GT(double(rays_in_columns(sharp, kEdge - 1, kEdge + 1)), 0.5 * double(sharp.result.rays));
 }
 
-TEST(FirstFrameShares, TheReconstructionLeavesThePixelsThatTookMoreAlone) {
-  // A row of pixels blurred by 2 px, one holding 16 samples of another
-  // colour among neighbours of 2: kept above 4 samples, it keeps its own mean
-  // and lends its neighbours nothing; not kept, it pulls them towards it.
+TEST(FirstFrameShares, AFractionOfARayGoesToTheSharpPixelsFirst) {
+  // A quarter of the frame (the columns left of 8) blurred by 2 px, the rest
+  // sharp with the edge: a quarter of a ray a pixel more all goes to the
+  // sharp pixels, most of it to the edge's; the blurred ones take none.
+  OneRayFrame f = one_ray_frame(kFocusM, true, 0.5f);
+  for (std::uint32_t y = 0; y < kHeight; ++y)
+    for (std::uint32_t x = 0; x < 8; ++x)
+      f.aux[std::size_t(y) * kWidth + x].x = 1.0f; // 1 m: 2 px of blur
+  const double budget = 0.25 * kWidth * kHeight;
+  const Shared s = share(f, 0.25);
+  EXPECT_TRUE(s.result.uneven);
+  EXPECT_EQ(rays_in_columns(s, 0, 8), 0u);
+  EXPECT_NEAR(double(s.result.rays), budget, 0.05 * budget);
+  EXPECT_GT(double(rays_in_columns(s, kEdge - 1, kEdge + 1)), 0.5 * budget);
+  // Past a ray a pixel for each sharp one, the blurred ones share the rest:
+  // 0.9 of a ray a pixel is 0.75 for the sharp, 0.6 each for the blurred.
+  const Shared more = share(f, 0.9);
+  const double blurred = double(rays_in_columns(more, 0, 8)) / (8.0 * kHeight);
+  EXPECT_NEAR(blurred, 0.6, 0.15);
+  EXPECT_NEAR(double(more.result.rays), 0.9 * kWidth * kHeight, 0.05 * 0.9 * kWidth * kHeight);
+}
+
+TEST(FirstFrameShares, AFractionOfARayBlurredEverywhereGoesToPixelsAtRandom) {
+  // Nothing sharp: half a ray a pixel is one more ray in about half of them.
+  const Shared s = share(one_ray_frame(1.0f, true, 0.5f), 0.5);
+  EXPECT_TRUE(s.result.uneven);
+  std::uint64_t took = 0;
+  for (const std::uint32_t n : s.shares) {
+    ASSERT_LE(n, 1u);
+    took += n;
+  }
+  EXPECT_NEAR(double(took), 0.5 * kWidth * kHeight, 0.1 * kWidth * kHeight);
+  EXPECT_EQ(took, s.result.rays);
+}
+
+TEST(FirstFrameShares, APixelOfManySamplesLendsNoMoreThanItsNeighboursOwn) {
+  // A row of pixels blurred by 2 px, one of them white among grey ones of 2
+  // samples. Holding 16 samples, it lends its neighbours its mean with the
+  // weight of their own 2, exactly as if it held 2; it borrows theirs whole,
+  // and its own 16 keep it nearer its own mean than 2 would.
   const OneRayFrame f = one_ray_frame(1.0f, false, 0.0f);
   const std::size_t pixels = f.aux.size();
-  std::vector<glm::vec4> mixed(pixels), real(pixels, glm::vec4(0.2f, 0.2f, 0.2f, 0.0f) * 2.0f);
-  std::vector<glm::vec4> aux = f.aux;
-  std::vector<std::uint32_t> counts(pixels, 2u);
   const std::size_t edge = std::size_t(kHeight / 2) * kWidth + kEdge;
-  for (std::size_t i = 0; i < pixels; ++i) {
-    aux[i] *= 2.0f; // two samples' sums
-    mixed[i] = glm::vec4(0.2f, 0.2f, 0.2f, 0.0f) * 2.0f;
-  }
-  counts[edge] = 16;
-  aux[edge] = f.aux[edge] * 16.0f;
-  mixed[edge] = glm::vec4(1.0f, 1.0f, 1.0f, 1.0f) * 16.0f;
-  real[edge] = glm::vec4(0.2f, 0.2f, 0.2f, 0.0f) * 16.0f;
   std::vector<glm::vec4> out_mixed(pixels), out_real(pixels), scratch_mixed(pixels),
       scratch_real(pixels);
   std::vector<float> scratch_weight(pixels), blur(pixels);
   std::vector<DefocusGaussian> gaussian(pixels);
   WorkerPool pool(2);
-  const auto filtered = [&](std::uint32_t keep_above) {
-    DefocusFilterSettings settings;
-    settings.keep_above_samples = keep_above;
+  const auto filtered = [&](std::uint32_t edge_samples, bool lend_up_to_own) {
+    const glm::vec4 grey(0.2f, 0.2f, 0.2f, 0.0f);
+    std::vector<glm::vec4> mixed(pixels, grey * 2.0f), real(pixels, grey * 2.0f), aux = f.aux;
+    std::vector<std::uint32_t> counts(pixels, 2u);
+    for (glm::vec4 &a : aux)
+      a *= 2.0f; // two samples' sums
+    const float n = float(edge_samples);
+    counts[edge] = edge_samples;
+    aux[edge] = f.aux[edge] * n;
+    mixed[edge] = glm::vec4(1.0f) * n;
+    real[edge] = grey * n;
     filter_defocus(
-        camera(), f.spans, mixed, real, aux, counts, settings,
+        camera(), f.spans, mixed, real, aux, counts,
+        DefocusFilterSettings{.lend_up_to_own = lend_up_to_own},
         {out_mixed, out_real, scratch_mixed, scratch_real, scratch_weight, blur, gaussian}, pool);
     return std::pair(out_mixed[edge], out_mixed[edge - 1]);
   };
-  const auto [kept_edge, kept_neighbour] = filtered(4);
-  EXPECT_EQ(kept_edge, glm::vec4(1.0f));
-  EXPECT_NEAR(kept_neighbour.x, 0.2f, 1e-6f);
-  EXPECT_EQ(kept_neighbour.w, 0.0f);
-  const auto [edge_mean, neighbour_mean] = filtered(std::numeric_limits<std::uint32_t>::max());
-  EXPECT_LT(edge_mean.x, 0.99f);
-  EXPECT_GT(neighbour_mean.x, 0.3f);
+  const auto [many_edge, many_neighbour] = filtered(16, true);
+  const auto [few_edge, few_neighbour] = filtered(2, true);
+  EXPECT_GT(many_neighbour.x, 0.25f) << "the white pixel lends nothing";
+  EXPECT_NEAR(many_neighbour.x, few_neighbour.x, 1e-6f);
+  EXPECT_NEAR(many_neighbour.w, few_neighbour.w, 1e-6f);
+  EXPECT_GT(many_edge.x, few_edge.x + 0.05f);
+  EXPECT_LT(many_edge.x, 0.99f) << "it borrows nothing";
+  // Lent whole (a history of moved samples), its 16 samples pull the
+  // neighbour further; with 2 samples the rule changes nothing.
+  const glm::vec4 whole_neighbour = filtered(16, false).second;
+  EXPECT_GT(whole_neighbour.x, many_neighbour.x + 0.05f);
+  EXPECT_EQ(filtered(2, false), filtered(2, true));
 }
 
 } // namespace
@@ -256,6 +296,49 @@ TEST(FrameHistory, AFirstFrameInFocusGivesItsRaysToTheEdges) {
               alike4, spread4, alike8, spread8);
   EXPECT_LT(spread4, 0.9 * alike4);
   EXPECT_LT(spread8, 0.9 * alike8);
+}
+
+TEST(FrameHistory, AFirstFrameSpendsAFractionOfARayAtItsEdges) {
+  // Half a ray a pixel more (a frame budget between 1 and 2 rays a pixel)
+  // goes to the sharp ball's rim and its shadows': the frame traces 1.5
+  // rays a pixel, and its error is well below a frame of one ray alike.
+  const Scene scene = ball_scene();
+  const Frames reference = converged(scene, 77);
+  double one = 0.0, more = 0.0;
+  for (std::uint32_t n = 0; n < 8; ++n) {
+    Frames a(scene), b(scene);
+    FrameRequest request = still(scene, 1, 900 + n);
+    const FrameReport alike = a.render(request);
+    request.extra_rays_per_pixel = 0.5f;
+    const FrameReport shared = b.render(request);
+    EXPECT_EQ(alike.camera_rays, alike.traced_pixels);
+    EXPECT_NEAR(double(shared.camera_rays), 1.5 * double(shared.traced_pixels),
+                0.03 * double(shared.traced_pixels));
+    one += std::pow(virtual_error(a, reference), 2);
+    more += std::pow(virtual_error(b, reference), 2);
+  }
+  one = std::sqrt(one / 8.0);
+  more = std::sqrt(more / 8.0);
+  std::printf("[ history ] first frames in focus: error %.4f at 1 rpp, %.4f at 1.5\n", one, more);
+  EXPECT_LT(more, 0.85 * one);
+}
+
+TEST(FrameHistory, AHeldShotSpendsAFractionOfARayAfterItsPilot) {
+  // The pilot's frames give every pixel a ray alike and leave the fraction;
+  // from the fifth sample on, the frames share theirs by noise, fraction
+  // and all.
+  const Scene scene = ball_scene();
+  Frames frames(scene);
+  FrameRequest request = still(scene, 1, 23);
+  request.extra_rays_per_pixel = 0.5f;
+  for (int n = 0; n < 8; ++n) {
+    const FrameReport report = frames.render(request);
+    const double pixels = double(report.traced_pixels);
+    if (n == 0 || n >= 4)
+      EXPECT_NEAR(double(report.camera_rays), 1.5 * pixels, 0.05 * pixels) << n;
+    else
+      EXPECT_EQ(report.camera_rays, report.traced_pixels) << n;
+  }
 }
 
 TEST(FrameHistory, AFirstFrameSharedKeepsTheHistoryWithinItsMostSamples) {

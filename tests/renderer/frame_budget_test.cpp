@@ -106,6 +106,33 @@ TEST(FrameBudget, ScalesOnlyTheRaysTimeWithTheRays) {
   EXPECT_EQ(apart.rpp(), 2u);
 }
 
+TEST(FrameBudget, GivesTheFractionOfARayThatFits) {
+  // 8 ms fixed and 12 ms a ray a pixel: 2 whole rays fit 36 ms (0.9 of 40),
+  // and a fraction more 34 ms (0.85): 2.17 rays a pixel, in sixteenths 2
+  // and 2/16.
+  Device device{.overhead_s = 0.008, .per_rpp_s = 0.012};
+  FrameBudget budget(FrameBudgetSettings{.target_s = 0.040});
+  for (int i = 0; i < 30; ++i) {
+    const double rays = device.per_rpp_s * budget.rays_per_pixel();
+    budget.measured(budget.rays_per_pixel(), device.overhead_s + rays, rays);
+  }
+  EXPECT_DOUBLE_EQ(budget.rays_per_pixel(), 2.0 + 2.0 / 16.0);
+  EXPECT_EQ(budget.rpp(), 2u);
+  // A renderer that traces the whole rays alone is measured at them, and
+  // asked the same again.
+  budget.measured(2.0, device.overhead_s + 2.0 * device.per_rpp_s, 2.0 * device.per_rpp_s);
+  EXPECT_DOUBLE_EQ(budget.rays_per_pixel(), 2.0 + 2.0 / 16.0);
+  // At 14 ms a ray, 2 whole rays fill 36 ms exactly; within 34 ms only 1.86
+  // would: the whole rays stay.
+  Device dearer{.overhead_s = 0.008, .per_rpp_s = 0.014};
+  FrameBudget whole(FrameBudgetSettings{.target_s = 0.040});
+  for (int i = 0; i < 30; ++i) {
+    const double rays = dearer.per_rpp_s * whole.rays_per_pixel();
+    whole.measured(whole.rays_per_pixel(), dearer.overhead_s + rays, rays);
+  }
+  EXPECT_DOUBLE_EQ(whole.rays_per_pixel(), 2.0);
+}
+
 TEST(FrameBudget, StaysWithinItsRange) {
   FrameBudget fast(FrameBudgetSettings{.target_s = 1.0, .max_rpp = 64});
   Device device;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdlib>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -340,6 +341,14 @@ TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
   EXPECT_EQ(r.status, FrameStatus::bad_input);
   EXPECT_NE(r.detail.find("plate-only frame without a camera frame"), std::string::npos)
       << r.detail;
+  // A fraction of a ray is less than a ray, and a number.
+  request.plate_only = false;
+  for (const float extra : {1.0f, -0.25f, std::numeric_limits<float>::quiet_NaN()}) {
+    request.extra_rays_per_pixel = extra;
+    r = renderer->render(request, {right, plate}, std::span(&target, 1));
+    EXPECT_EQ(r.status, FrameStatus::bad_input) << extra;
+    EXPECT_NE(r.detail.find("a fraction of a ray a pixel"), std::string::npos) << r.detail;
+  }
 }
 
 // A frame whose camera pose is not known yet (FrameRequest::plate_only) is

@@ -52,7 +52,8 @@ function show(state) {
     text('zoom', fixed(frame.focal_length_mm, 1));
     text('frame', String(frame.frame));
     health($('lens-fresh'), frame.lens_fresh, 'current', 'held (stale)');
-    text('rpp', String(frame.rpp));
+    // A mean: the frame budget gives fractions of a ray (frame_budget.h).
+    text('rpp', Number.isInteger(frame.rpp) ? String(frame.rpp) : fixed(frame.rpp, 2));
     text('traced', (100 * frame.traced).toFixed(0) + ' %');
   }
   const pose = state.pose;

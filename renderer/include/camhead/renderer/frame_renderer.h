@@ -41,6 +41,13 @@ struct VideoBuffer {
 struct FrameRequest {
   FrameCamera camera;
   std::uint32_t rays_per_pixel = 1; // the mean, for adaptive frames
+  // A fraction of a ray a pixel more, on average, in [0, 1): the part of a
+  // frame budget between two whole numbers (frame_budget.h). Only frames
+  // that share their rays unevenly spend it: the CPU reference's
+  // accumulating frames with share_by_noise, a history's first frame (its
+  // sharp pixels first) and a held shot's after the pilot (its noisiest
+  // pixels; ray_shares.h). The others trace rays_per_pixel.
+  float extra_rays_per_pixel = 0.0f;
   bool adaptive = false;
   AdaptiveSampling adaptive_settings;
   // The frame's own noise pattern; 0 takes the scene's render.seed. An
