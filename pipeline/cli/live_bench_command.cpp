@@ -368,7 +368,14 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
   write_canvas(args.out_dir / "live_pull.png", canvas);
 }
 
-int run_live(const LiveArgs &args) {
+int run_live(LiveArgs args) {
+  // In sixteenths of a ray, as the frame budget gives them: the fraction is
+  // then exact in a float, below 1.
+  if (!(args.rpp >= 1.0)) { // NaN passes CLI::Range
+    std::fprintf(stderr, "bench live: --rpp %g is not a number of rays per pixel\n", args.rpp);
+    return 2;
+  }
+  args.rpp = std::floor(args.rpp * 16.0) / 16.0;
   if (!args.device.empty() && args.executor != "gpu") {
     std::fprintf(stderr,
                  "bench live: --device '%s' picks a Vulkan device for --executor gpu; the "
@@ -522,8 +529,9 @@ void add_bench_live_command(CLI::App &bench) {
       ->check(path_text());
   cmd->add_option("--rpp", args->rpp,
                   "Rays per pixel of each live frame, a mean: what the frame budget holds\n"
-                  "at the camera's rate (camhead run's status line). A fraction (1.5) goes\n"
-                  "where a frame shares its rays unevenly (a first frame's sharp edges)")
+                  "at the camera's rate (camhead run's status line). A fraction (1.5; in\n"
+                  "sixteenths of a ray) goes where a frame shares its rays unevenly (a\n"
+                  "first frame's sharp edges)")
       ->check(CLI::Range(1.0, 4096.0))
       ->capture_default_str();
   cmd->add_option("--frames", args->frames, "Still frames after rest")

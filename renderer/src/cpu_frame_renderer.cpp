@@ -374,7 +374,7 @@ private:
       const std::uint32_t k =
           std::min(first_frame_rest_ > 0.0 ? 1u : rpp, most - std::min(most, history_uniform_));
       // No pixel goes past its pattern's end: after a first frame that gave
-      // its sharp pixels' rays by spread, they hold more than the others.
+      // its rays unevenly, some pixels hold more than the others.
       bool alike = true;
       std::uint64_t rays = 0;
       span_firsts_.clear();

@@ -22,7 +22,8 @@
 // no mask) keeps I_m == I_r, and its composite stays the camera's.
 //
 // The GPU executor's twin is renderer/shaders/reconstruct.glsl, the same
-// steps in the same order (its exp and cube root the device's). The rules
+// steps in the same order (its exp and cube root the device's), but for
+// lend_up_to_own: its pixels all hold the same samples. The rules
 // for one pixel (its blur, its sigma and reach, which neighbours are alike)
 // are written once, in renderer/shaders/reconstruct_rules.glsl, which both
 // compile.
@@ -52,7 +53,9 @@ struct DefocusFilterSettings {
   // the 14-m pull frame afresh: 0.0375, 0.0443 and 0.0370 lent whole;
   // 0.0339, 0.0253 and 0.0351 with the pixels that took more left out (the
   // rule before); 0.0265, 0.0249 and 0.0273 lent up to the pixel's own
-  // count. Not for a history of samples moved from the frames before
+  // count. In the columns' pass the rows' sums are lent by the two pixels'
+  // own counts, which holds the rule only nearly on the diagonals. Not for
+  // a history of samples moved from the frames before
   // (sample_store.h), whose counts differ by where the samples land: there
   // it made the rig's pull frames up to 6 % noisier (bench/RESULTS.md). The
   // GPU executor's pixels all hold the same samples, and lend whole.

@@ -12,6 +12,12 @@ FrameBudget::FrameBudget(const FrameBudgetSettings &settings)
   if (!(settings.target_s > 0.0))
     throw std::invalid_argument("frame-time target must be > 0 s, not " +
                                 std::to_string(settings.target_s));
+  if (!(settings.headroom > 0.0 && settings.headroom <= 1.0 && settings.fraction_headroom > 0.0 &&
+        settings.fraction_headroom <= settings.headroom))
+    throw std::invalid_argument("headroom " + std::to_string(settings.headroom) +
+                                " and fraction headroom " +
+                                std::to_string(settings.fraction_headroom) +
+                                " must be in (0, 1], the fraction's no larger");
   if (settings.min_rpp == 0 || settings.min_rpp > settings.max_rpp)
     throw std::invalid_argument("rays per pixel range " + std::to_string(settings.min_rpp) + ".." +
                                 std::to_string(settings.max_rpp) + " is empty or 0");

@@ -200,7 +200,7 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
   const std::uint64_t rays =
       round_shares(spans, width, wanted, {counts, own, settings.most, settings.pattern_room},
                    settings.rounding_key, buffers.shares);
-  return {rays, sharp > 0.0 || blurred_each != std::floor(blurred_each)};
+  return {rays, rays > 0 && (sharp > 0.0 || blurred_each != std::floor(blurred_each))};
 }
 
 } // namespace camhead::renderer::cpu

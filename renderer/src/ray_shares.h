@@ -57,7 +57,8 @@ struct RayShareBuffers {
 // rays a pixel: FrameRequest::extra_rays_per_pixel).
 //   - Where the lens blurs a pixel by kSharpBlurPx or more, the
 //     reconstruction (defocus_filter.h) averages it with its neighbours, and
-//     those pixels take the rays alike. Given by the spread of their one-ray
+//     those pixels take the rays alike (below a ray a pixel, what the sharp
+//     ones leave, at random). Given by the spread of their one-ray
 //     neighbourhoods (noise, there) they came out noisier.
 //   - Where it is sharp, little smooths it, and one ray a pixel aliases an
 //     edge. The sharp pixels share their rays by how much the picture varies
@@ -86,7 +87,7 @@ struct FirstFrameShares {
 
 struct FirstFrameShared {
   std::uint64_t rays = 0; // the rays given
-  bool uneven = false;    // whether the pixels took different shares
+  bool uneven = false;    // whether the pixels took different shares (not all 0)
 };
 
 // The shares of the rays after the first for each pixel of `spans` (the

@@ -343,6 +343,9 @@ TEST_P(FramePassThrough, RefusesFramesOfAnotherSizeOrTooFewBytes) {
       << r.detail;
   // A fraction of a ray is less than a ray, and a number.
   request.plate_only = false;
+  request.extra_rays_per_pixel = 15.0f / 16.0f;
+  EXPECT_EQ(renderer->render(request, {right, plate}, std::span(&target, 1)).status,
+            FrameStatus::ok);
   for (const float extra : {1.0f, -0.25f, std::numeric_limits<float>::quiet_NaN()}) {
     request.extra_rays_per_pixel = extra;
     r = renderer->render(request, {right, plate}, std::span(&target, 1));

@@ -52,7 +52,8 @@ struct FrameBudgetSettings {
 
 class FrameBudget {
 public:
-  // Throws std::invalid_argument for a target <= 0 or min_rpp > max_rpp (or 0).
+  // Throws std::invalid_argument for a target <= 0, min_rpp > max_rpp (or
+  // 0), or headrooms outside (0, 1] (the fraction's above the whole rays').
   explicit FrameBudget(const FrameBudgetSettings &settings);
 
   // Rays per pixel for the next frame, a mean in sixteenths of a ray (exact
