@@ -216,12 +216,9 @@ public:
         const cpu::FirstFrameShared rest = share_first_frame_rest(request, has_plate);
         report.camera_rays += rest.rays;
         trace_shares(has_plate, {});
-        if (rest.uneven) {
+        history_uniform_ += rest.least; // every pixel holds them
+        if (rest.uneven)
           history_all_uniform_ = false; // its pixels hold counts of their own
-        } else {                        // every pixel took the same share
-          history_uniform_ +=
-              std::uint32_t(rest.rays / std::max<std::uint64_t>(region_->pixels(), 1));
-        }
       }
       history_rays_ += report.camera_rays;
       report.history_samples =

@@ -197,10 +197,19 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
     return buffers.noise[i] == kAlike ? blurred_each
                                       : std::min(double(buffers.noise[i]) * scale, most_a_frame);
   };
-  const std::uint64_t rays =
+  FirstFrameShared shared;
+  shared.rays =
       round_shares(spans, width, wanted, {counts, own, settings.most, settings.pattern_room},
                    settings.rounding_key, buffers.shares);
-  return {rays, rays > 0 && (sharp > 0.0 || blurred_each != std::floor(blurred_each))};
+  std::uint32_t least = ~0u, most = 0;
+  for (const PixelSpan &span : spans)
+    for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i) {
+      least = std::min(least, buffers.shares[i]);
+      most = std::max(most, buffers.shares[i]);
+    }
+  shared.least = most >= least ? least : 0; // no span: no pixel
+  shared.uneven = most > least;
+  return shared;
 }
 
 } // namespace camhead::renderer::cpu

@@ -86,8 +86,9 @@ struct FirstFrameShares {
 };
 
 struct FirstFrameShared {
-  std::uint64_t rays = 0; // the rays given
-  bool uneven = false;    // whether the pixels took different shares (not all 0)
+  std::uint64_t rays = 0;  // the rays given
+  std::uint32_t least = 0; // the fewest any pixel took
+  bool uneven = false;     // whether the pixels took different shares
 };
 
 // The shares of the rays after the first for each pixel of `spans` (the

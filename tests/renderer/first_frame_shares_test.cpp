@@ -164,6 +164,7 @@ TEST(FirstFrameShares, BlurredByAPixelOrMoreEveryPixelTakesTheRaysAlike) {
   for (const float depth : {1.0f, 8.0f}) {
     const Shared s = share(one_ray_frame(depth, true, 0.5f), 3.0);
     EXPECT_FALSE(s.result.uneven) << depth;
+    EXPECT_EQ(s.result.least, 3u) << depth;
     for (const std::uint32_t n : s.shares)
       ASSERT_EQ(n, 3u) << depth;
   }
@@ -197,15 +198,21 @@ TEST(FirstFrameShares, AFractionOfARayGoesToTheSharpPixelsFirst) {
 }
 
 TEST(FirstFrameShares, AFractionOfARayBlurredEverywhereGoesToPixelsAtRandom) {
-  // Nothing sharp: half a ray a pixel is one more ray in about half of them.
-  const Shared s = share(one_ray_frame(1.0f, true, 0.5f), 0.5);
-  EXPECT_TRUE(s.result.uneven);
-  std::uint64_t took = 0;
-  for (const std::uint32_t n : s.shares) {
-    ASSERT_LE(n, 1u);
-    took += n;
+  // Nothing sharp: half a ray a pixel is one more ray in about half of
+  // them; and of 1.5, every pixel holds one at least (the history's alike
+  // samples).
+  for (const double rest : {0.5, 1.5}) {
+    const Shared s = share(one_ray_frame(1.0f, true, 0.5f), rest);
+    EXPECT_TRUE(s.result.uneven) << rest;
+    EXPECT_EQ(double(s.result.least), std::floor(rest)) << rest;
+    std::uint64_t more = 0;
+    for (const std::uint32_t n : s.shares) {
+      ASSERT_GE(double(n), std::floor(rest)) << rest;
+      ASSERT_LE(double(n), std::ceil(rest)) << rest;
+      more += n - std::uint32_t(std::floor(rest));
+    }
+    EXPECT_NEAR(double(more), 0.5 * kWidth * kHeight, 0.1 * kWidth * kHeight) << rest;
   }
-  EXPECT_NEAR(double(took), 0.5 * kWidth * kHeight, 0.1 * kWidth * kHeight);
 }
 
 TEST(FirstFrameShares, APixelOfManySamplesLendsNoMoreThanItsNeighboursOwn) {
