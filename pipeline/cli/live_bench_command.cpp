@@ -189,8 +189,7 @@ private:
                             bool reproject) const {
     FrameRequest request;
     request.camera = camera;
-    request.rays_per_pixel = std::uint32_t(rpp);
-    request.extra_rays_per_pixel = float(rpp - std::floor(rpp));
+    set_mean_rays_per_pixel(request, rpp);
     request.seed = seed;
     request.accumulation.enabled = true;
     request.accumulation.reconstruct = args_.reconstruct > 0.0;
@@ -369,13 +368,13 @@ void write_pull_pictures(const LiveArgs &args, const Scene &scene,
 }
 
 int run_live(LiveArgs args) {
-  // In sixteenths of a ray, as the frame budget gives them: the fraction is
-  // then exact in a float, below 1.
   if (!(args.rpp >= 1.0)) { // NaN passes CLI::Range
     std::fprintf(stderr, "bench live: --rpp %g is not a number of rays per pixel\n", args.rpp);
     return 2;
   }
-  args.rpp = std::floor(args.rpp * 16.0) / 16.0;
+  // In sixteenths of a ray, as the frames take it (set_mean_rays_per_pixel),
+  // so that the tables print what was rendered.
+  args.rpp = std::floor(args.rpp * kRaySteps) / kRaySteps;
   if (!args.device.empty() && args.executor != "gpu") {
     std::fprintf(stderr,
                  "bench live: --device '%s' picks a Vulkan device for --executor gpu; the "

@@ -152,12 +152,10 @@ void Pipeline::render_loop() {
     r.up = posed.up;
     renderer::FrameRequest request = setup_request(*setup_, options_.influence_region);
     request.camera = lens_camera(posed, lens.state);
-    if (setup_->board.render.rays_per_pixel) {
+    if (setup_->board.render.rays_per_pixel)
       request.rays_per_pixel = *setup_->board.render.rays_per_pixel;
-    } else {
-      request.rays_per_pixel = budget.rpp();
-      request.extra_rays_per_pixel = float(budget.rays_per_pixel() - budget.rpp());
-    }
+    else
+      renderer::set_mean_rays_per_pixel(request, budget.rays_per_pixel());
     request.seed = std::uint32_t(frame.sequence * 2654435761u) | 1u;
     // Before the pose source's first pose, virtual objects drawn from the
     // stand-in (the scene's camera) would stand wherever that puts them (on

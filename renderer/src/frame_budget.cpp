@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "camhead/renderer/frame_renderer.h"
+
 namespace camhead::renderer {
 
 FrameBudget::FrameBudget(const FrameBudgetSettings &settings)
@@ -45,10 +47,9 @@ void FrameBudget::measured(double rpp, double seconds, double rays_seconds) {
   const double most = std::max(rpp + 1.0, rpp * settings_.max_growth);
   // Whole rays within the headroom, or a ray's sixteenths within the
   // fraction's, whichever gives more.
-  constexpr double kSteps = 16.0;
   const double whole = std::floor(std::min(fits(settings_.headroom), most));
   const double sixteenths =
-      std::floor(std::min(fits(settings_.fraction_headroom), most) * kSteps) / kSteps;
+      std::floor(std::min(fits(settings_.fraction_headroom), most) * kRaySteps) / kRaySteps;
   rays_ =
       std::clamp(std::max(whole, sixteenths), double(settings_.min_rpp), double(settings_.max_rpp));
 }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "camhead/renderer/frame_budget.h"
+#include "camhead/renderer/frame_renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -127,6 +128,21 @@ TEST(FrameBudget, GivesTheFractionOfARayThatFits) {
     whole.measured(whole.rays_per_pixel(), dearer.overhead_s + rays, rays);
   }
   EXPECT_DOUBLE_EQ(whole.rays_per_pixel(), 2.0);
+}
+
+TEST(FrameBudget, AMeanOfRaysIsSplitIntoWholeRaysAndAFractionBelowOne) {
+  renderer::FrameRequest request;
+  renderer::set_mean_rays_per_pixel(request, 2.0 + 5.0 / 16.0 + 0.01);
+  EXPECT_EQ(request.rays_per_pixel, 2u);
+  EXPECT_EQ(request.extra_rays_per_pixel, 5.0f / 16.0f);
+  renderer::set_mean_rays_per_pixel(request, 1.99999999);
+  EXPECT_EQ(request.rays_per_pixel, 1u);
+  EXPECT_EQ(request.extra_rays_per_pixel, 15.0f / 16.0f);
+  for (const double bad : {0.5, -3.0, std::nan("")}) {
+    renderer::set_mean_rays_per_pixel(request, bad);
+    EXPECT_EQ(request.rays_per_pixel, 1u) << bad;
+    EXPECT_EQ(request.extra_rays_per_pixel, 0.0f) << bad;
+  }
 }
 
 TEST(FrameBudget, StaysWithinItsRange) {

@@ -12,6 +12,7 @@
 // Thread safety: one thread renders at a time.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -80,6 +81,21 @@ struct FrameRequest {
   // starts a new history.
   bool keep_composite = false;
 };
+
+// A mean of rays per pixel is given in sixteenths of a ray (the frame
+// budget's, frame_budget.h): the fraction is then exact in a float, and
+// below 1.
+inline constexpr double kRaySteps = 16.0;
+
+// Sets `request`'s rays per pixel to `mean` (at least 1; NaN is 1) rounded
+// down to sixteenths of a ray: its whole part in rays_per_pixel, the rest
+// in extra_rays_per_pixel.
+inline void set_mean_rays_per_pixel(FrameRequest &request, double mean) {
+  const double at_least_one = mean >= 1.0 ? mean : 1.0;
+  const double sixteenths = std::floor(at_least_one * kRaySteps) / kRaySteps;
+  request.rays_per_pixel = std::uint32_t(sixteenths);
+  request.extra_rays_per_pixel = float(sixteenths - std::floor(sixteenths));
+}
 
 enum class FrameStatus {
   ok,
