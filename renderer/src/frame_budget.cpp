@@ -5,8 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "camhead/renderer/frame_renderer.h"
-
 namespace camhead::renderer {
 
 FrameBudget::FrameBudget(const FrameBudgetSettings &settings)

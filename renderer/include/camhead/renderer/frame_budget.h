@@ -33,6 +33,11 @@
 
 namespace camhead::renderer {
 
+// A mean of rays per pixel is given in sixteenths of a ray, the budget's and
+// a frame request's alike (set_mean_rays_per_pixel, frame_renderer.h): the
+// fraction is then exact in a float, and below 1.
+inline constexpr double kRaySteps = 16.0;
+
 struct FrameBudgetSettings {
   double target_s = 1.0 / 30.0;
   std::uint32_t min_rpp = 1;

@@ -24,6 +24,7 @@
 #include "camhead/base/video_format.h"
 #include "camhead/renderer/accumulation.h"
 #include "camhead/renderer/adaptive.h"
+#include "camhead/renderer/frame_budget.h"
 #include "camhead/renderer/frame_camera.h"
 #include "camhead/renderer/scene.h"
 
@@ -82,14 +83,9 @@ struct FrameRequest {
   bool keep_composite = false;
 };
 
-// A mean of rays per pixel is given in sixteenths of a ray (the frame
-// budget's, frame_budget.h): the fraction is then exact in a float, and
-// below 1.
-inline constexpr double kRaySteps = 16.0;
-
 // Sets `request`'s rays per pixel to `mean` (at least 1; NaN is 1) rounded
-// down to sixteenths of a ray: its whole part in rays_per_pixel, the rest
-// in extra_rays_per_pixel.
+// down to sixteenths of a ray (kRaySteps, frame_budget.h): its whole part
+// in rays_per_pixel, the rest in extra_rays_per_pixel.
 inline void set_mean_rays_per_pixel(FrameRequest &request, double mean) {
   const double at_least_one = mean >= 1.0 ? mean : 1.0;
   const double sixteenths = std::floor(at_least_one * kRaySteps) / kRaySteps;
