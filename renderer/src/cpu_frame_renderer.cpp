@@ -399,6 +399,8 @@ private:
   cpu::FirstFrameShared share_first_frame_rest(const FrameRequest &request, bool has_plate) {
     cpu::FirstFrameShares settings;
     settings.rest = first_frame_rest_;
+    settings.reconstruct_strength =
+        request.accumulation.reconstruct ? request.accumulation.reconstruct_strength : 0.0;
     settings.most = request.accumulation.max_samples;
     settings.pattern_room = request.accumulation.max_samples - pattern_base_;
     settings.rounding_key = kernel_.frame.sampling.w ^ 0x5bd1e995u; // the frame's seed

@@ -80,6 +80,11 @@ float defocus_blur_px(const gpu::FrameParams &frame, const glm::vec4 &aux) {
   return rules::reconstruct_blur(aux, frame.lens.x * frame.lens.z, 1.0f / frame.lens.y);
 }
 
+float defocus_sigma_px(float blur, float samples, const DefocusFilterSettings &settings) {
+  return rules::reconstruct_sigma_of(blur, samples, float(settings.strength),
+                                     float(settings.max_radius_px));
+}
+
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
                     std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,
                     std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,

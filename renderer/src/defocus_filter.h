@@ -89,6 +89,11 @@ struct DefocusFilterBuffers {
 // infinity): the reconstruction's rule (reconstruct_rules.glsl).
 [[nodiscard]] float defocus_blur_px(const gpu::FrameParams &frame, const glm::vec4 &aux);
 
+// A pixel's Gaussian sigma in pixels, from its signed blur radius `blur`
+// and its `samples`: the reconstruction's rule (reconstruct_rules.glsl).
+[[nodiscard]] float defocus_sigma_px(float blur, float samples,
+                                     const DefocusFilterSettings &settings);
+
 void filter_defocus(const gpu::FrameParams &frame, std::span<const PixelSpan> spans,
                     std::span<const glm::vec4> mixed, std::span<const glm::vec4> real,
                     std::span<const glm::vec4> aux, std::span<const std::uint32_t> counts,

@@ -37,21 +37,22 @@ struct SampleLimits {
 
 // Each span pixel's share, wanted(i) rays (a double: 16 times a budget of
 // 2^28 rays a pixel would wrap 32 bits) within `limits`, rounded up or down
-// at random (a hash of the pixel and `key`) so that the shares add up to the
-// budget on average; their sum.
-template <typename Wanted>
+// at random so that the shares add up to the budget on average; their sum.
+// The draw is a hash of `key` and cell(i, x, y): the pixel's own index, or
+// one that a block of pixels shares, which then round alike.
+template <typename Wanted, typename Cell>
 std::uint64_t round_shares(std::span<const PixelSpan> spans, int width, const Wanted &wanted,
-                           const SampleLimits &limits, std::uint32_t key,
+                           const Cell &cell, const SampleLimits &limits, std::uint32_t key,
                            std::span<std::uint32_t> shares) {
   CpuKernel hasher; // for sampling.glsl's hash_u32
   std::uint64_t rays = 0;
   for (const PixelSpan &span : spans)
-    for (std::size_t i = std::size_t(span.y) * std::size_t(width) + span.x0;
-         i < std::size_t(span.y) * std::size_t(width) + span.x1; ++i) {
+    for (std::uint32_t x = span.x0; x < span.x1; ++x) {
+      const std::size_t i = std::size_t(span.y) * std::size_t(width) + x;
       const double want = wanted(i);
       const double whole = std::floor(want);
       const double u =
-          double(hasher.hash_u32(std::uint32_t(i) * 0x9e3779b9u ^ key)) * (1.0 / 4294967296.0);
+          double(hasher.hash_u32(cell(i, x, span.y) * 0x9e3779b9u ^ key)) * (1.0 / 4294967296.0);
       const std::uint32_t k = std::uint32_t(whole) + (u < want - whole ? 1u : 0u);
       shares[i] = std::min({k, sample_room(limits.most, limits.counts[i]),
                             sample_room(limits.pattern_room, limits.own[i])});
@@ -118,8 +119,11 @@ std::uint64_t share_rays_by_noise(std::span<const PixelSpan> spans, int width, i
   const auto wanted = [&](std::size_t i) {
     return std::min(double(buffers.noise[i]) * scale, most_a_frame);
   };
-  return round_shares(spans, width, wanted, {counts, own, most, pattern_room}, frame_index,
-                      buffers.shares);
+  const auto own_cell = [](std::size_t i, std::uint32_t, std::uint32_t) {
+    return std::uint32_t(i);
+  };
+  return round_shares(spans, width, wanted, own_cell, {counts, own, most, pattern_room},
+                      frame_index, buffers.shares);
 }
 
 FirstFrameShared
@@ -197,10 +201,36 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
     return buffers.noise[i] == kAlike ? blurred_each
                                       : std::min(double(buffers.noise[i]) * scale, most_a_frame);
   };
+  // A blurred pixel rounds with the aligned block of pixels that its
+  // reconstruction reaches over (2 sigma at its one sample, the widest
+  // power of two within it on a side, so that the block's pixels' keys are
+  // one aligned run of the pattern's Z order, sampling.glsl): the pixels
+  // holding a ray more then lie in whole blocks, whose samples spread over
+  // the aperture as the pattern's do, and their neighbours' one ray stays
+  // the pattern's too. Rounded a pixel at a time, a quarter of a ray a pixel
+  // left a blurred frame noisier than one ray alike; blocks of one side for
+  // every blurred pixel cost a frame of pixels blurred by one or two 4 %
+  // (bench/RESULTS.md).
+  const DefocusFilterSettings reconstruction{.strength = settings.reconstruct_strength};
+  const auto block_cell = [&](std::size_t i, std::uint32_t x, std::uint32_t y) {
+    if (buffers.noise[i] != kAlike)
+      return std::uint32_t(i);
+    const float reach =
+        2.0f * defocus_sigma_px(defocus_blur_px(frame, aux[i]), 1.0f, reconstruction);
+    std::uint32_t level = 0; // the block's side: 2^level pixels
+    while ((2u << level) <= kMostBlockSidePx && float(2u << level) <= reach)
+      ++level;
+    if (level == 0)
+      return std::uint32_t(i);
+    // Apart from the pixels' own indices (below 2^31) and each level's
+    // from the others'.
+    return 0x80000000u | (level << 27) | ((y >> level) << 13 & 0x07ffe000u) |
+           ((x >> level) & 0x1fffu);
+  };
   FirstFrameShared shared;
-  shared.rays =
-      round_shares(spans, width, wanted, {counts, own, settings.most, settings.pattern_room},
-                   settings.rounding_key, buffers.shares);
+  shared.rays = round_shares(spans, width, wanted, block_cell,
+                             {counts, own, settings.most, settings.pattern_room},
+                             settings.rounding_key, buffers.shares);
   std::uint32_t least = ~0u, most = 0;
   for (const PixelSpan &span : spans)
     for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i) {

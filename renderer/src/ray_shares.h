@@ -57,9 +57,10 @@ struct RayShareBuffers {
 // rays a pixel: FrameRequest::extra_rays_per_pixel).
 //   - Where the lens blurs a pixel by kSharpBlurPx or more, the
 //     reconstruction (defocus_filter.h) averages it with its neighbours, and
-//     those pixels take the rays alike (below a ray a pixel, what the sharp
-//     ones leave, at random). Given by the spread of their one-ray
-//     neighbourhoods (noise, there) they came out noisier.
+//     those pixels take the rays alike (a fraction of a ray, or below a ray
+//     a pixel what the sharp ones leave, in whole blocks of pixels as wide
+//     as the reconstruction reaches, at random). Given by the spread of
+//     their one-ray neighbourhoods (noise, there) they came out noisier.
 //   - Where it is sharp, little smooths it, and one ray a pixel aliases an
 //     edge. The sharp pixels share their rays by how much the picture varies
 //     about them: the spread of the virtual part of the 3x3 neighbourhood's
@@ -68,21 +69,26 @@ struct RayShareBuffers {
 //     rim, small where the virtual objects change nothing.
 //   - With a ray a pixel or more to give, the sharp pixels take as many in
 //     all as they would alike. With less, they take theirs first, up to a
-//     ray each, and the blurred ones share what is left, at random.
+//     ray each, and the blurred ones share what is left.
 // First frames, `camhead bench live --frames 1`, relative error focused at
 // 14 m (bench/RESULTS.md): on the moving rig's scene 0.0348 at 1 rpp,
 // 0.0244, 0.0198 and 0.0169 at 1.25, 1.5 and 1.75, and 0.0149 at 2 (0.0264
 // with every pixel's rays alike, 9 rpp's 0.0170); on the locked-off rig's
-// 0.0419, 0.0370, 0.0349, 0.0302 and 0.0265 (alike 0.0312).
+// 0.0419, 0.0370, 0.0351, 0.0300 and 0.0265 (alike 0.0312).
 // At 0.5 px the moving rig's scene focused far came out as noisy as with
 // every pixel alike, at 0.75 px with a fifth of the gain that 1 px gives.
 inline constexpr float kSharpBlurPx = 1.0f;
 
+// The widest block of blurred pixels that take a first frame's fraction of
+// a ray whole (share_first_frame_rays).
+inline constexpr std::uint32_t kMostBlockSidePx = 16;
+
 struct FirstFrameShares {
-  double rest = 1.0;              // rays a pixel after the first, a mean (> 0)
-  std::uint32_t most = 0;         // samples a pixel, at most (max_samples)
-  std::uint32_t pattern_room = 0; // samples of a pixel's own pattern, at most
-  std::uint32_t rounding_key = 0; // a new one each frame
+  double rest = 1.0;                 // rays a pixel after the first, a mean (> 0)
+  double reconstruct_strength = 1.0; // the reconstruction's (0: none), for its reach
+  std::uint32_t most = 0;            // samples a pixel, at most (max_samples)
+  std::uint32_t pattern_room = 0;    // samples of a pixel's own pattern, at most
+  std::uint32_t rounding_key = 0;    // a new one each frame
 };
 
 struct FirstFrameShared {

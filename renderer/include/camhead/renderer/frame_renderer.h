@@ -47,9 +47,9 @@ struct FrameRequest {
   // frame budget between two whole numbers (frame_budget.h). Only frames
   // that share their rays unevenly spend it: the CPU reference's
   // accumulating frames with share_by_noise, a history's first frame with
-  // nothing moved into it (its sharp pixels first) and a held shot's after
-  // the pilot (its noisiest pixels; ray_shares.h). The others trace
-  // rays_per_pixel.
+  // nothing moved into it (its sharp pixels first, then whole blocks of its
+  // blurred ones) and a held shot's after the pilot (its noisiest pixels;
+  // ray_shares.h). The others trace rays_per_pixel.
   float extra_rays_per_pixel = 0.0f;
   bool adaptive = false;
   AdaptiveSampling adaptive_settings;
