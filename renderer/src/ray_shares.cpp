@@ -22,8 +22,24 @@ float luminance_sigma(std::span<const glm::vec4> aux, std::span<const std::uint3
   return std::sqrt(std::max(variance, 0.0f));
 }
 
-// A first frame's pixel taking its rays alike (not sharp).
-constexpr float kAlike = -1.0f;
+// A first frame's pixel taking its rays alike (not sharp) is marked so in
+// place of a sharp one's want (which is above 0), with the level of the
+// block it rounds with (share_first_frame_rays): its side 2^level pixels.
+float alike_mark(std::uint32_t level) {
+  return -1.0f - float(level);
+}
+bool is_alike(float want) {
+  return want < 0.0f;
+}
+std::uint32_t alike_level(float mark) {
+  return std::uint32_t(-1.0f - mark);
+}
+
+// The widest block: the reconstruction's widest reach (2 sigma, at most
+// DefocusFilterSettings::max_radius_px), and a bound that the blocks' cell
+// numbers rely on.
+constexpr std::uint32_t kMostBlockLevel = 4;
+static_assert(DefocusFilterSettings{}.max_radius_px <= 1 << kMostBlockLevel);
 // The least want of a sharp pixel: its neighbours all alike, a pixel the
 // virtual objects may still reach on another ray.
 constexpr float kSharpFloor = 0.001f;
@@ -146,16 +162,35 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
                         (has_plate ? kernel.composite_luminance(glm::vec3(plate[i])) : 0.0f);
   };
   pool.run(int(spans.size()), virtual_part_of);
+  // A blurred pixel rounds with the aligned block of pixels that its
+  // reconstruction reaches over (2 sigma at its one sample, the widest
+  // power of two within it on a side, so that the block's pixels' keys are
+  // one aligned run of the pattern's Z order, sampling.glsl): the pixels
+  // holding a ray more then lie in whole blocks, whose samples spread over
+  // the aperture as the pattern's do, and their neighbours' one ray stays
+  // the pattern's too. Rounded a pixel at a time, a quarter of a ray a pixel
+  // left a blurred frame noisier than one ray alike; a side of 4 or 8 for
+  // every blurred pixel made a frame of pixels blurred by one or two 4 %
+  // noisier (bench/RESULTS.md).
+  const DefocusFilterSettings reconstruction{.strength = settings.reconstruct_strength};
+  const auto block_level = [&](float blur) {
+    const float reach = 2.0f * defocus_sigma_px(blur, 1.0f, reconstruction);
+    std::uint32_t level = 0;
+    while (level < kMostBlockLevel && float(2u << level) <= reach)
+      ++level;
+    return level;
+  };
   // A sharp pixel's want, in `noise`: the spread of the virtual part over
-  // the traced pixels of its 3x3 neighbourhood, and a floor; kAlike for the
+  // the traced pixels of its 3x3 neighbourhood, and a floor; alike_mark for the
   // others.
   auto want_of = [&](int k) {
     const PixelSpan &span = spans[std::size_t(k)];
     const int y = int(span.y);
     for (int x = int(span.x0); x < int(span.x1); ++x) {
       const std::size_t i = at(y, x);
-      if (!(std::abs(defocus_blur_px(frame, aux[i])) < kSharpBlurPx)) {
-        buffers.noise[i] = kAlike;
+      const float blur = defocus_blur_px(frame, aux[i]);
+      if (!(std::abs(blur) < kSharpBlurPx)) {
+        buffers.noise[i] = alike_mark(block_level(blur));
         continue;
       }
       float sum = 0.0f, squares = 0.0f, n = 0.0f;
@@ -181,12 +216,13 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
   // With a ray a pixel after the first or more, the sharp pixels take as
   // many in all as alike; with less, theirs first, up to a ray each (one
   // ray a pixel aliases a sharp edge, and the reconstruction smooths a
-  // blurred one), and the blurred ones share what is left, at random.
+  // blurred one), and the blurred ones share what is left, a block of them
+  // at a time.
   double want_sum = 0.0, sharp = 0.0, pixels = 0.0;
   for (const PixelSpan &span : spans)
     for (std::size_t i = at(int(span.y), int(span.x0)); i < at(int(span.y), int(span.x1)); ++i) {
       pixels += 1.0;
-      if (buffers.noise[i] != kAlike) {
+      if (!is_alike(buffers.noise[i])) {
         want_sum += buffers.noise[i];
         sharp += 1.0;
       }
@@ -198,33 +234,17 @@ share_first_frame_rays(std::span<const PixelSpan> spans, const gpu::FrameParams 
   const double scale = want_sum > 0.0 ? sharp_rays / want_sum : 0.0;
   const double most_a_frame = double(kMostRaysAPixel) * (1.0 + rest);
   const auto wanted = [&](std::size_t i) {
-    return buffers.noise[i] == kAlike ? blurred_each
+    return is_alike(buffers.noise[i]) ? blurred_each
                                       : std::min(double(buffers.noise[i]) * scale, most_a_frame);
   };
-  // A blurred pixel rounds with the aligned block of pixels that its
-  // reconstruction reaches over (2 sigma at its one sample, the widest
-  // power of two within it on a side, so that the block's pixels' keys are
-  // one aligned run of the pattern's Z order, sampling.glsl): the pixels
-  // holding a ray more then lie in whole blocks, whose samples spread over
-  // the aperture as the pattern's do, and their neighbours' one ray stays
-  // the pattern's too. Rounded a pixel at a time, a quarter of a ray a pixel
-  // left a blurred frame noisier than one ray alike; blocks of one side for
-  // every blurred pixel cost a frame of pixels blurred by one or two 4 %
-  // (bench/RESULTS.md).
-  const DefocusFilterSettings reconstruction{.strength = settings.reconstruct_strength};
   const auto block_cell = [&](std::size_t i, std::uint32_t x, std::uint32_t y) {
-    if (buffers.noise[i] != kAlike)
-      return std::uint32_t(i);
-    const float reach =
-        2.0f * defocus_sigma_px(defocus_blur_px(frame, aux[i]), 1.0f, reconstruction);
-    std::uint32_t level = 0; // the block's side: 2^level pixels
-    while ((2u << level) <= kMostBlockSidePx && float(2u << level) <= reach)
-      ++level;
+    const std::uint32_t level = is_alike(buffers.noise[i]) ? alike_level(buffers.noise[i]) : 0u;
     if (level == 0)
       return std::uint32_t(i);
-    // Apart from the pixels' own indices (below 2^31) and each level's
-    // from the others'.
-    return 0x80000000u | (level << 27) | ((y >> level) << 13 & 0x07ffe000u) |
+    // Above the pixels' own indices (a frame has far fewer than 2^31
+    // pixels), each level's apart; blocks 2^13 or 2^14 blocks apart share
+    // a draw, which ties their rounding but biases nothing.
+    return 0x80000000u | (level << 27) | (((y >> level) << 13) & 0x07ffe000u) |
            ((x >> level) & 0x1fffu);
   };
   FirstFrameShared shared;

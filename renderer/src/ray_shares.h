@@ -59,8 +59,9 @@ struct RayShareBuffers {
 //     reconstruction (defocus_filter.h) averages it with its neighbours, and
 //     those pixels take the rays alike (a fraction of a ray, or below a ray
 //     a pixel what the sharp ones leave, in whole blocks of pixels as wide
-//     as the reconstruction reaches, at random). Given by the spread of
-//     their one-ray neighbourhoods (noise, there) they came out noisier.
+//     as the reconstruction reaches, at random; a pixel at a time without
+//     the reconstruction). Given by the spread of their one-ray
+//     neighbourhoods (noise, there) they came out noisier.
 //   - Where it is sharp, little smooths it, and one ray a pixel aliases an
 //     edge. The sharp pixels share their rays by how much the picture varies
 //     about them: the spread of the virtual part of the 3x3 neighbourhood's
@@ -78,10 +79,6 @@ struct RayShareBuffers {
 // At 0.5 px the moving rig's scene focused far came out as noisy as with
 // every pixel alike, at 0.75 px with a fifth of the gain that 1 px gives.
 inline constexpr float kSharpBlurPx = 1.0f;
-
-// The widest block of blurred pixels that take a first frame's fraction of
-// a ray whole (share_first_frame_rays).
-inline constexpr std::uint32_t kMostBlockSidePx = 16;
 
 struct FirstFrameShares {
   double rest = 1.0;                 // rays a pixel after the first, a mean (> 0)

@@ -209,6 +209,15 @@ bool alike_in_blocks(const Shared &s, std::uint32_t side) {
   return true;
 }
 
+// Whether every row (or column) of pixels took one share.
+bool alike_along(const Shared &s, bool rows) {
+  for (std::uint32_t y = 0; y < kHeight; ++y)
+    for (std::uint32_t x = 0; x < kWidth; ++x)
+      if (s.shares[std::size_t(y) * kWidth + x] != s.shares[rows ? std::size_t(y) * kWidth : x])
+        return false;
+  return true;
+}
+
 TEST(FirstFrameShares, AFractionOfARayBlurredEverywhereGoesToWholeBlocksAtRandom) {
   // Nothing sharp: half a ray a pixel is one more ray in about half of
   // them; and of 1.5, every pixel holds one at least (the history's alike
@@ -231,6 +240,22 @@ TEST(FirstFrameShares, AFractionOfARayBlurredEverywhereGoesToWholeBlocksAtRandom
   const Shared wider = share(one_ray_frame(0.5f, true, 0.5f), 0.5);
   EXPECT_TRUE(alike_in_blocks(wider, 4));
   EXPECT_FALSE(alike_in_blocks(wider, 8));
+  // Each block draws its own: not a row's or a column's draw.
+  EXPECT_FALSE(alike_along(wider, true));
+  EXPECT_FALSE(alike_along(wider, false));
+  // Both in one frame, the left half at 2 px of blur, the right at 6: each
+  // pixel by its own reach.
+  OneRayFrame both = one_ray_frame(1.0f, true, 0.5f);
+  for (std::size_t i = 0; i < both.aux.size(); ++i)
+    if (i % kWidth >= kWidth / 2)
+      both.aux[i].x = 0.5f; // the depth sum of its one sample
+  const Shared mixed = share(both, 0.5);
+  Shared left = mixed, right = mixed;
+  for (std::size_t i = 0; i < mixed.shares.size(); ++i)
+    (i % kWidth < kWidth / 2 ? right : left).shares[i] = 0;
+  EXPECT_TRUE(alike_in_blocks(left, 2));
+  EXPECT_FALSE(alike_in_blocks(left, 4));
+  EXPECT_TRUE(alike_in_blocks(right, 4));
   // With no reconstruction to reach over, a pixel at a time.
   EXPECT_FALSE(alike_in_blocks(share(one_ray_frame(1.0f, true, 0.5f), 0.5, 0.0), 2));
 }
