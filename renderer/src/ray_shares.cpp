@@ -40,6 +40,7 @@ std::uint32_t alike_level(float mark) {
 // numbers rely on.
 constexpr std::uint32_t kMostBlockLevel = 4;
 static_assert(DefocusFilterSettings{}.max_radius_px <= 1 << kMostBlockLevel);
+
 // The least want of a sharp pixel: its neighbours all alike, a pixel the
 // virtual objects may still reach on another ray.
 constexpr float kSharpFloor = 0.001f;
