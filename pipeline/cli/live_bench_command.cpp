@@ -374,7 +374,7 @@ int run_live(LiveArgs args) {
   }
   // In sixteenths of a ray, as the frames take it (set_mean_rays_per_pixel),
   // so that the tables print what was rendered.
-  args.rpp = std::floor(args.rpp * kRaySteps) / kRaySteps;
+  args.rpp = in_ray_steps(args.rpp);
   if (!args.device.empty() && args.executor != "gpu") {
     std::fprintf(stderr,
                  "bench live: --device '%s' picks a Vulkan device for --executor gpu; the "

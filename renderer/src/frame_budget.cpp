@@ -46,8 +46,7 @@ void FrameBudget::measured(double rpp, double seconds, double rays_seconds) {
   // Whole rays within the headroom, or a ray's sixteenths within the
   // fraction's, whichever gives more.
   const double whole = std::floor(std::min(fits(settings_.headroom), most));
-  const double sixteenths =
-      std::floor(std::min(fits(settings_.fraction_headroom), most) * kRaySteps) / kRaySteps;
+  const double sixteenths = in_ray_steps(std::min(fits(settings_.fraction_headroom), most));
   rays_ =
       std::clamp(std::max(whole, sixteenths), double(settings_.min_rpp), double(settings_.max_rpp));
 }

@@ -29,6 +29,7 @@
 // Pure arithmetic on the timings it is given: testable with a made-up clock.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 namespace camhead::renderer {
@@ -37,6 +38,11 @@ namespace camhead::renderer {
 // a frame request's alike (set_mean_rays_per_pixel, frame_renderer.h): the
 // fraction is then exact in a float, and below 1.
 inline constexpr double kRaySteps = 16.0;
+
+// `rays` rounded down to sixteenths of a ray (kRaySteps).
+[[nodiscard]] inline double in_ray_steps(double rays) {
+  return std::floor(rays * kRaySteps) / kRaySteps;
+}
 
 struct FrameBudgetSettings {
   double target_s = 1.0 / 30.0;

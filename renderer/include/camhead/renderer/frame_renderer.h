@@ -88,7 +88,7 @@ struct FrameRequest {
 // in rays_per_pixel, the rest in extra_rays_per_pixel.
 inline void set_mean_rays_per_pixel(FrameRequest &request, double mean) {
   const double at_least_one = mean >= 1.0 ? mean : 1.0;
-  const double sixteenths = std::floor(at_least_one * kRaySteps) / kRaySteps;
+  const double sixteenths = in_ray_steps(at_least_one);
   request.rays_per_pixel = std::uint32_t(sixteenths);
   request.extra_rays_per_pixel = float(sixteenths - std::floor(sixteenths));
 }
