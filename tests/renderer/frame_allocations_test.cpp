@@ -203,6 +203,25 @@ TEST_P(FrameAllocations, APullThroughALensModelAllocatesNothingFrameAfterFrame) 
   EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull_and_pan(live, rest)); }), 0u);
 }
 
+// A frame budget between two whole rays (FrameRequest::extra_rays_per_pixel):
+// a held shot's frames after the pilot spend the fraction by noise, and a
+// pull's frames, none moved into the next (so each a first frame), at
+// their edges and in blocks of their blurred pixels (ray_shares.h).
+TEST_P(FrameAllocations, AFractionOfARayAllocatesNothingFrameAfterFrame) {
+  LiveFrames live(GetParam());
+  if (!live.available())
+    GTEST_SKIP() << "no Vulkan device";
+  live.request.rays_per_pixel = 1;
+  live.request.extra_rays_per_pixel = 0.5f;
+  live.request.accumulation.reproject = false;
+  live.prepare();
+  EXPECT_EQ(live.allocations_in([&] { live.frames(20); }), 0u);
+  const auto pull = [&](int k) {
+    live.request.camera.focus_distance_m = 0.3f + 0.05f * float(k % 20);
+  };
+  EXPECT_EQ(live.allocations_in([&] { live.frames(20, pull); }), 0u);
+}
+
 // Frames whose pose is not known yet go out as the camera image alone
 // (FrameRequest::plate_only), as a run's do until its tracker first finds
 // the board, and between them frames that accumulate.
