@@ -3,6 +3,7 @@
 // byte; a camera that goes away leaves the outputs running on the
 // placeholder and is taken up again; drops are counted, never hidden.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -241,6 +242,66 @@ TEST_F(RunLoop, ACalibratedTraceDrivesTheLens) {
     }
     EXPECT_EQ(composites, n) << (with_profile ? "with a profile" : "without");
   }
+}
+
+// The frame budget's rays a pixel are a mean in sixteenths of a ray
+// (frame_budget.h): between two whole numbers the frame gets the fraction
+// too, spends it, and the record says so. An offline take at 5 fps leaves
+// the budget room to grow past whole rays (1, 2, 3, 4.5, ...) however slow
+// the machine; the lens moves every frame (a tolerance of 0), so each frame
+// is a history's first, which gives its rays after the first where the
+// picture lacks them, nothing moved into it (a history of moved samples
+// traces whole rays: FrameRequest::extra_rays_per_pixel).
+TEST_F(RunLoop, TheBudgetsFractionOfARayIsTracedAndRecorded) {
+  const int w = 48, h = 32, n = 8;
+  const std::vector<std::vector<std::uint8_t>> frames(
+      n, std::vector<std::uint8_t>(std::size_t(w) * h * 2, 128));
+  std::string take = y4m_422(w, h, frames);
+  take.replace(take.find(" F25:1 "), 7, " F5:1 ");
+  const fs::path input = write("in.y4m", take);
+  std::string trace = "# camhead lens trace v1\nt_s,focus_m,f_stop,focal_mm\n";
+  for (int k = 0; k <= 2000; ++k) // 20 s at 100 Hz, the focus 0.5 m further each second
+    trace += std::to_string(0.01 * k) + "," + std::to_string(1.0 + 0.005 * k) + ",2.8,50\n";
+  const fs::path trace_file = write("pull.csv", trace);
+  // A lit virtual wall that fills the frame: every pixel traced.
+  const fs::path scene = write("wall.json", R"({"render": {"width": 48, "height": 32, "samples": 1},
+    "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0],
+               "focal_length_mm": 50, "sensor_width_mm": 36, "f_number": 2.8, "focus_distance_m": 2},
+    "materials": {"grey": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "objects": [{"name": "wall", "type": "plane", "center": [0, 0, -3], "size": [20, 20],
+                 "rotation_deg": [90, 0, 0], "material": "grey", "real": false}],
+    "lights": [{"name": "key", "type": "point", "position": [0, 1, -1], "power_W": 100}]})");
+  RunOptions options;
+  options.board = load_board(write("board.json", R"({"format": "camhead-board", "version": 1,
+    "name": "t", "lens": {"sources": [{"type": "trace", "file": ")" +
+                                                     trace_file.string() + R"("}]},
+    "camera": {"type": "file", "path": ")" + input.string() +
+                                                     R"(", "loop": false,
+               "realtime": false, "width": 48, "height": 32},
+    "scene": ")" + scene.string() + R"(",
+    "render": {"executor": "cpu", "max_rays_per_pixel": 8, "accumulate_tolerance_px": 0,
+               "reproject": false}})"));
+  options.outputs = {"null"};
+  options.stats_file = dir_ / "stats.jsonl";
+  options.status = nullptr;
+  (void)run_pipeline(options);
+  std::ifstream stats(dir_ / "stats.jsonl");
+  int composites = 0, with_a_fraction = 0;
+  for (std::string line; std::getline(stats, line);) {
+    if (line.find("\"kind\":\"composite\"") == std::string::npos)
+      continue;
+    ++composites;
+    const double rpp = json_number(line, "rpp");
+    EXPECT_EQ(rpp * 16.0, std::floor(rpp * 16.0)) << "not in sixteenths of a ray: " << line;
+    if (rpp != std::floor(rpp))
+      ++with_a_fraction;
+    ASSERT_EQ(json_number(line, "traced"), 1.0) << line;
+    // Shares are rounded at random, pixel by pixel: on average the budget.
+    const double traced_rpp = json_number(line, "camera_rays") / double(w * h);
+    EXPECT_NEAR(traced_rpp, rpp, 0.02 * rpp) << line;
+  }
+  EXPECT_EQ(composites, n);
+  EXPECT_GE(with_a_fraction, 1) << "the budget grew through whole rays alone";
 }
 
 TEST_F(RunLoop, RefusesABoardWithoutCameraOrOutput) {
