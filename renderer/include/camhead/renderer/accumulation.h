@@ -50,8 +50,9 @@ struct AccumulationSettings {
   // holds fewer (two pictures' worth: 13 frames of 1 rpp where the influence
   // region is 15 % of the picture, 9 where it is 22 %). 12 rather than 8
   // brings `camhead bench live`'s pull frame focused at 1.47 m from 1.12x
-  // 9 rpp's error to par with it (0.98-1.03x over five seeds), for about 1
-  // ms a pull frame (bench/RESULTS.md).
+  // 9 rpp's error to par with it (0.98-1.03x over five seeds then, 0.96-1.00x
+  // since the pixels' Sobol' keys), for about 1 ms a pull frame
+  // (bench/RESULTS.md).
   std::uint32_t reproject_frames = 12;
   // The most reproject_frames means: the store keeps no more frames.
   static constexpr std::uint32_t kMostReprojectFrames = 16;
