@@ -12,7 +12,10 @@
 // before moved through the new focus (accumulation.h, reproject) or, as
 // before that, afresh. Error = relative RMSE of the composite over the
 // influence region (elsewhere the composite is the camera image, exactly),
-// in linear light before the outputs' 8-bit rounding.
+// in linear light before the outputs' 8-bit rounding. For the pull frames,
+// also the speed-accuracy chart: error against frame time for fresh frames
+// and live ones across their rays per pixel, each time a median of three
+// measured in the same run.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -105,7 +108,7 @@ class Shot {
 public:
   Shot(const Scene &scene, const CompiledScene &compiled, const LensPoint &lens,
        const LiveArgs &args)
-      : args_(args), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
+      : scene_(scene), args_(args), camera_(camera_at(scene, lens)), format_(rgb24(scene)),
         renderer_(live_renderer(scene, args)) {
     // The camera image: the proxy alone through the same lens, 16 rpp.
     Scene real = scene;
@@ -184,6 +187,43 @@ public:
     return double(region_pixels_.size()) / double(std::size_t(format_.width) * format_.height);
   }
 
+  // For the chart of error against frame time: a method's error and the
+  // median of kTimings frame times, its frame rendered kTimings times with
+  // the same samples (the same error each time).
+  struct Timed {
+    double error = 0.0;
+    double seconds = 0.0;
+  };
+  static constexpr int kTimings = 3;
+
+  // A fresh frame of `rpp`, as uniform_error.
+  Timed timed_uniform(std::uint32_t rpp, std::uint32_t seed) {
+    std::array<double, kTimings> seconds{};
+    Timed t;
+    for (double &s : seconds) {
+      t.error = uniform_error(rpp, seed);
+      s = last_seconds_;
+    }
+    t.seconds = median(seconds);
+    return t;
+  }
+
+  // The last frame of a pull, as pull_error, each time on a new renderer:
+  // the one before would move its own last frames' samples into the first.
+  Timed timed_pull(double rpp, std::uint32_t seed, std::span<const float> focus_before,
+                   bool reproject) {
+    std::array<double, kTimings> seconds{};
+    Timed t;
+    for (double &s : seconds) {
+      renderer_ = live_renderer(scene_, args_);
+      std::uint32_t history = 0;
+      t.error = pull_error(rpp, seed, focus_before, reproject, &history);
+      s = last_seconds_;
+    }
+    t.seconds = median(seconds);
+    return t;
+  }
+
 private:
   FrameRequest live_request(const FrameCamera &camera, double rpp, std::uint32_t seed,
                             bool reproject) const {
@@ -208,7 +248,15 @@ private:
     const VideoBuffer target{format_, out_};
     const FrameReport report = renderer_->render(request, {format_, plate_}, std::span(&target, 1));
     check(report, what);
+    // What the frame budget counts of a frame (FrameBudget::measured): the
+    // camera frame in, the trace, the outputs out.
+    last_seconds_ = report.decode_s + report.trace_s + report.encode_s;
     return report;
+  }
+
+  static double median(std::array<double, kTimings> values) {
+    std::sort(values.begin(), values.end());
+    return values[kTimings / 2];
   }
 
   // Relative RMSE (compare.py's: RMSE / RMS of the reference) of the last
@@ -225,6 +273,7 @@ private:
     return std::sqrt(diff / ref);
   }
 
+  const Scene &scene_;
   const LiveArgs &args_;
   FrameCamera camera_;
   base::VideoFormat format_;
@@ -232,6 +281,7 @@ private:
   std::vector<std::uint8_t> plate_, out_, reference_picture_;
   std::vector<std::size_t> region_pixels_;
   std::vector<glm::vec4> reference_;
+  double last_seconds_ = 0.0;
 };
 
 struct RestCurve {
@@ -246,12 +296,38 @@ struct RestCurve {
   std::uint32_t afresh_samples = 0;
   // Pull frames: 1 rpp, the live frame, 9 rpp, the reference (RGB, 8 bits).
   std::vector<std::vector<std::uint8_t>> pictures;
+  // Pull frames: error and frame time of fresh frames (kUniformRays) and of
+  // live frames with the frames before moved and afresh (kLiveRays).
+  std::vector<Shot::Timed> uniform, moved, fresh;
 };
+
+// The rays per pixel of the chart of error against frame time: fresh frames
+// as before, and live frames across the frame budget's range on two cores
+// (1 to 2) and above it.
+constexpr std::array<std::uint32_t, 6> kUniformRays = {1, 2, 4, 9, 16, 49};
+constexpr std::array<double, 4> kLiveRays = {1.0, 1.5, 2.0, 4.0};
 
 std::string fmt(double v, const char *f = "%.4f") {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
+}
+
+// The frame time of a fresh frame as accurate as `error`, in ms: log-log
+// between the two fresh frames about it (their error falls as a power of
+// their time); beyond those measured, "< " the quickest's or "> " the
+// slowest's.
+std::string fresh_ms_for(std::span<const Shot::Timed> fresh, double error) {
+  if (error >= fresh.front().error)
+    return "< " + fmt(1e3 * fresh.front().seconds, "%.0f");
+  for (std::size_t k = 0; k + 1 < fresh.size(); ++k) {
+    const Shot::Timed &a = fresh[k], &b = fresh[k + 1];
+    if (error >= b.error && a.error > b.error) {
+      const double f = std::log(a.error / error) / std::log(a.error / b.error);
+      return fmt(1e3 * a.seconds * std::pow(b.seconds / a.seconds, f), "%.0f");
+    }
+  }
+  return "> " + fmt(1e3 * fresh.back().seconds, "%.0f");
 }
 
 void write_canvas(const fs::path &png, const chart::Canvas &canvas) {
@@ -315,6 +391,92 @@ void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
                                                        ", still shots: error against time",
                                                    panels, 520, 420);
   write_canvas(args.out_dir / "live.png", canvas);
+}
+
+// The pull frames' error against frame time, as a table: each live frame's
+// error and time, and the time of a fresh frame as accurate (interpolated
+// between the fresh frames measured), so that the live frame's gain is a
+// ratio of two times measured in the same run.
+void print_speed(const LiveArgs &args, const std::vector<RestCurve> &pull) {
+  std::printf("\nError against frame time (the render call: camera frame in, trace, outputs "
+              "out; medians of %d), the %s executor:\n\n| pull frame | fresh 1 / 2 / 4 / 9 / "
+              "16 / 49 rpp: ms | live, frames before moved, 1 / 1.5 / 2 / 4 rpp: error at ms "
+              "(a fresh frame as accurate: ms) |\n|---|---|---|\n",
+              Shot::kTimings, args.executor.c_str());
+  for (const RestCurve &c : pull) {
+    std::string fresh, live;
+    for (const Shot::Timed &t : c.uniform)
+      fresh += (fresh.empty() ? "" : " / ") + fmt(1e3 * t.seconds, "%.1f");
+    for (const Shot::Timed &t : c.moved) {
+      live += (live.empty() ? "" : ", ") + fmt(t.error) + " at " + fmt(1e3 * t.seconds, "%.1f") +
+              " (" + fresh_ms_for(c.uniform, t.error) + ")";
+    }
+    std::printf("| %s | %s | %s |\n", c.lens.name.c_str(), fresh.c_str(), live.c_str());
+  }
+}
+
+// DIR/live_speed.csv and DIR/live_speed.png: the pull frames' error against
+// frame time, each method a curve of rays per pixel, the camera's frame
+// time a vertical line.
+void write_speed(const LiveArgs &args, const std::vector<RestCurve> &pull) {
+  const fs::path csv_path = args.out_dir / "live_speed.csv";
+  std::ofstream csv(csv_path);
+  if (!csv)
+    throw std::runtime_error("cannot write " + csv_path.string());
+  csv << "frame,method,rpp,frame_ms,error\n";
+  for (const RestCurve &c : pull) {
+    const auto rows = [&](const char *method, std::span<const Shot::Timed> points,
+                          const auto &rays) {
+      for (std::size_t k = 0; k < points.size(); ++k)
+        csv << c.lens.name << "," << method << "," << rays_text(double(rays[k])) << ","
+            << fmt(1e3 * points[k].seconds, "%.3f") << "," << fmt(points[k].error, "%.6g") << "\n";
+    };
+    rows("fresh", c.uniform, kUniformRays);
+    rows("live_moved", c.moved, kLiveRays);
+    rows("live_afresh", c.fresh, kLiveRays);
+  }
+  std::printf("wrote %s\n", csv_path.string().c_str());
+
+  std::vector<chart::Panel> panels;
+  for (const RestCurve &c : pull) {
+    chart::Panel panel;
+    panel.title = c.lens.name;
+    panel.x_label = "ms a frame";
+    panel.y_label = "rel. RMSE over the region";
+    const auto series = [](std::string name, chart::Rgb color, chart::Marker marker,
+                           std::span<const Shot::Timed> points, const auto &rays) {
+      chart::Series s{std::move(name), color, marker, {}, {}, {}};
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        s.x.push_back(1e3 * points[k].seconds);
+        s.y.push_back(points[k].error);
+        s.labels.push_back(rays_text(double(rays[k])));
+      }
+      return s;
+    };
+    panel.series = {
+        series("fresh frames (rpp)", {200, 120, 30}, chart::Marker::square, c.uniform,
+               kUniformRays),
+        series("live, the frames before moved", {30, 90, 200}, chart::Marker::circle, c.moved,
+               kLiveRays),
+        series("live, afresh", {120, 120, 120}, chart::Marker::triangle, c.fresh, kLiveRays)};
+    double lo = 1.0, hi = 0.0;
+    for (const chart::Series &s : panel.series)
+      for (const double y : s.y) {
+        lo = std::min(lo, y);
+        hi = std::max(hi, y);
+      }
+    const double frame_ms = 1e3 / args.fps;
+    panel.series.push_back({"the camera's frame",
+                            {200, 40, 40},
+                            chart::Marker::diamond,
+                            {frame_ms, frame_ms},
+                            {lo, hi},
+                            {}});
+    panels.push_back(std::move(panel));
+  }
+  const chart::Canvas canvas = chart::plot_log_log(
+      "pull frames on the " + args.executor + ": error against frame time", panels, 520, 420);
+  write_canvas(args.out_dir / "live_speed.png", canvas);
 }
 
 // DIR/live_pull.png: the pull frames side by side, cropped around the first
@@ -455,6 +617,15 @@ int run_live(LiveArgs args) {
           c.pictures.push_back(shot.picture());
           c.pictures.push_back(nine);
           c.pictures.push_back(shot.reference_picture());
+          base::ProgressLine progress(lens.name + ": error against frame time");
+          for (const std::uint32_t rpp : kUniformRays)
+            c.uniform.push_back(shot.timed_uniform(rpp, salt + 0x1000u + rpp));
+          const std::vector<float> before = approach(lens);
+          for (const double rpp : kLiveRays) {
+            c.moved.push_back(shot.timed_pull(rpp, salt + 0x2000u, before, true));
+            c.fresh.push_back(shot.timed_pull(rpp, salt + 0x2000u, before, false));
+          }
+          progress.finish();
         }
         (is_still ? rest : pull).push_back(std::move(c));
       }
@@ -492,8 +663,10 @@ int run_live(LiveArgs args) {
     if (args.executor == "gpu")
       std::printf("\n(The GPU executor moves no samples through a new focus: its pull frames "
                   "start afresh either way.)\n");
+    print_speed(args, pull);
     std::printf("\n");
     write_outputs(args, rest, pull);
+    write_speed(args, pull);
     write_pull_pictures(args, scene, pull);
     return 0;
   } catch (const std::exception &e) {
@@ -516,9 +689,13 @@ void add_bench_live_command(CLI::App &bench) {
               "through the new focus, and afresh; each against a --ref-rpp reference of\n"
               "the same camera (the CPU reference's) and against fresh frames of 1, 9 and\n"
               "49 rays per pixel measured in the same run. Error: relative RMSE of the\n"
-              "composite over the influence region, linear light. Writes DIR/live.csv,\n"
-              "DIR/live.png (the error against time) and DIR/live_pull.png (the pull\n"
-              "frames, cropped). About 3 minutes on 2 cores for the simulated rig.\n"
+              "composite over the influence region, linear light. For the pull frames,\n"
+              "also their error against frame time: fresh frames of 1 to 49 rpp and live\n"
+              "frames of 1 to 4, each frame's time the median of three. Writes\n"
+              "DIR/live.csv, DIR/live.png (the error against time), DIR/live_speed.csv,\n"
+              "DIR/live_speed.png (the pull frames' error against frame time) and\n"
+              "DIR/live_pull.png (the pull frames, cropped). About 5 minutes on 2 cores\n"
+              "for the simulated rig.\n"
               "Example:\n"
               "  camhead bench live -o /tmp/live");
   cmd->add_option("--scene", args->scene, "Scene file (default: the simulated rig's)")
