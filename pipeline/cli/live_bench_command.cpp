@@ -170,16 +170,22 @@ public:
 
   // The live frame at the end of a pull through `focus_before` (metres, the
   // frames before it, in order), each frame `rpp` rays; with `reproject`,
-  // each frame's history starts with the frames before it moved.
+  // each frame's history starts with the frames before it moved. On a new
+  // renderer: the one before would move its own last frames' samples into
+  // the pull's first, or go on with its pattern.
   double pull_error(double rpp, std::uint32_t seed, std::span<const float> focus_before,
                     bool reproject, std::uint32_t *history) {
+    renderer_ = live_renderer(scene_, args_);
     for (std::size_t k = 0; k < focus_before.size(); ++k) {
       FrameCamera camera = camera_;
       camera.focus_distance_m = focus_before[k];
       (void)render(live_request(camera, rpp, seed + 1 + std::uint32_t(k), reproject),
                    "a pull frame");
     }
-    *history = render(live_request(camera_, rpp, seed, reproject), "a pull frame").history_samples;
+    const FrameReport last = render(live_request(camera_, rpp, seed, reproject), "a pull frame");
+    *history = last.history_samples;
+    last_rays_ =
+        last.traced_pixels > 0 ? double(last.camera_rays) / double(last.traced_pixels) : 0.0;
     return error();
   }
 
@@ -193,6 +199,8 @@ public:
   struct Timed {
     double error = 0.0;
     double seconds = 0.0;
+    double rays = 0.0; // a pixel of the region, as traced (a pull frame of
+                       // moved samples spends no fraction of a ray)
   };
   static constexpr int kTimings = 3;
 
@@ -205,22 +213,22 @@ public:
       s = last_seconds_;
     }
     t.seconds = median(seconds);
+    t.rays = rpp;
     return t;
   }
 
-  // The last frame of a pull, as pull_error, each time on a new renderer:
-  // the one before would move its own last frames' samples into the first.
+  // The last frame of a pull, as pull_error.
   Timed timed_pull(double rpp, std::uint32_t seed, std::span<const float> focus_before,
                    bool reproject) {
     std::array<double, kTimings> seconds{};
     Timed t;
     for (double &s : seconds) {
-      renderer_ = live_renderer(scene_, args_);
       std::uint32_t history = 0;
       t.error = pull_error(rpp, seed, focus_before, reproject, &history);
       s = last_seconds_;
     }
     t.seconds = median(seconds);
+    t.rays = last_rays_;
     return t;
   }
 
@@ -282,6 +290,7 @@ private:
   std::vector<std::size_t> region_pixels_;
   std::vector<glm::vec4> reference_;
   double last_seconds_ = 0.0;
+  double last_rays_ = 0.0;
 };
 
 struct RestCurve {
@@ -311,6 +320,12 @@ std::string fmt(double v, const char *f = "%.4f") {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
+}
+
+// A fresh frame's seed, the same for its rays per pixel wherever it is
+// measured: 0x1000 and the number's decimal digits as hex (49: 0x1049).
+std::uint32_t uniform_seed(std::uint32_t salt, std::uint32_t rpp) {
+  return salt + 0x1000u + (rpp / 10u) * 16u + rpp % 10u;
 }
 
 // The frame time of a fresh frame as accurate as `error`, in ms: log-log
@@ -413,6 +428,12 @@ void print_speed(const LiveArgs &args, const std::vector<RestCurve> &pull) {
     }
     std::printf("| %s | %s | %s |\n", c.lens.name.c_str(), fresh.c_str(), live.c_str());
   }
+  std::printf("\n(A pull frame of moved samples traces whole rays: 1.5 rpp traces 1, but in "
+              "the pull's first frame.%s)\n",
+              args.executor == "gpu" ? " The GPU's times include reading the composite back "
+                                       "for the error, which camhead run's frames do not; its "
+                                       "frames trace whole rays and move no samples."
+                                     : "");
 }
 
 // DIR/live_speed.csv and DIR/live_speed.png: the pull frames' error against
@@ -423,13 +444,16 @@ void write_speed(const LiveArgs &args, const std::vector<RestCurve> &pull) {
   std::ofstream csv(csv_path);
   if (!csv)
     throw std::runtime_error("cannot write " + csv_path.string());
-  csv << "frame,method,rpp,frame_ms,error\n";
+  // rpp: what the frame was given; traced_rpp: what it traced (a pull frame
+  // of moved samples spends no fraction of a ray).
+  csv << "frame,method,rpp,traced_rpp,frame_ms,error\n";
   for (const RestCurve &c : pull) {
     const auto rows = [&](const char *method, std::span<const Shot::Timed> points,
                           const auto &rays) {
       for (std::size_t k = 0; k < points.size(); ++k)
         csv << c.lens.name << "," << method << "," << rays_text(double(rays[k])) << ","
-            << fmt(1e3 * points[k].seconds, "%.3f") << "," << fmt(points[k].error, "%.6g") << "\n";
+            << fmt(points[k].rays, "%.4g") << "," << fmt(1e3 * points[k].seconds, "%.3f") << ","
+            << fmt(points[k].error, "%.6g") << "\n";
     };
     rows("fresh", c.uniform, kUniformRays);
     rows("live_moved", c.moved, kLiveRays);
@@ -443,22 +467,21 @@ void write_speed(const LiveArgs &args, const std::vector<RestCurve> &pull) {
     panel.title = c.lens.name;
     panel.x_label = "ms a frame";
     panel.y_label = "rel. RMSE over the region";
+    // Each point labelled with the rays a pixel it traced.
     const auto series = [](std::string name, chart::Rgb color, chart::Marker marker,
-                           std::span<const Shot::Timed> points, const auto &rays) {
+                           std::span<const Shot::Timed> points) {
       chart::Series s{std::move(name), color, marker, {}, {}, {}};
-      for (std::size_t k = 0; k < points.size(); ++k) {
-        s.x.push_back(1e3 * points[k].seconds);
-        s.y.push_back(points[k].error);
-        s.labels.push_back(rays_text(double(rays[k])));
+      for (const Shot::Timed &p : points) {
+        s.x.push_back(1e3 * p.seconds);
+        s.y.push_back(p.error);
+        s.labels.push_back(fmt(p.rays, "%.2g"));
       }
       return s;
     };
     panel.series = {
-        series("fresh frames (rpp)", {200, 120, 30}, chart::Marker::square, c.uniform,
-               kUniformRays),
-        series("live, the frames before moved", {30, 90, 200}, chart::Marker::circle, c.moved,
-               kLiveRays),
-        series("live, afresh", {120, 120, 120}, chart::Marker::triangle, c.fresh, kLiveRays)};
+        series("fresh frames (rays a pixel)", {200, 120, 30}, chart::Marker::square, c.uniform),
+        series("live, the frames before moved", {30, 90, 200}, chart::Marker::circle, c.moved),
+        series("live, afresh", {120, 120, 120}, chart::Marker::triangle, c.fresh)};
     double lo = 1.0, hi = 0.0;
     for (const chart::Series &s : panel.series)
       for (const double y : s.y) {
@@ -589,12 +612,12 @@ int run_live(LiveArgs args) {
         RestCurve c;
         c.lens = lens;
         c.region = shot.region_fraction();
-        c.uniform1 = shot.uniform_error(1, salt + 0x1001u);
+        c.uniform1 = shot.uniform_error(1, uniform_seed(salt, 1));
         if (!is_still)
           c.pictures.push_back(shot.picture());
-        c.uniform9 = shot.uniform_error(9, salt + 0x1009u);
+        c.uniform9 = shot.uniform_error(9, uniform_seed(salt, 9));
         const std::vector<std::uint8_t> nine = shot.picture();
-        c.uniform49 = shot.uniform_error(49, salt + 0x1049u);
+        c.uniform49 = shot.uniform_error(49, uniform_seed(salt, 49));
         // Still: frame after frame; pulling: the state's frame at the end
         // of the pull, afresh, then with the frames before moved.
         if (is_still) {
@@ -619,7 +642,7 @@ int run_live(LiveArgs args) {
           c.pictures.push_back(shot.reference_picture());
           base::ProgressLine progress(lens.name + ": error against frame time");
           for (const std::uint32_t rpp : kUniformRays)
-            c.uniform.push_back(shot.timed_uniform(rpp, salt + 0x1000u + rpp));
+            c.uniform.push_back(shot.timed_uniform(rpp, uniform_seed(salt, rpp)));
           const std::vector<float> before = approach(lens);
           for (const double rpp : kLiveRays) {
             c.moved.push_back(shot.timed_pull(rpp, salt + 0x2000u, before, true));

@@ -57,10 +57,11 @@ struct DefocusFilterSettings {
   // own counts, which holds the rule only nearly on the diagonals. Not for
   // a history of samples moved from the frames before
   // (sample_store.h), whose counts differ by where the samples land: there
-  // it made the rigs' pull frames up to 6 % noisier under three seeds, though
-  // the faster pull of tests/renderer/reprojection_test.cpp's ball 25 %
-  // less noisy (bench/RESULTS.md). The GPU executor's pixels all hold the
-  // same samples, and lend whole.
+  // it made the rigs' pull frames up to 6.5 % noisier under three seeds,
+  // though the faster pull of tests/renderer/reprojection_test.cpp's ball
+  // 25 % less noisy through an ideal lens (2 % through a distorting one;
+  // bench/RESULTS.md). The GPU executor's pixels all hold the same samples,
+  // and lend whole.
   bool lend_up_to_own = false;
 };
 

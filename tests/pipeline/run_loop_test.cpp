@@ -247,11 +247,13 @@ TEST_F(RunLoop, ACalibratedTraceDrivesTheLens) {
 // The frame budget's rays a pixel are a mean in sixteenths of a ray
 // (frame_budget.h): between two whole numbers the frame gets the fraction
 // too, spends it, and the record says so. An offline take at 5 fps leaves
-// the budget room to grow past whole rays (1, 2, 3, 4.5, ...) however slow
-// the machine; the lens moves every frame (a tolerance of 0), so each frame
-// is a history's first, which gives its rays after the first where the
-// picture lacks them, nothing moved into it (a history of moved samples
-// traces whole rays: FrameRequest::extra_rays_per_pixel).
+// the budget room to grow from one ray to the board's most through
+// fractions (1, 2, 3, 4.4375, 6.625, 8 here) on any machine that renders
+// these 48x32 pixels in well under 200 ms; the lens moves every frame (a
+// tolerance of 0), so each frame is a history's first, which gives its rays
+// after the first where the picture lacks them, nothing moved into it (a
+// history of moved samples traces whole rays:
+// FrameRequest::extra_rays_per_pixel).
 TEST_F(RunLoop, TheBudgetsFractionOfARayIsTracedAndRecorded) {
   const int w = 48, h = 32, n = 8;
   const std::vector<std::vector<std::uint8_t>> frames(
@@ -296,9 +298,11 @@ TEST_F(RunLoop, TheBudgetsFractionOfARayIsTracedAndRecorded) {
     if (rpp != std::floor(rpp))
       ++with_a_fraction;
     ASSERT_EQ(json_number(line, "traced"), 1.0) << line;
-    // Shares are rounded at random, pixel by pixel: on average the budget.
+    // Shares are rounded at random, pixel by pixel: on average the budget,
+    // within 0.013 rays (the rounding's standard deviation over 1536
+    // pixels); the bound is 5 of those, or 2 %.
     const double traced_rpp = json_number(line, "camera_rays") / double(w * h);
-    EXPECT_NEAR(traced_rpp, rpp, 0.02 * rpp) << line;
+    EXPECT_NEAR(traced_rpp, rpp, std::max(0.02 * rpp, 0.065)) << line;
   }
   EXPECT_EQ(composites, n);
   EXPECT_GE(with_a_fraction, 1) << "the budget grew through whole rays alone";
