@@ -25,6 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace renderer;
 
+constexpr const char *kErrorLabel = "rel. RMSE over the region";
+
 // The frame time of a fresh frame as accurate as `error`, in ms: log-log
 // between the two fresh frames about it (their error falls as a power of
 // their time); beyond those measured, "< " the quickest's or "> " the
@@ -80,10 +82,7 @@ void write_outputs(const LiveArgs &args, const std::vector<RestCurve> &rest,
 
   std::vector<chart::Panel> panels;
   for (const RestCurve &c : rest) {
-    chart::Panel panel;
-    panel.title = c.lens.name;
-    panel.x_label = "seconds since the lens came to rest";
-    panel.y_label = "rel. RMSE over the region";
+    chart::Panel panel{c.lens.name, "seconds since the lens came to rest", kErrorLabel, {}};
     chart::Series live{"live, " + rays_text(args.rpp) + " rpp a frame, accumulated",
                        {30, 90, 200},
                        chart::Marker::circle,
@@ -160,10 +159,7 @@ void write_speed(const LiveArgs &args, const std::vector<RestCurve> &pull) {
 
   std::vector<chart::Panel> panels;
   for (const RestCurve &c : pull) {
-    chart::Panel panel;
-    panel.title = c.lens.name;
-    panel.x_label = "ms a frame";
-    panel.y_label = "rel. RMSE over the region";
+    chart::Panel panel{c.lens.name, "ms a frame", kErrorLabel, {}};
     // Each point labelled with the rays a pixel it traced.
     const auto series = [](std::string name, chart::Rgb color, chart::Marker marker,
                            std::span<const TimedFrame> points) {
